@@ -1,0 +1,47 @@
+"""encctl-gym: adversarial experiments on encrypted control systems.
+
+Layers, importing downward only::
+
+    crypto (arith -> group -> encoding -> elgamal -> dyn_elgamal -> modified -> controller)
+    sim (plant, identification, parallel)
+    security (pure math, beside the others)
+    envs (the Gymnasium environment)
+
+Implements K. Teranishi and K. Kogiso, "Optimal Security Parameter for Encrypted Control
+Systems Against Eavesdropper and Malicious Server" (arXiv 2303.13059).
+"""
+
+from __future__ import annotations
+
+from .errors import (
+    BudgetError,
+    CiphertextError,
+    ConfigError,
+    EncctlError,
+    EncodingOverflowError,
+    GroupError,
+    KeyMismatchError,
+    ParameterError,
+    PlaintextError,
+    ShapeError,
+    SolverError,
+    UnstableSystemError,
+)
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "__version__",
+    "EncctlError",
+    "ParameterError",
+    "ShapeError",
+    "UnstableSystemError",
+    "GroupError",
+    "KeyMismatchError",
+    "PlaintextError",
+    "CiphertextError",
+    "EncodingOverflowError",
+    "SolverError",
+    "BudgetError",
+    "ConfigError",
+]
