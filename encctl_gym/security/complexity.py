@@ -1,0 +1,331 @@
+"""Sample identifying complexity (Definition def:sic) of the plant eq:system.
+
+Implements
+
+* the estimation error of Definition def:error,
+  ``epsilon = ||[A B] - [A_hat B_hat]||_F^2 / (n (n + m))``;
+* Theorem thm:sic (eq:sic), the complexity for i.i.d. Gaussian attack inputs,
+
+  ``gamma(N) = (m+n) sigma_w2 / (sigma_x2 tr Psi_w + (N-1) [sigma_u2 (tr Psi_u + m) + sigma_w2 tr Psi_w])``;
+* the Corollary (eq:sic2), its large-N form with ``R_sigma = sigma_u2 / sigma_w2``,
+
+  ``gamma(N) = (m+n) / ((N-1) [R_sigma (tr Psi_u + m) + tr Psi_w])``;
+* the upper bounds eq:bound ``(m+n) / ((N-1) m R_sigma)`` and ``(m+n) / ((N-1) n)``.
+
+Every function comes in a trace-level form (``*_from_traces``) that needs no matrices, so the
+paper's design example (``Psi_w = 2I``, ``Psi_u = 0.5I``) can be evaluated without a plant.
+
+The sample size ``N`` (Definition def:adversary) is the number of pairs (u_t, x_t); the least
+squares of eq:estimate uses ``N - 1`` regression columns, so ``N`` must be an integer >= 2
+(scalar or array; the result has the same shape). ``sigma_x2`` (the variance of x_0 in
+Theorem thm:sic) is kept apart from ``sigma_w2``; the threat model of the paper draws x_0
+with variance ``sigma_w2`` and its simulations use ``sigma_x2 = 1``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .._validation import (
+    as_finite_array,
+    check_int,
+    check_nonnegative,
+    check_positive,
+    check_system,
+)
+from ..errors import ParameterError, ShapeError
+from .gramians import controllability_gramian, noise_gramian
+
+__all__ = [
+    "estimation_error",
+    "sample_identifying_complexity",
+    "sample_identifying_complexity_asymptotic",
+    "sic_from_traces",
+    "sic_asymptotic_from_traces",
+    "sic2_denominator",
+    "input_upper_bound",
+    "noise_upper_bound",
+    "check_sample_size",
+]
+
+
+
+def check_sample_size(N: Any, name: str = "N") -> tuple[np.ndarray, bool]:
+    """Validate a sample size (scalar or array of integers >= 2).
+
+    Parameters
+    ----------
+    N : int or array_like of int
+        Sample size(s) of Definition def:adversary.
+    name : str
+        Name used in error messages.
+
+    Returns
+    -------
+    (ndarray of float64, bool)
+        The sizes as floats and whether ``N`` was a scalar.
+
+    Raises
+    ------
+    ParameterError
+        If any entry is not an integer or is smaller than 2.
+    """
+    if np.ndim(N) == 0:
+        return np.asarray(float(check_int(name, N if not isinstance(N, np.ndarray) else N.item(), 2))), True
+    arr = as_finite_array(name, N)
+    if not np.all(arr == np.round(arr)):
+        raise ParameterError(f"{name} must contain integers, got {np.asarray(N)!r}")
+    if np.any(arr < 2):
+        raise ParameterError(f"{name} must be >= 2 (N - 1 regression columns), got min {arr.min():g}")
+    return arr, False
+
+
+def _out(value: np.ndarray, scalar: bool) -> float | np.ndarray:
+    return float(value) if scalar else value
+
+
+def estimation_error(A: Any, B: Any, A_hat: Any, B_hat: Any) -> float | np.ndarray:
+    """Estimation error of Definition def:error.
+
+    ``epsilon = ||[A B] - [A_hat B_hat]||_F^2 / (n (n + m))``.
+
+    Parameters
+    ----------
+    A, B : array_like, shapes (n, n) and (n, m)
+        True plant matrices of eq:system.
+    A_hat, B_hat : array_like, shapes (..., n, n) and (..., n, m)
+        Estimates (e.g. from eq:estimate); leading batch dimensions broadcast against each
+        other.
+
+    Returns
+    -------
+    float or ndarray
+        A float for unbatched estimates, else an array of the broadcast batch shape.
+
+    Raises
+    ------
+    ShapeError
+        If the trailing shapes of the estimates do not match ``A`` and ``B``.
+    """
+    A, B = check_system(A, B)
+    n, m = B.shape
+    A_hat = as_finite_array("A_hat", A_hat)
+    B_hat = as_finite_array("B_hat", B_hat)
+    if B_hat.ndim == 1 and m == 1 and B_hat.shape[0] == n:
+        B_hat = B_hat.reshape(n, 1)
+    if A_hat.ndim < 2 or A_hat.shape[-2:] != (n, n):
+        raise ShapeError(f"A_hat must have shape (..., {n}, {n}), got {A_hat.shape}")
+    if B_hat.ndim < 2 or B_hat.shape[-2:] != (n, m):
+        raise ShapeError(f"B_hat must have shape (..., {n}, {m}), got {B_hat.shape}")
+    try:
+        batch = np.broadcast_shapes(A_hat.shape[:-2], B_hat.shape[:-2])
+    except ValueError as exc:
+        raise ShapeError(
+            f"batch shapes of A_hat {A_hat.shape[:-2]} and B_hat {B_hat.shape[:-2]} do not broadcast"
+        ) from exc
+    ea = np.sum((A_hat - A) ** 2, axis=(-2, -1))
+    eb = np.sum((B_hat - B) ** 2, axis=(-2, -1))
+    err = np.broadcast_to(ea + eb, batch) / (n * (n + m))
+    return float(err) if batch == () else np.array(err)
+
+
+def _check_dims(m: Any, n: Any) -> tuple[int, int]:
+    return check_int("m", m, 1), check_int("n", n, 1)
+
+
+def sic2_denominator(tr_psi_u: float, tr_psi_w: float, m: int, r_sigma: float) -> float:
+    """The bracket ``R_sigma (tr Psi_u + m) + tr Psi_w`` of eq:sic2 and eq:opt_sec.
+
+    Parameters
+    ----------
+    tr_psi_u : float
+        ``tr(Psi_u) >= 0``.
+    tr_psi_w : float
+        ``tr(Psi_w) > 0``.
+    m : int
+        Input dimension.
+    r_sigma : float
+        Variance ratio ``R_sigma = sigma_u2 / sigma_w2 > 0``.
+
+    Returns
+    -------
+    float
+    """
+    tr_u = check_nonnegative("tr_psi_u", tr_psi_u)
+    tr_w = check_positive("tr_psi_w", tr_psi_w)
+    m = check_int("m", m, 1)
+    r = check_positive("r_sigma", r_sigma)
+    return r * (tr_u + m) + tr_w
+
+
+def sic_from_traces(
+    N: Any,
+    tr_psi_u: float,
+    tr_psi_w: float,
+    m: int,
+    n: int,
+    sigma_u2: float,
+    sigma_w2: float,
+    sigma_x2: float = 1.0,
+) -> float | np.ndarray:
+    """Sample identifying complexity eq:sic (Theorem thm:sic) from the Gramian traces.
+
+    ``gamma(N) = (m+n) sigma_w2 / (sigma_x2 tr Psi_w + (N-1)[sigma_u2 (tr Psi_u + m) + sigma_w2 tr Psi_w])``.
+
+    Parameters
+    ----------
+    N : int or array_like of int
+        Sample size(s), integers >= 2.
+    tr_psi_u, tr_psi_w : float
+        Traces of the Gramians ``Psi_u`` (>= 0) and ``Psi_w`` (> 0).
+    m, n : int
+        Input and state dimensions.
+    sigma_u2, sigma_w2 : float
+        Variances (> 0) of the attack input and of the noise.
+    sigma_x2 : float, default 1.0
+        Variance (>= 0) of the initial state x_0.
+
+    Returns
+    -------
+    float or ndarray
+        Same shape as ``N``.
+    """
+    Nf, scalar = check_sample_size(N)
+    m, n = _check_dims(m, n)
+    tr_u = check_nonnegative("tr_psi_u", tr_psi_u)
+    tr_w = check_positive("tr_psi_w", tr_psi_w)
+    su = check_positive("sigma_u2", sigma_u2)
+    sw = check_positive("sigma_w2", sigma_w2)
+    sx = check_nonnegative("sigma_x2", sigma_x2)
+    den = sx * tr_w + (Nf - 1.0) * (su * (tr_u + m) + sw * tr_w)
+    return _out((m + n) * sw / den, scalar)
+
+
+def sic_asymptotic_from_traces(
+    N: Any, tr_psi_u: float, tr_psi_w: float, m: int, n: int, r_sigma: float
+) -> float | np.ndarray:
+    """Large-sample complexity eq:sic2 (Corollary of Theorem thm:sic) from the Gramian traces.
+
+    ``gamma(N) = (m+n) / ((N-1) [R_sigma (tr Psi_u + m) + tr Psi_w])``.
+
+    Parameters
+    ----------
+    N : int or array_like of int
+        Sample size(s), integers >= 2.
+    tr_psi_u, tr_psi_w : float
+        Traces of ``Psi_u`` (>= 0) and ``Psi_w`` (> 0).
+    m, n : int
+        Input and state dimensions.
+    r_sigma : float
+        ``R_sigma = sigma_u2 / sigma_w2 > 0``.
+
+    Returns
+    -------
+    float or ndarray
+        Same shape as ``N``.
+    """
+    Nf, scalar = check_sample_size(N)
+    m, n = _check_dims(m, n)
+    den = sic2_denominator(tr_psi_u, tr_psi_w, m, r_sigma)
+    return _out((m + n) / ((Nf - 1.0) * den), scalar)
+
+
+def sample_identifying_complexity(
+    N: Any, A: Any, B: Any, *, sigma_u2: float, sigma_w2: float, sigma_x2: float = 1.0
+) -> float | np.ndarray:
+    """Sample identifying complexity eq:sic (Theorem thm:sic) of the plant ``(A, B)``.
+
+    Parameters
+    ----------
+    N : int or array_like of int
+        Sample size(s), integers >= 2.
+    A, B : array_like, shapes (n, n) and (n, m)
+        Plant of eq:system; ``A`` Schur stable.
+    sigma_u2, sigma_w2 : float
+        Variances (> 0) of the i.i.d. Gaussian attack input and of the noise.
+    sigma_x2 : float, default 1.0
+        Variance (>= 0) of x_0.
+
+    Returns
+    -------
+    float or ndarray
+        ``gamma(N)``, same shape as ``N``.
+
+    Raises
+    ------
+    UnstableSystemError, ShapeError, ParameterError
+    """
+    A, B = check_system(A, B)
+    n, m = B.shape
+    tr_u = float(np.trace(controllability_gramian(A, B)))
+    tr_w = float(np.trace(noise_gramian(A)))
+    return sic_from_traces(N, tr_u, tr_w, m, n, sigma_u2, sigma_w2, sigma_x2)
+
+
+def sample_identifying_complexity_asymptotic(N: Any, A: Any, B: Any, *, r_sigma: float) -> float | np.ndarray:
+    """Large-sample complexity eq:sic2 of the plant ``(A, B)``.
+
+    Parameters
+    ----------
+    N : int or array_like of int
+        Sample size(s), integers >= 2.
+    A, B : array_like, shapes (n, n) and (n, m)
+        Plant of eq:system; ``A`` Schur stable.
+    r_sigma : float
+        ``R_sigma = sigma_u2 / sigma_w2 > 0``.
+
+    Returns
+    -------
+    float or ndarray
+        Same shape as ``N``.
+    """
+    A, B = check_system(A, B)
+    n, m = B.shape
+    tr_u = float(np.trace(controllability_gramian(A, B)))
+    tr_w = float(np.trace(noise_gramian(A)))
+    return sic_asymptotic_from_traces(N, tr_u, tr_w, m, n, r_sigma)
+
+
+def input_upper_bound(N: Any, m: int, n: int, r_sigma: float) -> float | np.ndarray:
+    """Upper bound eq:bound of eq:sic2 as ``tr Psi_u -> 0``: ``(m+n) / ((N-1) m R_sigma)``.
+
+    Parameters
+    ----------
+    N : int or array_like of int
+        Sample size(s), integers >= 2.
+    m, n : int
+        Input and state dimensions.
+    r_sigma : float
+        ``R_sigma > 0``.
+
+    Returns
+    -------
+    float or ndarray
+    """
+    Nf, scalar = check_sample_size(N)
+    m, n = _check_dims(m, n)
+    r = check_positive("r_sigma", r_sigma)
+    return _out((m + n) / ((Nf - 1.0) * m * r), scalar)
+
+
+def noise_upper_bound(N: Any, m: int, n: int) -> float | np.ndarray:
+    """Upper bound of eq:sic2 for small ``R_sigma`` (after eq:bound): ``(m+n) / ((N-1) n)``.
+
+    It holds because ``tr Psi_w >= n`` (with equality only for ``A = 0``).
+
+    Parameters
+    ----------
+    N : int or array_like of int
+        Sample size(s), integers >= 2.
+    m, n : int
+        Input and state dimensions.
+
+    Returns
+    -------
+    float or ndarray
+    """
+    Nf, scalar = check_sample_size(N)
+    m, n = _check_dims(m, n)
+    return _out((m + n) / ((Nf - 1.0) * n), scalar)
