@@ -1,7 +1,7 @@
 """Numerical engine: the plant of eq:system, least-squares identification (eq:estimate) and
 its error (Definition def:error) on grids of sample sizes, and seeded parallel sweeps.
 
-Modules import downward only: ``plant -> identification -> parallel``.
+Modules import downward only: ``plant -> identification -> parallel -> montecarlo``.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ from .identification import (
     least_squares,
     prefix_estimates,
 )
+from .montecarlo import AttackSpec, gaussian_attack_errors, log_grid, sweep_gaussian_attack
 from .parallel import child_seeds, run_tasks
 from .plant import LinearPlant, SimulationResult, simulate, simulate_gaussian_attack
 
@@ -28,4 +29,8 @@ __all__ = [
     "identification_errors",
     "child_seeds",
     "run_tasks",
+    "AttackSpec",
+    "log_grid",
+    "gaussian_attack_errors",
+    "sweep_gaussian_attack",
 ]

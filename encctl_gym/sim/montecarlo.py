@@ -1,0 +1,163 @@
+"""Monte Carlo estimation errors of the paper's attacker, for one system or a sweep.
+
+One task = one system: ``runs`` trajectories of length ``N_max`` under i.i.d. Gaussian attack
+inputs (Theorem thm:sic), and the error ``epsilon(N)`` of Definition def:error on a whole grid
+of sample sizes from each trajectory (:func:`~encctl_gym.sim.identification.identification_errors`).
+A sweep spreads systems over workers with :func:`~encctl_gym.sim.parallel.run_tasks`, one
+child seed per system.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal, Sequence
+
+import numpy as np
+
+from .._validation import check_int, check_nonnegative
+from ..errors import ParameterError
+from .identification import check_sample_sizes, identification_errors
+from .parallel import run_tasks
+from .plant import LinearPlant, SeedLike, simulate_gaussian_attack
+
+__all__ = ["AttackSpec", "gaussian_attack_errors", "sweep_gaussian_attack", "log_grid"]
+
+
+def log_grid(N_min: int, N_max: int, points: int) -> np.ndarray:
+    """A log-spaced grid of distinct integer sample sizes from ``N_min`` to ``N_max``.
+
+    Parameters
+    ----------
+    N_min, N_max
+        First and last sample size (``2 <= N_min <= N_max``).
+    points
+        Requested number of points (>= 1); rounding may merge a few at the low end.
+
+    Returns
+    -------
+    numpy.ndarray of int64
+        Strictly increasing, starting at ``N_min`` and ending at ``N_max``.
+    """
+    N_min = check_int("N_min", N_min, minimum=2)
+    N_max = check_int("N_max", N_max, minimum=N_min)
+    points = check_int("points", points, minimum=1)
+    if points == 1:
+        return np.array([N_max], dtype=np.int64)
+    return np.unique(np.round(np.geomspace(N_min, N_max, points)).astype(np.int64))
+
+
+@dataclass(frozen=True)
+class AttackSpec:
+    """One system under the Gaussian attack of Theorem thm:sic (a picklable task).
+
+    Attributes
+    ----------
+    A, B : numpy.ndarray
+        The plant of eq:system.
+    sigma_w2, sigma_u2, sigma_x2 : float
+        Noise, attack-input and initial-state variances.
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    sigma_w2: float
+    sigma_u2: float
+    sigma_x2: float = 1.0
+
+
+def gaussian_attack_errors(
+    plant: LinearPlant,
+    *,
+    sample_sizes: Any,
+    runs: int,
+    sigma_u2: float,
+    seed: SeedLike,
+    method: Literal["auto", "gram", "qr"] = "auto",
+) -> np.ndarray:
+    """Errors ``epsilon(N)`` (Definition def:error) of ``runs`` independent Gaussian attacks.
+
+    Each run simulates one trajectory of length ``max(sample_sizes)`` with
+    ``u_t ~ N(0, sigma_u2 I)`` (Theorem thm:sic) and identifies ``(A, B)`` by eq:estimate on
+    every prefix in ``sample_sizes``.
+
+    Parameters
+    ----------
+    plant
+        The plant of eq:system.
+    sample_sizes : array_like of int
+        Strictly increasing, each ``>= n + m + 1``.
+    runs
+        Number of independent identifications per sample size.
+    sigma_u2
+        Attack input variance.
+    seed
+        Integer or SeedSequence (see :func:`~encctl_gym.sim.plant.simulate_gaussian_attack`).
+    method
+        Solver for the prefix estimates (see :func:`~encctl_gym.sim.identification.prefix_estimates`).
+
+    Returns
+    -------
+    numpy.ndarray, shape (runs, len(sample_sizes))
+    """
+    grid = check_sample_sizes(sample_sizes, plant.n, plant.m)
+    sim = simulate_gaussian_attack(plant, N=int(grid[-1]), runs=runs, sigma_u2=sigma_u2, seed=seed)
+    return identification_errors(sim.states, sim.inputs, plant.A, plant.B, grid, method=method)
+
+
+def _task(job: tuple[AttackSpec, np.ndarray, int, str], seed: np.random.SeedSequence) -> np.ndarray:
+    spec, grid, runs, method = job
+    plant = LinearPlant(spec.A, spec.B, sigma_w2=spec.sigma_w2, sigma_x2=spec.sigma_x2)
+    return gaussian_attack_errors(
+        plant, sample_sizes=grid, runs=runs, sigma_u2=spec.sigma_u2, seed=seed, method=method  # type: ignore[arg-type]
+    )
+
+
+def sweep_gaussian_attack(
+    systems: Sequence[AttackSpec],
+    *,
+    sample_sizes: Any,
+    runs: int,
+    seed: SeedLike,
+    n_jobs: int = -1,
+    scheduler: Any = None,
+    cluster_kwargs: dict[str, Any] | None = None,
+    method: Literal["auto", "gram", "qr"] = "auto",
+    progress: bool = False,
+    desc: str | None = None,
+) -> np.ndarray:
+    """:func:`gaussian_attack_errors` for several systems, in parallel, one child seed each.
+
+    Parameters
+    ----------
+    systems
+        The systems (:class:`AttackSpec`).
+    sample_sizes, runs, method
+        As in :func:`gaussian_attack_errors` (the same grid for every system).
+    seed
+        System ``i`` uses child ``i`` of ``SeedSequence(seed)``; the result does not depend on
+        ``n_jobs`` or ``scheduler``.
+    n_jobs, scheduler, cluster_kwargs, progress, desc
+        See :func:`~encctl_gym.sim.parallel.run_tasks`.
+
+    Returns
+    -------
+    numpy.ndarray, shape (len(systems), runs, len(sample_sizes))
+    """
+    systems = list(systems)
+    if not systems:
+        raise ParameterError("systems must not be empty")
+    runs = check_int("runs", runs, minimum=1)
+    jobs = []
+    for i, s in enumerate(systems):
+        if not isinstance(s, AttackSpec):
+            raise ParameterError(f"systems[{i}] must be an AttackSpec, got {type(s).__name__}")
+        # Validate in the caller, so a bad system fails before any worker starts.
+        plant = LinearPlant(s.A, s.B, sigma_w2=s.sigma_w2, sigma_x2=s.sigma_x2)
+        check_nonnegative("sigma_u2", s.sigma_u2)
+        grid = check_sample_sizes(sample_sizes, plant.n, plant.m)
+        jobs.append((s, grid, runs, method))
+    out = run_tasks(
+        _task, jobs, seed=seed, n_jobs=n_jobs, scheduler=scheduler,
+        cluster_kwargs=cluster_kwargs, progress=progress, desc=desc,
+    )
+    return np.stack(out)

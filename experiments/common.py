@@ -1,0 +1,224 @@
+"""Shared pieces of the reproduction scripts: the grid of sample sizes, the tidy result table
+(CSV), the command-line options and the log-log panel plot.
+
+A figure's numbers come from a ``compute(...)`` function (called by the tests too) that returns
+a :class:`Table`; plotting only reads the table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from encctl_gym.errors import ParameterError
+from encctl_gym.sim.montecarlo import log_grid
+
+__all__ = [
+    "GridConfig",
+    "FULL",
+    "QUICK",
+    "Table",
+    "add_common_arguments",
+    "grid_config",
+    "figure_seed",
+    "ensure_out_dir",
+]
+
+#: CSV columns, in order.
+COLUMNS = (
+    "figure", "panel", "sigma_w2", "sigma_u2", "r_sigma", "psi_u", "N", "run", "error", "gamma", "bound",
+)
+
+
+@dataclass(frozen=True)
+class GridConfig:
+    """Monte Carlo size: sample sizes on a log grid from ``n + m + 1`` to ``N_max``, ``runs`` each."""
+
+    N_max: int
+    points: int
+    runs: int
+
+    def grid(self, n: int, m: int) -> np.ndarray:
+        """The grid of sample sizes for an ``n``-state, ``m``-input plant."""
+        return log_grid(n + m + 1, self.N_max, self.points)
+
+
+#: The paper's size: 50 identifications per N, N up to 10^4.
+FULL = GridConfig(N_max=10_000, points=30, runs=50)
+#: Smoke test: a few seconds.
+QUICK = GridConfig(N_max=500, points=8, runs=8)
+
+
+def grid_config(quick: bool) -> GridConfig:
+    """:data:`QUICK` or :data:`FULL`."""
+    return QUICK if quick else FULL
+
+
+def figure_seed(seed: int, figure: int) -> np.random.SeedSequence:
+    """The seed of figure ``figure``: child ``figure`` of ``SeedSequence(seed)``.
+
+    Figures get independent streams, so Figure 2 (a) does not reuse the random numbers of a
+    panel of Figure 1 with the same seed.
+    """
+    ss = np.random.SeedSequence(int(seed))
+    return np.random.SeedSequence(ss.entropy, spawn_key=(figure,))
+
+
+@dataclass
+class Table:
+    """A tidy table: one row per (system, N, run), columns :data:`COLUMNS`."""
+
+    columns: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @classmethod
+    def concat(cls, parts: Sequence["Table"]) -> "Table":
+        """Stack tables with the same columns."""
+        if not parts:
+            return cls({c: np.array([]) for c in COLUMNS})
+        return cls({c: np.concatenate([p.columns[c] for p in parts]) for c in COLUMNS})
+
+    @classmethod
+    def from_errors(
+        cls,
+        *,
+        figure: str,
+        panel: str,
+        grid: np.ndarray,
+        errors: np.ndarray,
+        gamma: np.ndarray,
+        bound: np.ndarray | None = None,
+        sigma_w2: float,
+        sigma_u2: float,
+        psi_u: float,
+    ) -> "Table":
+        """Rows of one panel from ``errors`` of shape (runs, K) and per-N curves of shape (K,)."""
+        runs, K = errors.shape
+        N = np.tile(grid, runs)
+        run = np.repeat(np.arange(runs), K)
+        rows = runs * K
+        bound_col = np.full(K, np.nan) if bound is None else np.asarray(bound, dtype=float)
+        return cls({
+            "figure": np.full(rows, figure, dtype=object),
+            "panel": np.full(rows, panel, dtype=object),
+            "sigma_w2": np.full(rows, sigma_w2),
+            "sigma_u2": np.full(rows, sigma_u2),
+            "r_sigma": np.full(rows, sigma_u2 / sigma_w2),
+            "psi_u": np.full(rows, psi_u),
+            "N": N.astype(np.int64),
+            "run": run.astype(np.int64),
+            "error": errors.reshape(-1),
+            "gamma": np.tile(np.asarray(gamma, dtype=float), runs),
+            "bound": np.tile(bound_col, runs),
+        })
+
+    def __len__(self) -> int:
+        return len(self.columns["N"]) if self.columns else 0
+
+    def panels(self) -> list[str]:
+        """Panel labels in order of first appearance."""
+        labels = self.columns["panel"]
+        _, idx = np.unique(labels.astype(str), return_index=True)
+        return [str(labels[i]) for i in sorted(idx)]
+
+    def panel(self, label: str) -> "Table":
+        """The rows of one panel."""
+        mask = self.columns["panel"].astype(str) == label
+        if not mask.any():
+            raise ParameterError(f"no panel {label!r} in the table")
+        return Table({c: v[mask] for c, v in self.columns.items()})
+
+    def summary(self, label: str) -> dict[str, Any]:
+        """Per-N statistics of one panel: grid, errors (runs, K), mean, gamma, bound, parameters."""
+        t = self.panel(label)
+        grid = np.unique(t.columns["N"])
+        runs = np.unique(t.columns["run"])
+        order = np.lexsort((t.columns["N"], t.columns["run"]))
+        err = t.columns["error"][order].reshape(runs.size, grid.size)
+        first = order[: grid.size]
+        return {
+            "N": grid,
+            "errors": err,
+            "mean": err.mean(axis=0),
+            "gamma": t.columns["gamma"][first],
+            "bound": t.columns["bound"][first],
+            "sigma_w2": float(t.columns["sigma_w2"][0]),
+            "sigma_u2": float(t.columns["sigma_u2"][0]),
+            "r_sigma": float(t.columns["r_sigma"][0]),
+            "psi_u": float(t.columns["psi_u"][0]),
+        }
+
+    def to_csv(self, path: str | os.PathLike[str]) -> Path:
+        """Write the table as CSV (floats with 17 significant digits, empty for NaN)."""
+        path = Path(path)
+        with path.open("w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(COLUMNS)
+            cols = [self.columns[c] for c in COLUMNS]
+            for row in zip(*cols):
+                w.writerow(_fmt(v) for v in row)
+        return path
+
+
+def _fmt(v: Any) -> str:
+    if isinstance(v, (float, np.floating)):
+        return "" if np.isnan(v) else repr(float(v))
+    return str(v)
+
+
+def read_csv(path: str | os.PathLike[str]) -> Table:
+    """Read a table written by :meth:`Table.to_csv`."""
+    with Path(path).open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    cols: dict[str, np.ndarray] = {}
+    for c in COLUMNS:
+        vals = [r[c] for r in rows]
+        if c in ("figure", "panel"):
+            cols[c] = np.array(vals, dtype=object)
+        elif c in ("N", "run"):
+            cols[c] = np.array(vals, dtype=np.int64)
+        else:
+            cols[c] = np.array([float(v) if v else np.nan for v in vals])
+    return Table(cols)
+
+
+def add_common_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options every reproduction script shares."""
+    parser.add_argument("--out", default="results", help="output directory (default: results/)")
+    parser.add_argument("--quick", action="store_true", help="small grid and few runs: a smoke test of a few seconds")
+    parser.add_argument("--seed", type=int, default=0, help="master seed (default: 0)")
+    parser.add_argument("--n-jobs", type=int, default=-1, help="worker processes (-1: all cores; 1: serial)")
+    parser.add_argument(
+        "--scheduler", default=None,
+        help="Dask scheduler: 'local' (start a LocalCluster) or an address like tcp://host:8786 "
+        "(default: joblib processes on this machine; needs encctl-gym[dask])",
+    )
+    parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+
+
+def ensure_out_dir(out: str | os.PathLike[str]) -> Path:
+    """Create the output directory."""
+    path = Path(out)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ParameterError(f"cannot create the output directory {str(path)!r}: {exc}") from exc
+    return path
+
+
+def plot_panel(ax: Any, s: dict[str, Any], title: str, *, bound: bool = False) -> None:
+    """One log-log panel: gray dots per run, mean (solid), gamma (dashed), bound (dotted)."""
+    N, err = s["N"], s["errors"]
+    ax.loglog(np.broadcast_to(N, err.shape).ravel(), err.ravel(), ".", color="0.6", ms=2, alpha=0.5,
+              rasterized=True, label="error (each run)")
+    ax.loglog(N, s["mean"], "-", color="tab:blue", lw=1.6, label="mean error")
+    ax.loglog(N, s["gamma"], "--", color="tab:orange", lw=1.6, label=r"$\gamma(N)$ (eq:sic2)")
+    if bound:
+        ax.loglog(N, s["bound"], ":", color="k", lw=1.6, label=r"$\bar\gamma(N)$ (eq:bound)")
+    ax.set_title(title, fontsize=9)
+    ax.grid(True, which="major", alpha=0.3)

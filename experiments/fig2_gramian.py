@@ -1,0 +1,195 @@
+"""Figure 2 (fig:gramian): the complexity approaches the bound eq:bound as tr(Psi_u) decreases.
+
+``m = n = 4``, ``sigma_x2 = 1``, ``Psi_w = 2I``, ``R_sigma = 100`` and
+``Psi_u in {2, 1, 0.5, 0.3, 0.2, 0.1} I``. The paper gives only the Gramians; we realise them
+with ``A = sqrt(1/2) I`` (so ``Psi_w = I / (1 - 1/2) = 2I``) and ``B = b I`` with
+``b = sqrt(psi_u (1 - 1/2))``, since ``Psi_u = b^2 / (1 - a^2) I`` for ``A = a I, B = b I``.
+The paper fixes only the ratio ``R_sigma``; we take ``sigma_w2 = 0.1`` and ``sigma_u2 = 10``
+(the variances of Figure 1 (c), which has the same ratio; presets ``fig2-psi<v>``).
+
+Per panel: gray dots each run's error (Definition def:error), solid the mean over 50 runs,
+dashed ``gamma(N)`` of eq:sic2 and dotted the upper bound ``(m+n) / ((N-1) m R_sigma)`` of
+eq:bound (both from :mod:`encctl_gym.security.complexity`).
+
+Usage: ``python experiments/fig2_gramian.py [--quick] [--out DIR] [--seed S] [--n-jobs J]
+[--scheduler local|tcp://host:port]`` (also ``encctl-gym reproduce``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+from typing import Any, Sequence
+
+if __package__ in (None, ""):  # run as a script: make the repository importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import numpy as np
+
+from encctl_gym.presets import get_preset
+from encctl_gym.security.complexity import input_upper_bound, sample_identifying_complexity_asymptotic
+from encctl_gym.security.gramians import controllability_gramian
+from encctl_gym.sim.montecarlo import AttackSpec, sweep_gaussian_attack
+from experiments.common import (
+    FULL,
+    GridConfig,
+    Table,
+    add_common_arguments,
+    ensure_out_dir,
+    figure_seed,
+    grid_config,
+    plot_panel,
+)
+
+__all__ = ["PSI_U", "PANELS", "panel_systems", "compute", "plot", "add_arguments", "run", "main"]
+
+FIGURE = "fig2"
+#: The scalar psi_u of Psi_u = psi_u I, in the paper's panel order (a)..(f).
+PSI_U = (2.0, 1.0, 0.5, 0.3, 0.2, 0.1)
+PANELS = tuple("abcdef")
+
+
+def panel_systems() -> list[tuple[str, float, AttackSpec]]:
+    """The six systems of Figure 2: ``(letter, psi_u, spec)``.
+
+    Returns
+    -------
+    list of (str, float, AttackSpec)
+        ``A = I / sqrt(2)``, ``B = sqrt(psi_u / 2) I``, ``sigma_w2 = 0.1``, ``sigma_u2 = 10``
+        (presets ``fig2-psi<v>`` of :mod:`encctl_gym.presets`).
+    """
+    out = []
+    for letter, psi in zip(PANELS, PSI_U):
+        p = get_preset(f"fig2-psi{psi:g}")
+        out.append((letter, psi, AttackSpec(p.A, p.B, sigma_w2=p.sigma_w2, sigma_u2=p.sigma_u2, sigma_x2=p.sigma_x2)))
+    return out
+
+
+def compute(
+    config: GridConfig = FULL,
+    *,
+    seed: int = 0,
+    n_jobs: int = -1,
+    scheduler: Any = None,
+    progress: bool = False,
+) -> Table:
+    """The data of Figure 2: errors (Definition def:error), ``gamma(N)`` (eq:sic2), bound (eq:bound).
+
+    Parameters
+    ----------
+    config
+        Grid of sample sizes and number of runs (:data:`experiments.common.FULL` is the paper's).
+    seed
+        Master seed; the figure uses child 2 of ``SeedSequence(seed)``, panel ``k`` its child ``k``.
+    n_jobs, scheduler, progress
+        Parallel execution (see :func:`encctl_gym.sim.parallel.run_tasks`).
+
+    Returns
+    -------
+    Table
+        One row per (panel, N, run); ``psi_u`` is the scalar of ``Psi_u = psi_u I`` computed
+        from ``(A, B)`` by :func:`encctl_gym.security.gramians.controllability_gramian`.
+    """
+    systems = panel_systems()
+    grid = config.grid(4, 4)
+    errors_all = sweep_gaussian_attack(
+        [spec for _, _, spec in systems], sample_sizes=grid, runs=config.runs, seed=figure_seed(seed, 2),
+        n_jobs=n_jobs, scheduler=scheduler, progress=progress, desc="Figure 2",
+    )
+    parts = []
+    for (letter, _, spec), errors in zip(systems, errors_all):
+        n, m = spec.B.shape
+        r_sigma = spec.sigma_u2 / spec.sigma_w2
+        gamma = sample_identifying_complexity_asymptotic(grid, spec.A, spec.B, r_sigma=r_sigma)
+        bound = input_upper_bound(grid, m, n, r_sigma)
+        psi_u = float(np.trace(controllability_gramian(spec.A, spec.B))) / n
+        parts.append(Table.from_errors(
+            figure=FIGURE, panel=letter, grid=grid, errors=errors, gamma=gamma, bound=bound,
+            sigma_w2=spec.sigma_w2, sigma_u2=spec.sigma_u2, psi_u=psi_u,
+        ))
+    return Table.concat(parts)
+
+
+def plot(table: Table, path: str | Path) -> Path:
+    """Draw Figure 2 (2 x 3 log-log panels) from a table of :func:`compute` and save it.
+
+    Parameters
+    ----------
+    table
+        Output of :func:`compute`.
+    path
+        PNG file to write.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 3, figsize=(11, 7), sharex=True, sharey=True)
+    for ax, letter in zip(axes.ravel(), PANELS):
+        s = table.summary(letter)
+        plot_panel(ax, s, f"({letter}) $\\Psi_u = {s['psi_u']:.3g}I$", bound=True)
+    for ax in axes[-1]:
+        ax.set_xlabel("sample size $N$")
+    for ax in axes[:, 0]:
+        ax.set_ylabel(r"estimation error $\epsilon(N)$")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=4, frameon=False)
+    s0 = table.summary(PANELS[0])
+    runs = s0["errors"].shape[0]
+    fig.suptitle(
+        "Figure 2: varying $\\Psi_u$ with $\\Psi_w = 2I$, $R_\\sigma = 100$ "
+        f"($\\sigma_w^2={s0['sigma_w2']:g}$, $\\sigma_u^2={s0['sigma_u2']:g}$, {runs} runs per $N$)\n"
+        "realised by $A = I/\\sqrt{2}$, $B = bI$, $b = \\sqrt{\\psi_u(1-1/2)}$, "
+        "i.e. $\\Psi_u = b^2/(1-a^2)\\,I$",
+        fontsize=10,
+    )
+    fig.tight_layout(rect=(0, 0.05, 1, 0.95))
+    path = Path(path)
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    return path
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Command-line options (``--out --quick --seed --n-jobs --scheduler --no-progress``)."""
+    add_common_arguments(parser)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Compute, save ``fig2_gramian.csv`` and ``.png`` under ``args.out``; print the paths."""
+    out = ensure_out_dir(args.out)
+    t0 = time.perf_counter()
+    table = compute(grid_config(args.quick), seed=args.seed, n_jobs=args.n_jobs,
+                    scheduler=args.scheduler, progress=not args.no_progress)
+    elapsed = time.perf_counter() - t0
+    csv_path = table.to_csv(out / "fig2_gramian.csv")
+    png_path = plot(table, out / "fig2_gramian.png")
+    print(f"Figure 2: {len(table)} rows in {elapsed:.1f} s")
+    print(f"  wrote {csv_path}")
+    print(f"  wrote {png_path}")
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``python experiments/fig2_gramian.py``."""
+    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().splitlines()[0])
+    add_arguments(parser)
+    from encctl_gym.errors import EncctlError
+
+    args = parser.parse_args(argv)
+    try:
+        return run(args)
+    except EncctlError as exc:
+        print(f"fig2_gramian: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
