@@ -1,0 +1,119 @@
+"""Modified homomorphic evaluation and decryption (Definition def:modification).
+
+``modified_eval`` keeps the first components of both ciphertexts apart, so the product
+can be decrypted with two keys of *different* steps (the theorem after
+Definition def:modification):
+
+    Dec_bar(sk_t, sk_{t+k}, Eval_bar(pk_t, Enc(pk_t, m1), Enc(pk_{t+k}, m2))) = m1 m2 mod p.
+
+This is what lets the controller server of eq:ec keep the controller-parameter ciphertexts
+under pk_0 forever and never receive an update token.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Optional
+
+from ..errors import CiphertextError, KeyMismatchError
+from . import arith
+from .elgamal import (
+    Ciphertext,
+    PublicKey,
+    SecretKey,
+    _check_component,
+    _check_key,
+    _dec,
+    _int_field,
+    _step_field,
+    check_ciphertext,
+    check_same_group,
+)
+from .group import GroupParams
+
+__all__ = ["ModifiedCiphertext", "modified_eval", "modified_decrypt", "check_modified_ciphertext"]
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class ModifiedCiphertext:
+    """Three-component ciphertext (c1, c2, c3) = (c11, c21, c12 c22 mod p) of Definition def:modification.
+
+    ``t1`` and ``t2`` optionally record the steps of the keys that decrypt ``c1`` and ``c2``
+    (the steps of the two input ciphertexts); ``None`` means unknown (no check).
+    """
+
+    c1: int
+    c2: int
+    c3: int
+    t1: Optional[int] = None
+    t2: Optional[int] = None
+
+    def __post_init__(self) -> None:
+        for name in ("c1", "c2", "c3"):
+            _int_field(self, name, CiphertextError)
+        _step_field(self, "t1", CiphertextError, optional=True)
+        _step_field(self, "t2", CiphertextError, optional=True)
+
+
+def modified_eval(pk: PublicKey, ct1: Ciphertext, ct2: Ciphertext) -> ModifiedCiphertext:
+    """Eval_bar of Definition def:modification: ``(c11, c21, c12 c22 mod p)``.
+
+    Only one modular multiplication; the ciphertexts may come from different steps.
+
+    Raises
+    ------
+    CiphertextError
+        If an input is not a two-component ciphertext with components in G.
+    """
+    _check_key(pk, PublicKey, "pk")
+    grp = pk.group
+    check_ciphertext(grp, ct1)
+    check_ciphertext(grp, ct2)
+    c3 = arith.mulmod(ct1.c2, ct2.c2, grp.p)
+    return ModifiedCiphertext(ct1.c1, ct2.c1, int(c3), ct1.t, ct2.t)
+
+
+def check_modified_ciphertext(grp: GroupParams, ct: Any) -> ModifiedCiphertext:
+    """Check that ``ct`` is a :class:`ModifiedCiphertext` with components in G (CiphertextError)."""
+    if not isinstance(ct, ModifiedCiphertext):
+        raise CiphertextError(f"expected a ModifiedCiphertext (c1, c2, c3), got {ct!r}")
+    _check_component(grp, ct.c1, "c1")
+    _check_component(grp, ct.c2, "c2")
+    _check_component(grp, ct.c3, "c3")
+    return ct
+
+
+def modified_decrypt(sk1: SecretKey, sk2: SecretKey, ct: ModifiedCiphertext) -> int:
+    """Dec_bar of Definition def:modification: ``c~ = Dec(sk2, (c2, c3))``, ``m = Dec(sk1, (c1, c~))``.
+
+    Parameters
+    ----------
+    sk1 : SecretKey
+        Key of the first input ciphertext (sk_0 for the controller parameter in eq:ec).
+    sk2 : SecretKey
+        Key of the second input ciphertext (sk_t for the state in eq:ec).
+    ct : ModifiedCiphertext
+
+    Returns
+    -------
+    int
+        ``m1 m2 mod p``.
+
+    Raises
+    ------
+    KeyMismatchError
+        If the keys belong to different groups, or ``ct`` records steps other than
+        ``sk1.t`` / ``sk2.t``.
+    CiphertextError
+        If ``ct`` is malformed.
+    """
+    _check_key(sk1, SecretKey, "sk1")
+    _check_key(sk2, SecretKey, "sk2")
+    grp = check_same_group(sk1, sk2, "sk1 and sk2")
+    check_modified_ciphertext(grp, ct)
+    if ct.t1 is not None and ct.t1 != sk1.t:
+        raise KeyMismatchError(f"component c1 is of step t = {ct.t1}, sk1 is of step t = {sk1.t}")
+    if ct.t2 is not None and ct.t2 != sk2.t:
+        raise KeyMismatchError(f"component c2 is of step t = {ct.t2}, sk2 is of step t = {sk2.t}")
+    c_tilde = _dec(grp, sk2.s, ct.c2, ct.c3)
+    return _dec(grp, sk1.s, ct.c1, c_tilde)

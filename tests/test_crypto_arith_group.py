@@ -1,0 +1,263 @@
+"""Tests of crypto.arith (gmpy2 layer, random sources) and crypto.group (Example ex:elgamal parameters)."""
+
+from __future__ import annotations
+
+import json
+import time
+
+import gmpy2
+import numpy as np
+import pytest
+
+from encctl_gym.crypto import arith, group as group_mod
+from encctl_gym.crypto.arith import (
+    PowmodCounter,
+    RandomSource,
+    SecureRandom,
+    SeededRandom,
+    as_random_source,
+    invert,
+    is_prime,
+    jacobi,
+    powmod,
+    secure_random,
+    seeded_random,
+)
+from encctl_gym.crypto.elgamal import keygen
+from encctl_gym.crypto.group import (
+    MIN_GENERATE_BITS,
+    SHIPPED_BITS,
+    GroupParams,
+    generate_safe_prime_group,
+    get_group,
+    shipped_group,
+)
+from encctl_gym.errors import EncctlError, GroupError, ParameterError
+
+# Toy group used for known answers (hand-checked):
+#   p = 23 = 2 * 11 + 1, q = 11, g = 4 = 2^2.
+#   Powers of 4 mod 23: 4, 16, 18, 3, 12, 2, 8, 9, 13, 6, 1  (4^11 = 1), so
+#   G = {1, 2, 3, 4, 6, 8, 9, 12, 13, 16, 18} = the quadratic residues mod 23.
+TOY = GroupParams(23, 11, 4)
+TOY_G = {1, 2, 3, 4, 6, 8, 9, 12, 13, 16, 18}
+
+
+# ---------------------------------------------------------------------------- arith
+def test_powmod_invert_known_answers():
+    assert powmod(4, 3, 23) == 18  # 64 - 46
+    assert powmod(12, -3, 23) == 8  # 12 = 4^5, 12^-3 = 4^-15 = 4^7 = 8
+    assert invert(12, 23) * 12 % 23 == 1
+    with pytest.raises(ParameterError, match="no inverse"):
+        invert(6, 12)
+    with pytest.raises(ParameterError):
+        powmod(6, -1, 12)
+
+
+def test_powmod_counter_counts_calls():
+    before = arith.powmod_count()
+    with PowmodCounter() as c:
+        for _ in range(5):
+            powmod(3, 5, 7)
+    assert c.count == 5
+    assert arith.powmod_count() == before + 5
+
+
+def test_is_prime_and_jacobi():
+    assert [n for n in range(30) if is_prime(n)] == [2, 3, 5, 7, 11, 13, 17, 19, 23, 29]
+    assert not is_prime(561)  # Carmichael number
+    assert not is_prime(-7)
+    # The Legendre symbol mod 23 is +1 exactly on G.
+    assert {m for m in range(1, 23) if jacobi(m, 23) == 1} == TOY_G
+    assert arith.legendre(5, 23) == -1
+    assert arith.bit_length(23) == 5
+
+
+def test_seeded_random_is_reproducible_and_uniform():
+    a, b, c = seeded_random(7), seeded_random(7), seeded_random(8)
+    sa = [a.below(10**30) for _ in range(20)]
+    assert sa == [b.below(10**30) for _ in range(20)]
+    assert sa != [c.below(10**30) for _ in range(20)]
+    assert not a.secure and SecureRandom().secure
+    # Uniformity on a small range: 14000 draws in 7 cells, each expected 2000.
+    counts = np.bincount([a.below(7) for _ in range(14000)], minlength=7)
+    chi2 = float(((counts - 2000) ** 2 / 2000).sum())
+    assert chi2 < 30.0  # 6 degrees of freedom; p ~ 4e-5 for 30
+    assert all(0 <= secure_random().below(5) < 5 for _ in range(200))
+    assert {secure_random().below(2) for _ in range(200)} == {0, 1}
+
+
+def test_as_random_source_and_bad_bounds():
+    assert isinstance(as_random_source(None), SecureRandom)
+    assert isinstance(as_random_source(3), SeededRandom)
+    src = SeededRandom(1)
+    assert as_random_source(src) is src
+    g1 = as_random_source(np.random.default_rng(5))
+    g2 = as_random_source(np.random.default_rng(5))
+    assert g1.below(10**9) == g2.below(10**9)
+    for bad in ("seed", 1.5, True, [1]):
+        with pytest.raises(ParameterError):
+            as_random_source(bad)
+    with pytest.raises(ParameterError):
+        seeded_random(-1)
+    for bad_n in (0, -3, 2.5):
+        with pytest.raises(ParameterError):
+            src.below(bad_n)
+    with pytest.raises(ParameterError):
+        src.between(5, 5)
+    with pytest.raises(NotImplementedError):
+        RandomSource().below(3)
+
+
+# ---------------------------------------------------------------------------- group
+def test_toy_group_known_answers():
+    assert TOY.bits == 5 and TOY.cofactor == 2 and TOY.is_safe_prime and TOY.half == 11
+    assert TOY.verify() is TOY and TOY.verified
+    assert {m for m in range(25) if TOY.contains(m)} == TOY_G
+    assert {powmod(4, i, 23) for i in range(11)} == TOY_G
+
+
+def test_group_accepts_mpz_and_hex_and_stores_ints():
+    g = GroupParams(gmpy2.mpz(23), "0xb", np.int64(4))
+    assert g == TOY and type(g.p) is int and type(g.q) is int and type(g.g) is int
+
+
+@pytest.mark.parametrize(
+    "p, q, g, match",
+    [
+        (24, 11, 4, "does not divide"),  # 11 does not divide 23
+        (23, 11, 1, "1 < g < p"),  # g = 1
+        (23, 11, 23, "1 < g < p"),
+        (23, 1, 4, "q must be"),
+        (3, 2, 2, "p must be"),
+        ("x", 11, 4, "integer"),
+        (23.5, 11, 4, "integer"),
+    ],
+)
+def test_group_construction_errors(p, q, g, match):
+    with pytest.raises(GroupError, match=match):
+        GroupParams(p, q, g)
+
+
+@pytest.mark.parametrize(
+    "p, q, g, match",
+    [
+        (27, 13, 4, "p is not prime: p = 27"),  # 26 = 2 * 13 but 27 = 3^3
+        (23, 22, 4, "q is not prime: q = 22"),
+        (23, 11, 5, "g = 5 does not have order q"),  # 5 is a non-residue: 5^11 = -1
+        (23, 11, 22, "g = 22 does not have order q"),  # 22 = -1 has order 2
+        (2 * 1000003 + 1, 1000003, 4, "p is not prime"),  # 2000007 = 3 * 666669
+    ],
+)
+def test_group_verify_errors(p, q, g, match):
+    grp = GroupParams(p, q, g)
+    with pytest.raises(GroupError, match=match):
+        grp.verify()
+    assert not grp.verified
+    with pytest.raises(GroupError):
+        keygen(grp)  # keys are never made over unverified parameters
+
+
+def test_group_with_other_cofactor_loads_and_verifies():
+    # p = 29 = 4 * 7 + 1; 2 is a primitive root mod 29, so 16 = 2^4 has order 7.
+    g = GroupParams(29, 7, 16).verify()
+    assert g.cofactor == 4 and not g.is_safe_prime
+    members = {m for m in range(1, 29) if g.contains(m)}
+    assert members == {powmod(16, i, 29) for i in range(7)}
+    assert len(members) == 7
+    with pytest.raises(GroupError, match="does not have order"):
+        GroupParams(29, 7, 2).verify()  # 2 has order 28
+
+
+def test_json_roundtrip(tmp_path):
+    grp = shipped_group(128)
+    text = grp.to_json()
+    assert GroupParams.from_json(text) == grp
+    assert json.loads(text)["bits"] == 128
+    path = tmp_path / "g.json"
+    grp.save(path)
+    assert GroupParams.load(path) == grp
+    bad = json.loads(text)
+    bad["bits"] = 127
+    with pytest.raises(GroupError, match="declared bits"):
+        GroupParams.from_dict(bad)
+    with pytest.raises(GroupError, match="invalid group JSON"):
+        GroupParams.from_json("{not json")
+    with pytest.raises(GroupError, match="fields p, q, g"):
+        GroupParams.from_dict({"p": 23})
+    with pytest.raises(GroupError):
+        GroupParams.from_json("[1, 2]")
+    (tmp_path / "bad.json").write_text(GroupParams(27, 13, 4).to_json())
+    with pytest.raises(GroupError, match="p is not prime"):
+        GroupParams.load(tmp_path / "bad.json")
+
+
+def _assert_safe_prime_group(grp: GroupParams, bits: int) -> None:
+    assert grp.bits == bits and grp.p == 2 * grp.q + 1
+    assert gmpy2.is_prime(grp.p) and gmpy2.is_prime(grp.q)
+    assert grp.g != 1 and pow(grp.g, grp.q, grp.p) == 1
+
+
+@pytest.mark.parametrize("bits", [MIN_GENERATE_BITS, 17, 32, 64, 100, 256, 512])
+def test_generate_safe_prime_group(bits):
+    grp = generate_safe_prime_group(bits, rng=bits)
+    _assert_safe_prime_group(grp, bits)
+    assert generate_safe_prime_group(bits, rng=bits) == grp  # reproducible from a seed
+
+
+def test_generate_progress_goes_to_stderr(capsys):
+    generate_safe_prime_group(128, rng=3, progress=True)
+    captured = capsys.readouterr()
+    assert "generated 128-bit safe prime" in captured.err and captured.out == ""
+
+
+@pytest.mark.parametrize("bits", [712, pytest.param(1024, marks=pytest.mark.slow)])
+def test_generation_takes_seconds_not_minutes(bits):
+    t0 = time.perf_counter()
+    grp = generate_safe_prime_group(bits, rng=11)
+    _assert_safe_prime_group(grp, bits)
+    assert time.perf_counter() - t0 < 30.0
+
+
+@pytest.mark.slow
+def test_generate_2048():
+    _assert_safe_prime_group(generate_safe_prime_group(2048, rng=1), 2048)
+
+
+@pytest.mark.parametrize("bits", [15, 8, 0, -64, 64.5, 64.0, "64", True, None])
+def test_generate_rejects_bad_bits(bits):
+    with pytest.raises(ParameterError, match="bits"):
+        generate_safe_prime_group(bits)
+    with pytest.raises(ParameterError, match="bits"):
+        get_group(bits)
+
+
+def test_shipped_groups_are_safe_prime_groups_and_verify_fast():
+    assert SHIPPED_BITS == (64, 128, 256, 512, 712, 1024, 2048)
+    for bits in SHIPPED_BITS:
+        grp = shipped_group(bits)
+        _assert_safe_prime_group(grp, bits)
+        assert get_group(bits) == grp
+    # Verification from scratch (cache cleared) of the largest group is well under 2 s,
+    # and the cached verification is instant.
+    big = shipped_group(2048)
+    group_mod._VERIFIED.discard((big.p, big.q, big.g))
+    t0 = time.perf_counter()
+    big.verify()
+    assert time.perf_counter() - t0 < 2.0
+    t0 = time.perf_counter()
+    shipped_group(2048)
+    assert time.perf_counter() - t0 < 0.05
+    with pytest.raises(ParameterError, match="no shipped group of 100 bits"):
+        shipped_group(100)
+
+
+def test_get_group_generates_unshipped_sizes():
+    grp = get_group(48, rng=2)
+    _assert_safe_prime_group(grp, 48)
+
+
+def test_errors_are_package_errors():
+    with pytest.raises(EncctlError):
+        GroupParams(27, 13, 4).verify()
+    with pytest.raises(ValueError):  # GroupError is also a ValueError
+        GroupParams(27, 13, 4).verify()
