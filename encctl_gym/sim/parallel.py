@@ -31,6 +31,9 @@ from .plant import SeedLike, as_seed_sequence
 
 __all__ = ["child_seeds", "run_tasks"]
 
+#: How long to wait for a remote Dask scheduler before giving up.
+CONNECT_TIMEOUT = "10s"
+
 T = TypeVar("T")
 R = TypeVar("R")
 
@@ -94,7 +97,7 @@ def _dask_client(scheduler: Any, n_jobs: int, cluster_kwargs: dict[str, Any] | N
         if cluster_kwargs:
             raise ParameterError("cluster_kwargs only apply to scheduler='local'")
         try:
-            client = distributed.Client(scheduler, timeout="10s")
+            client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT)
         except (OSError, TimeoutError) as exc:
             raise ConfigError(f"cannot connect to the Dask scheduler at {scheduler!r}: {exc}") from exc
         with client:
