@@ -45,3 +45,20 @@ __all__ = [
     "BudgetError",
     "ConfigError",
 ]
+
+
+def _register() -> None:
+    # Register the Gymnasium environment on import, without importing the environment module
+    # (and its dependencies) until gymnasium.make asks for it.
+    import gymnasium as gym
+
+    env_id = "encctl_gym/EncryptedLTIAttack-v0"
+    if env_id not in gym.registry:
+        gym.register(
+            id=env_id,
+            entry_point="encctl_gym.envs.encrypted_lti_attack:EncryptedLTIAttackEnv",
+            vector_entry_point="encctl_gym.envs.vector:EncryptedLTIAttackVectorEnv",
+        )
+
+
+_register()

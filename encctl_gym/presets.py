@@ -12,7 +12,7 @@ fig1-a ... fig1-i  Figure 1: A = 0.7071 I, B = I, sigma_w2 x sigma_u2 in {0.1, 1
                    panels in the paper's order (a) = (0.1, 0.1), (b) = (0.1, 1), ...
 fig2-psi<v>        Figure 2: Psi_w = 2I, R_sigma = 100, Psi_u = v I, v in {2, 1, 0.5, 0.3, 0.2,
                    0.1}; A = I/sqrt(2) and B = b I with b = sqrt(v (1 - 1/2))
-small              n = m = 2 system for quick training runs (not from the paper)
+small              n = m = 2 system for quick training runs (not from the paper), gamma_c = 1e-3
 =================  ==========================================================================
 
 The design example fixes only the ratio R_sigma = sigma_u2 / sigma_w2 = 100; its absolute
@@ -104,7 +104,7 @@ def _build() -> dict[str, SystemPreset]:
         "small",
         "n = m = 2 system for quick training runs (not from the paper)",
         np.array([[0.6, 0.2], [-0.1, 0.5]]), np.array([[1.0, 0.0], [0.3, 0.8]]),
-        sigma_w2=0.1, sigma_u2=1.0,
+        sigma_w2=0.1, sigma_u2=1.0, gamma_c=1e-3,
     )
     return presets
 

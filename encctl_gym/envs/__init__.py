@@ -1,0 +1,32 @@
+"""Gymnasium environments of encctl-gym.
+
+``encctl_gym/EncryptedLTIAttack-v0`` is registered when :mod:`encctl_gym` is imported::
+
+    import gymnasium as gym
+    import encctl_gym  # noqa: F401  (registers the environment)
+
+    env = gym.make("encctl_gym/EncryptedLTIAttack-v0", config={"preset": "small"})
+    envs = gym.make_vec("encctl_gym/EncryptedLTIAttack-v0", num_envs=1024)  # native batched
+"""
+
+from __future__ import annotations
+
+from .config import AttackParams, default_config, resolve_params
+from .encrypted_lti_attack import EncryptedLTIAttackEnv
+
+__all__ = ["EncryptedLTIAttackEnv", "default_config", "resolve_params", "AttackParams", "ENV_ID", "register_envs"]
+
+ENV_ID = "encctl_gym/EncryptedLTIAttack-v0"
+
+
+def register_envs() -> None:
+    """Register ``encctl_gym/EncryptedLTIAttack-v0`` with gymnasium (idempotent)."""
+    import gymnasium as gym
+
+    if ENV_ID in gym.registry:
+        return
+    gym.register(
+        id=ENV_ID,
+        entry_point="encctl_gym.envs.encrypted_lti_attack:EncryptedLTIAttackEnv",
+        vector_entry_point="encctl_gym.envs.vector:EncryptedLTIAttackVectorEnv",
+    )

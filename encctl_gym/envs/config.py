@@ -1,0 +1,281 @@
+"""Configuration of the attack environment: defaults, merging, validation.
+
+Following HighwayEnv, every knob lives in one dictionary, :func:`default_config`, merged with
+the user's ``config`` and keyword arguments and resolved once into an immutable
+:class:`AttackParams` that the single and the vector environment share.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import numpy as np
+
+from .._validation import check_int, check_nonnegative, check_positive, check_schur_stable, check_system
+from ..errors import BudgetError, ParameterError
+from ..presets import get_preset
+from ..security.complexity import sic_from_traces
+from ..security.deciphering import ADVERSARIES, SCHEMES, keys_to_break, max_affordable_samples, per_sample_cost
+from ..security.design import bit_security_of_key_length, design_from_traces, minimum_key_length
+from ..security.gramians import controllability_gramian, noise_gramian
+
+__all__ = ["default_config", "AttackParams", "resolve_params", "REWARDS", "BACKENDS"]
+
+REWARDS = ("log_error", "logdet")
+BACKENDS = ("ideal", "elgamal")
+
+
+def default_config() -> dict[str, Any]:
+    """Every parameter of ``EncryptedLTIAttack-v0`` with its default.
+
+    ============================  ==============================================================
+    key                           meaning
+    ============================  ==============================================================
+    ``preset``                    system preset (:mod:`encctl_gym.presets`); ``None`` needs A, B
+    ``A``, ``B``                  plant matrices of eq:system (override the preset's)
+    ``sigma_w2``                  process noise variance (preset's if ``None``)
+    ``sigma_x2``                  variance of x_0 (preset's if ``None``; the paper uses 1)
+    ``sigma_u2``                  attacker's average input power per channel (energy budget)
+    ``scheme``                    ``"modified"`` (the paper's), ``"token"``, ``"static"``
+    ``adversary``                 ``"eavesdropper"`` or ``"server"``
+    ``security_parameter``        lambda in bits; ``None``: from ``key_length``, else lambda* of
+                                  Theorem thm:opt_sec for the preset's design parameters
+    ``key_length``                key length k in bits (lambda = log2 Omega(k), eq:opt_key)
+    ``upsilon``, ``tau_c``        attacker FLOPS and defense period in s (preset's if ``None``)
+    ``gamma_c``                   acceptable error, used for the default lambda*
+    ``max_samples``               cap on the attack length N (truncation); required when one
+                                  break reveals every sample (static; token vs server)
+    ``decipher_delay``            0 (adaptive), an integer number of steps, or ``"end"``
+    ``warmup_steps``              steps of normal encrypted LQR control before the attack
+    ``reward``                    ``"log_error"`` or ``"logdet"``
+    ``logdet_regularization``     delta of ``log det(G + delta I)`` for ``reward="logdet"``
+    ``crypto``                    ``"ideal"`` (exact arithmetic, no big integers) or ``"elgamal"``
+    ``delta``                     encoder scaling factor Delta (Definition def:ec)
+    ``x_bound``                   declared state range of the encoder (overflow raises)
+    ``action_scale``              actuator bound in units of sigma_u: a = action * scale * sigma_u
+    ``input_history``             number of own past inputs in the observation
+    ``gamma_opt``                 compute gamma_opt(N) of the optimal attack design for info
+    ``crypto_seed``               seed of the crypto randomness (``None``: secure source)
+    ============================  ==============================================================
+    """
+    return {
+        "preset": "paper-example",
+        "A": None,
+        "B": None,
+        "sigma_w2": None,
+        "sigma_x2": None,
+        "sigma_u2": None,
+        "scheme": "modified",
+        "adversary": "eavesdropper",
+        "security_parameter": None,
+        "key_length": None,
+        "upsilon": None,
+        "tau_c": None,
+        "gamma_c": None,
+        "max_samples": None,
+        "decipher_delay": 0,
+        "warmup_steps": 0,
+        "reward": "log_error",
+        "logdet_regularization": 1.0,
+        "crypto": "ideal",
+        "delta": 4096,
+        "x_bound": 256.0,
+        "action_scale": 4.0,
+        "input_history": 2,
+        "gamma_opt": True,
+        "crypto_seed": None,
+    }
+
+
+@dataclass(frozen=True)
+class AttackParams:
+    """Resolved, validated parameters of one environment (shared by the vector environment)."""
+
+    A: np.ndarray
+    B: np.ndarray
+    sigma_w2: float
+    sigma_x2: float
+    sigma_u2: float
+    scheme: str
+    adversary: str
+    security_parameter: float
+    key_length: int
+    upsilon: float
+    tau_c: float
+    gamma_c: float
+    sample_cost: float  # 2^lambda / Upsilon, seconds per broken key
+    budget_samples: float  # samples affordable within tau_c (inf if one break reveals all)
+    horizon: int  # N: the attack length in samples
+    independent_keys: bool  # every sample under its own key (def:sdt), else one break reveals all
+    budget_limited: bool  # the horizon is set by tau_c (terminated) rather than max_samples (truncated)
+    decipher_delay: int | None  # None means "end"
+    warmup_steps: int
+    reward: str
+    logdet_regularization: float
+    crypto: str
+    delta: int
+    x_bound: float
+    u_max: float
+    input_history: int
+    gamma_opt: bool
+    crypto_seed: int | None
+    tr_psi_u: float
+    tr_psi_w: float
+
+    @property
+    def n(self) -> int:
+        return int(self.A.shape[0])
+
+    @property
+    def m(self) -> int:
+        return int(self.B.shape[1])
+
+    @property
+    def energy_budget(self) -> float:
+        """Total input energy sum_t ||a_t||^2 allowed over the episode: m sigma_u2 N."""
+        return self.m * self.sigma_u2 * self.horizon
+
+    @property
+    def obs_dim(self) -> int:
+        return self.n + self.m + 1 + self.input_history * self.m + 2
+
+    def observation_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Finite bounds of the observation: states within the encoder's declared range
+        ``x_bound`` (encoding beyond it raises), inputs within the actuator bound plus the
+        forged input's quantisation offset, flag and fractions within [0, 1]."""
+        n, m, H = self.n, self.m, self.input_history
+        u_hi = self.u_max + (1.0 + n) / self.delta
+        high = np.concatenate([np.full(n, self.x_bound), np.full(m, u_hi), [1.0], np.ones(H * m), [1.0, 1.0]])
+        low = np.concatenate([-high[: n + m], [0.0], -np.ones(H * m), [0.0, 0.0]])
+        return low.astype(np.float32), high.astype(np.float32)
+
+    def gamma(self, N: Any) -> Any:
+        """gamma(N) of eq:sic (Theorem thm:sic) for this plant and the attacker's input power."""
+        return sic_from_traces(N, self.tr_psi_u, self.tr_psi_w, self.m, self.n, self.sigma_u2, self.sigma_w2, self.sigma_x2)
+
+
+def _choice(name: str, value: Any, options: tuple[str, ...]) -> str:
+    if value not in options:
+        raise ParameterError(f"unknown {name} {value!r}; choose one of {', '.join(options)}")
+    return value
+
+
+def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> AttackParams:
+    """Merge ``config`` and ``kwargs`` over :func:`default_config` and validate everything.
+
+    Raises
+    ------
+    ParameterError
+        Unknown keys, schemes, backends, rewards or presets; non-positive Upsilon, tau_c or
+        variances; an unstable A (UnstableSystemError); mismatched shapes (ShapeError).
+    BudgetError
+        A budget too small to identify anything (fewer than n + m + 1 samples).
+    """
+    cfg = default_config()
+    merged = dict(config or {})
+    merged.update(kwargs)
+    unknown = sorted(set(merged) - set(cfg))
+    if unknown:
+        raise ParameterError(f"unknown configuration key(s) {unknown}; known keys: {sorted(cfg)}")
+    cfg.update(merged)
+
+    preset = get_preset(cfg["preset"]) if cfg["preset"] is not None else None
+    if preset is None and (cfg["A"] is None or cfg["B"] is None):
+        raise ParameterError("without a preset, both A and B must be given")
+    A, B = check_system(
+        cfg["A"] if cfg["A"] is not None else preset.A,
+        cfg["B"] if cfg["B"] is not None else preset.B,
+    )
+    check_schur_stable(A)
+
+    def pick(key: str, default: float | None) -> Any:
+        value = cfg[key] if cfg[key] is not None else (getattr(preset, key) if preset is not None else default)
+        if value is None:
+            raise ParameterError(f"{key} must be given when no preset is used")
+        return value
+
+    sigma_w2 = check_positive("sigma_w2", pick("sigma_w2", None))
+    sigma_x2 = check_nonnegative("sigma_x2", pick("sigma_x2", 1.0))
+    sigma_u2 = check_positive("sigma_u2", pick("sigma_u2", None))
+    upsilon = check_positive("upsilon", pick("upsilon", None))
+    tau_c = check_positive("tau_c", pick("tau_c", None))
+    gamma_c = check_positive("gamma_c", pick("gamma_c", None))
+    scheme = _choice("scheme", cfg["scheme"], SCHEMES)
+    adversary = _choice("adversary", cfg["adversary"], ADVERSARIES)
+    reward = _choice("reward", cfg["reward"], REWARDS)
+    crypto = _choice("crypto backend", cfg["crypto"], BACKENDS)
+
+    n, m = A.shape[0], B.shape[1]
+    psi_u = controllability_gramian(A, B)
+    psi_w = noise_gramian(A)
+    tr_psi_u, tr_psi_w = float(np.trace(psi_u)), float(np.trace(psi_w))
+
+    lam_cfg, k_cfg = cfg["security_parameter"], cfg["key_length"]
+    if lam_cfg is not None and k_cfg is not None:
+        raise ParameterError("give either security_parameter or key_length, not both")
+    if k_cfg is not None:
+        key_length = check_int("key_length", k_cfg, minimum=16)
+        lam = bit_security_of_key_length(key_length)
+    else:
+        if lam_cfg is not None:
+            lam = check_positive("security_parameter", lam_cfg)
+            if float(lam).is_integer():
+                lam = int(lam)
+        else:
+            design = design_from_traces(
+                tr_psi_u, tr_psi_w, m, n, sigma_u2=sigma_u2, sigma_w2=sigma_w2, sigma_x2=sigma_x2,
+                gamma_c=gamma_c, tau_c=tau_c, upsilon=upsilon,
+            )
+            lam = design.lam_star  # Theorem thm:opt_sec
+        key_length = minimum_key_length(lam)
+
+    budget = max_affordable_samples(tau_c, lam, upsilon, scheme=scheme, adversary=adversary)
+    max_samples = cfg["max_samples"]
+    if max_samples is not None:
+        max_samples = check_int("max_samples", max_samples, minimum=1)
+    if math.isinf(budget) and max_samples is None:
+        raise ParameterError(
+            f"with scheme={scheme!r} and adversary={adversary!r} one break reveals every sample, so the "
+            "deciphering budget does not bound the attack: set max_samples"
+        )
+    if max_samples is not None and max_samples < budget:
+        horizon, budget_limited = max_samples, False
+    else:
+        horizon, budget_limited = int(budget), True
+    if horizon < n + m + 1:
+        raise BudgetError(
+            f"the attack can collect only N = {horizon} samples (budget {budget} within tau_c = {tau_c:g} s at "
+            f"lambda = {lam}, Upsilon = {upsilon:g}; max_samples = {max_samples}); identification needs "
+            f"N >= n + m + 1 = {n + m + 1}"
+        )
+
+    delay = cfg["decipher_delay"]
+    if delay == "end":
+        delay_v: int | None = None
+    else:
+        delay_v = check_int("decipher_delay", delay, minimum=0) if not isinstance(delay, str) else None
+        if isinstance(delay, str):
+            raise ParameterError(f"decipher_delay must be a non-negative integer or 'end', got {delay!r}")
+
+    delta = check_int("delta", cfg["delta"], minimum=2)
+    action_scale = check_positive("action_scale", cfg["action_scale"])
+    crypto_seed = cfg["crypto_seed"]
+    if crypto_seed is not None:
+        crypto_seed = check_int("crypto_seed", crypto_seed, minimum=0)
+    return AttackParams(
+        A=A, B=B, sigma_w2=sigma_w2, sigma_x2=sigma_x2, sigma_u2=sigma_u2,
+        scheme=scheme, adversary=adversary, security_parameter=lam, key_length=key_length,
+        upsilon=upsilon, tau_c=tau_c, gamma_c=gamma_c,
+        sample_cost=per_sample_cost(lam, upsilon), budget_samples=budget,
+        horizon=horizon, independent_keys=keys_to_break(2, scheme, adversary) == 2, budget_limited=budget_limited, decipher_delay=delay_v,
+        warmup_steps=check_int("warmup_steps", cfg["warmup_steps"], minimum=0),
+        reward=reward,
+        logdet_regularization=check_positive("logdet_regularization", cfg["logdet_regularization"]),
+        crypto=crypto, delta=delta, x_bound=check_positive("x_bound", cfg["x_bound"]),
+        u_max=action_scale * math.sqrt(sigma_u2),
+        input_history=check_int("input_history", cfg["input_history"], minimum=0),
+        gamma_opt=bool(cfg["gamma_opt"]), crypto_seed=crypto_seed,
+        tr_psi_u=tr_psi_u, tr_psi_w=tr_psi_w,
+    )

@@ -1,0 +1,154 @@
+"""``EncryptedLTIAttack-v0``: an identification attacker inside an encrypted control loop."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from ..errors import ParameterError
+from ..loop import make_loop
+from .config import AttackParams, default_config, resolve_params
+from .episode import EpisodeCore, attack_design_for
+
+__all__ = ["EncryptedLTIAttackEnv"]
+
+
+class EncryptedLTIAttackEnv(gym.Env):
+    r"""An adversary identifying ``(A, B)`` of an encrypted control system.
+
+    ## Description
+
+    The plant ``x[t+1] = A x[t] + B u[t] + w[t]`` (eq:system) is controlled through the
+    updatable homomorphic encryption of the paper (Teranishi & Kogiso, arXiv 2303.13059):
+    dynamic-key ElGamal whose keys change every sampling period, with the *modified*
+    evaluation/decryption of Definition def:modification so the controller server works without
+    an update token (eq:ec). The agent is the adversary of Definition def:adversary: from the
+    attack start ``t_s`` it injects ``u_t = a_t`` (its action), collects the state and input
+    ciphertexts, pays computation time to break them and identifies ``(A, B)`` by least squares
+    (eq:estimate). It sees decrypted data only once they have been paid for and delivered.
+
+    Each collected sample costs ``2^lambda / Upsilon`` seconds of attacker computation
+    (Definition def:sdt) under ``scheme="modified"`` (either adversary) and ``scheme="token"``
+    with an eavesdropper; under ``"token"`` with a malicious server, and under ``"static"``
+    keys, only the first sample costs anything (Proposition prop:vulnerability; Remark after
+    Definition def:security). The budget is the defense period ``tau_c``.
+
+    With ``crypto="elgamal"`` real ciphertexts go through the loop (keys updated every step;
+    the injected input is forged from public keys only); with ``crypto="ideal"`` the same
+    encode/quantize/decode arithmetic runs without big integers. For one seed both give the
+    same trajectory bit for bit.
+
+    ## Action Space
+
+    ``Box(-1, 1, (m,), float32)``. The injected input is ``a_t = action * action_scale *
+    sigma_u`` (an actuator bound of ``action_scale`` standard deviations), then held to an
+    **energy budget**: over the episode ``sum_t ||a_t||^2 <= m sigma_u2 N`` (average power
+    ``sigma_u2`` per channel, as in Theorem thm:sic). An input that would overdraw the remaining
+    energy is scaled down to exhaust it exactly; afterwards inputs are zero. Every attacker is
+    thus held to the same input energy. Actions outside the box (beyond float32 rounding) or
+    NaN raise :class:`~encctl_gym.errors.ParameterError`.
+
+    | index | meaning                    | range   |
+    |-------|----------------------------|---------|
+    | 0..m-1| injected input / u_max      | [-1, 1] |
+
+    ## Observation Space
+
+    A flat ``float32`` vector of length ``n + m + 1 + H m + 2`` (``H = input_history``):
+
+    | slice              | content                                                             |
+    |--------------------|---------------------------------------------------------------------|
+    | ``[0, n)``         | latest delivered decrypted state ``x_j`` (zeros before any)          |
+    | ``[n, n+m)``       | delivered decrypted input ``u_{j-1}`` that led to ``x_j`` (zeros if none) |
+    | ``n+m``            | 1.0 if a sample was delivered at this step, else 0.0                 |
+    | next ``H m``       | the agent's own last ``H`` actions, newest first (action units)      |
+    | ``-2``             | fraction of the deciphering budget ``tau_c`` spent                   |
+    | ``-1``             | fraction of the input energy budget spent                            |
+
+    Nothing not yet paid for and delivered ever enters the observation: with
+    ``decipher_delay = d`` the state ``x_j`` appears at step ``j + d``; with ``"end"`` nothing
+    is delivered before the attack ends (the agent knows only its own inputs).
+
+    ## Rewards
+
+    * ``reward="log_error"`` (default): the decrease of ``log epsilon`` (Definition def:error)
+      of the least squares estimate on the delivered data against the true ``(A, B)``; before
+      ``n + m`` regression columns the estimate is ``[A B] = 0``. The return telescopes to
+      ``log epsilon_0 - log epsilon_final``.
+    * ``reward="logdet"``: the increase of ``log det(G + delta I)`` of the regressor Gram
+      matrix ``G`` of the delivered data, which an attacker can compute without ``(A, B)``.
+
+    ## Starting State
+
+    ``x_0 ~ N(0, sigma_x2 I)``; with ``warmup_steps > 0`` the plant first runs under an
+    encrypted LQR controller (eq:ec) and the attack starts from the state reached. The first
+    sample (``x_{t_s}``) is collected and paid for at reset.
+
+    ## Episode End
+
+    ``terminated`` when the next sample can no longer be paid for within ``tau_c``: the
+    deciphering budget is part of the environment's state (its spent fraction is observed) and
+    no reward can follow, so this is a true terminal state. ``truncated`` when ``max_samples``
+    ends the attack first: a cap from outside the attacker's problem. Either way all paid
+    samples are delivered in the final observation. ``N`` samples mean ``N`` actions.
+
+    ## Arguments
+
+    ``gymnasium.make("encctl_gym/EncryptedLTIAttack-v0", config={...}, render_mode=None,
+    **overrides)``. See :func:`encctl_gym.envs.config.default_config` for every key
+    (preset, A, B, variances, scheme, adversary, security_parameter or key_length, upsilon,
+    tau_c, max_samples, decipher_delay, warmup_steps, reward, crypto, delta, ...).
+
+    ``info``: ``epsilon`` (least squares error on all delivered data, ``nan`` until
+    identifiable), ``gamma`` (eq:sic at the delivered N), ``gamma_opt`` (optimal attack design,
+    when computed), ``samples_collected``, ``samples_delivered``, ``deciphering_time``,
+    ``input_energy``, ``average_power``.
+
+    ## Version History
+
+    * v0: initial version.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
+
+    def __init__(self, config: dict[str, Any] | None = None, render_mode: str | None = None, **kwargs: Any) -> None:
+        self.params: AttackParams = resolve_params(config, **kwargs)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ParameterError(f"unknown render_mode {render_mode!r}; choose one of {self.metadata['render_modes']}")
+        self.render_mode = render_mode
+        p = self.params
+        self.action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
+        self.observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
+        self.design = attack_design_for(p) if p.gamma_opt else None
+        self._loop = make_loop(p)
+        self._core = EpisodeCore(p, self._loop, self.design)
+
+    @staticmethod
+    def default_config() -> dict[str, Any]:
+        """The default configuration (see :func:`encctl_gym.envs.config.default_config`)."""
+        return default_config()
+
+    @property
+    def loop(self):
+        """The closed loop backend (ideal or ElGamal) behind the plant's input."""
+        return self._loop
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        obs = self._core.reset(self.np_random)
+        return obs[0], self._core.info()
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        reward, terminated, truncated = self._core.step(action)
+        return self._core.observation()[0], float(reward[0]), terminated, truncated, self._core.info()
+
+    def render(self) -> np.ndarray | None:
+        if self.render_mode != "rgb_array":
+            return None
+        from .render import render_error_curve
+
+        return render_error_curve(self._core, self.params, self.design)

@@ -1,0 +1,323 @@
+"""The attack episode, batched over K independent copies.
+
+One implementation serves both :class:`~encctl_gym.envs.EncryptedLTIAttackEnv` (K = 1) and the
+native vector environment (K copies stepped at once in numpy), so the two have the same
+semantics by construction. All copies share the horizon and the delivery schedule, so they run
+in lockstep: time indices are plain integers, only the data differ. Every array operation is
+row-wise (elementwise products and sums over the last axis, batched LAPACK solves), so copy
+``i`` of a batch computes bit for bit what a single environment seeded the same way computes.
+
+Per sampling period ``k`` of the attack (Definition def:adversary):
+
+1. the plant's state ciphertext ``ct_x_k`` is collected and paid for (``2^lambda / Upsilon``
+   seconds, Definition def:sdt, when the scheme gives every sample its own key);
+2. samples whose delay has passed are delivered: state ``x_j`` with the input ``u_{j-1}``;
+   each delivered state adds the regression column ``([x_{j-1}; u_{j-1}], x_j)`` of eq:data
+   to the running Gram matrices, and the least squares estimate (eq:estimate) is re-solved;
+3. the agent acts; its input is held to the energy budget, forged into the input ciphertext,
+   decrypted by the plant (``u_k``) and applied: ``x_{k+1} = A x_k + B u_k + w_k``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..errors import ParameterError
+from .config import AttackParams
+
+__all__ = ["EpisodeCore", "attack_design_for"]
+
+#: noise is drawn from each copy's generator in chunks of this many periods
+_CHUNK = 256
+
+
+def attack_design_for(p: AttackParams) -> Any:
+    """The optimal attack design behind ``info["gamma_opt"]`` (security.attack_design): closed
+    loop when states are delivered in time (``decipher_delay = 0``), open loop otherwise."""
+    from ..security.attack_design import optimal_attack_design
+
+    return optimal_attack_design(p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, feedback=p.decipher_delay == 0)
+
+
+class EpisodeCore:
+    """State and dynamics of K attack episodes stepped in lockstep.
+
+    Parameters
+    ----------
+    params : AttackParams
+        Resolved environment parameters.
+    loop : object
+        Closed-loop backend (:mod:`encctl_gym.loop`) with ``start_episode``, ``control``,
+        ``collect_state``, ``inject`` and ``tick``.
+    design : AttackDesign or None
+        Source of ``gamma_opt`` in the info.
+    num_envs : int
+        K.
+    """
+
+    def __init__(self, params: AttackParams, loop: Any, design: Any = None, num_envs: int = 1) -> None:
+        p = self.p = params
+        self.loop = loop
+        self.K = K = int(num_envs)
+        n, m, N = p.n, p.m, p.horizon
+        self.n, self.m, self.d = n, m, n + m
+        self._A = np.ascontiguousarray(p.A)
+        self._B = np.ascontiguousarray(p.B)
+        self._theta_true = np.hstack([p.A, p.B])  # (n, n+m)
+        self._c = n * (n + m)  # Definition def:error
+        self._eps0 = float(np.sum(self._theta_true**2)) / self._c  # error of the estimate [A B] = 0
+        self._sw = math.sqrt(p.sigma_w2)
+        self._sx = math.sqrt(p.sigma_x2)
+        self._logdet0 = self.d * math.log(p.logdet_regularization)
+        self._reg = p.logdet_regularization * np.eye(self.d)
+        # tables over the sample size N = 0..horizon
+        Ns = np.arange(N + 1)
+        self.gamma_table = np.full(N + 1, np.inf)
+        self.gamma_table[2:] = p.gamma(Ns[2:])  # eq:sic
+        self.has_gamma_opt = design is not None
+        self.gamma_opt_table = np.full(N + 1, np.inf)
+        if design is not None:
+            self.gamma_opt_table[2:] = design.gamma(Ns[2:])
+        keys = Ns if p.independent_keys else np.minimum(Ns, 1)
+        self.time_table = keys * p.sample_cost  # Definition def:sdt
+        self._time_frac = self.time_table / p.tau_c
+        # per-copy data: collected (deciphered) states and applied inputs
+        self.X = np.zeros((K, N, n))
+        self.U = np.zeros((K, N, m))
+        self.G = np.zeros((K, self.d, self.d))  # regressor Gram matrix of the delivered data
+        self.C = np.zeros((K, self.d, n))  # cross term sum z x_next^T
+        self.Q = np.zeros((K, self.d, self.d + n))  # recursive least squares: [P | Theta_hat^T]
+        self.rls_ready = False
+        self.x = np.zeros((K, n))
+        self.hist = np.zeros((K, p.input_history * m))
+        self.energy = np.zeros(K)
+        self.eps = np.full(K, self._eps0)
+        self.logdet = np.full(K, self._logdet0)
+        self.collected = 0  # samples collected and paid for
+        self.delivered = 0  # samples delivered to the agent
+        self.new = False
+        self.done = False
+        self._zeros_n = np.zeros((K, n))
+        self._zeros_m = np.zeros((K, m))
+        self._noise = np.zeros((K, _CHUNK, n))
+        self._noise_pos = _CHUNK
+        self._rngs: list[np.random.Generator] = []
+        self.history: list[tuple[int, float]] = []  # (N delivered, epsilon) of copy 0, for render
+
+    # ----------------------------------------------------------------- randomness
+    def _draw_noise(self) -> np.ndarray:
+        if self._noise_pos >= _CHUNK:
+            for i, rng in enumerate(self._rngs):
+                self._noise[i] = rng.standard_normal((_CHUNK, self.n))
+            self._noise *= self._sw
+            self._noise_pos = 0
+        w = self._noise[:, self._noise_pos]
+        self._noise_pos += 1
+        return w
+
+    # ----------------------------------------------------------------- reset
+    def reset(self, rng: np.random.Generator | Sequence[np.random.Generator]) -> np.ndarray:
+        """Start new episodes for all copies; return the observations, shape (K, obs_dim).
+
+        ``rng`` is one generator (K = 1) or one per copy; all draws of copy ``i`` come from
+        ``rng[i]`` in a fixed order (x_0, then the noise of every period).
+        """
+        rngs = [rng] if isinstance(rng, np.random.Generator) else list(rng)
+        if len(rngs) != self.K:
+            raise ParameterError(f"expected {self.K} random generators, got {len(rngs)}")
+        self._rngs = rngs
+        for i, g in enumerate(rngs):
+            self.x[i] = g.standard_normal(self.n) * self._sx
+        self._noise_pos = _CHUNK
+        self.loop.start_episode()
+        for _ in range(self.p.warmup_steps):  # normal operation under the encrypted controller (eq:ec)
+            self.x = self._next_state(self.x, self.loop.control(self.x), self._draw_noise())
+        self.X[:] = 0.0
+        self.U[:] = 0.0
+        self.G[:] = 0.0
+        self.C[:] = 0.0
+        self.rls_ready = False
+        self.hist[:] = 0.0
+        self.energy[:] = 0.0
+        self.eps[:] = self._eps0
+        self.logdet[:] = self._logdet0
+        self.collected = self.delivered = 0
+        self.done = False
+        self.history = []
+        self._collect()
+        self.new = self._deliver(final=False)
+        return self.observation()
+
+    # ----------------------------------------------------------------- step
+    def _next_state(self, x: np.ndarray, u: np.ndarray, w: np.ndarray) -> np.ndarray:
+        # eq:system, row-wise (no BLAS blocking), so every copy is bit-identical to a lone env
+        return (x[:, None, :] * self._A).sum(-1) + (u[:, None, :] * self._B).sum(-1) + w
+
+    def _collect(self) -> None:
+        """Collect and pay for the state ciphertext of the current period."""
+        self.X[:, self.collected] = self.loop.collect_state(self.x)
+        self.collected += 1
+
+    def _deliver(self, final: bool) -> bool:
+        """Deliver paid samples whose delay has passed; update the estimate and its error."""
+        delay = self.p.decipher_delay
+        if final:
+            target = self.collected
+        elif delay is None:  # "end": nothing before the attack ends
+            target = 0
+        else:
+            target = max(self.collected - delay, 0)
+        if target <= self.delivered:
+            return False
+        for j in range(max(self.delivered, 1), target):
+            # regression column (x_{j-1}, u_{j-1}) -> x_j, available once x_j is delivered
+            self._add_column(np.concatenate((self.X[:, j - 1], self.U[:, j - 1]), axis=1), self.X[:, j])
+        self.delivered = target
+        if self.p.reward == "logdet":
+            self.logdet = np.linalg.slogdet(self.G + self._reg)[1]
+        if self.delivered - 1 >= self.d:
+            if not self.rls_ready:
+                self._start_rls()
+            theta_hat_T = self.Q[:, :, self.d :] if self.rls_ready else self._pinv_estimate()
+            self.eps = ((theta_hat_T - self._theta_true.T) ** 2).sum(axis=(1, 2)) / self._c
+        self.history.append((self.delivered, float(self.eps[0])))
+        return True
+
+    def _add_column(self, z: np.ndarray, y: np.ndarray) -> None:
+        """One regression column: Gram update and the recursive least squares step.
+
+        With ``Q = [P | Theta_hat^T]`` (``P = G^{-1}``), ``r = z^T Q = [(P z)^T, (Theta_hat z)^T]``
+        and ``k = P z / (1 + z^T P z)``, the Sherman-Morrison update of ``P`` and the RLS update
+        ``Theta_hat += (y - Theta_hat z) k^T`` are together ``Q -= k (r - [0, y^T])``.
+        """
+        self.G += z[:, :, None] * z[:, None, :]
+        self.C += z[:, :, None] * y[:, None, :]
+        if self.rls_ready:
+            d = self.d
+            r = (z[:, :, None] * self.Q).sum(axis=1)
+            r[:, d:] -= y
+            k = r[:, :d] / (1.0 + (r[:, :d] * z).sum(axis=1))[:, None]
+            self.Q -= k[:, :, None] * r[:, None, :]
+
+    def _start_rls(self) -> None:
+        """Initialise P = G^{-1} and Theta_hat (eq:estimate) once the Gram matrix is invertible."""
+        G = self.G
+        s = 1.0 / np.sqrt(np.maximum(np.einsum("kii->ki", G), 1e-300))  # Jacobi scaling
+        Gs = G * s[:, :, None] * s[:, None, :]
+        try:
+            sol = np.linalg.solve(Gs, np.concatenate((np.eye(self.d)[None] * s[:, :, None], self.C * s[:, :, None]), axis=2))
+        except np.linalg.LinAlgError:  # rank-deficient data so far: keep the pseudo-inverse estimate
+            return
+        if np.linalg.cond(Gs).max() > 1e12:
+            return
+        self.Q = sol * s[:, :, None]
+        self.rls_ready = True
+
+    def _pinv_estimate(self) -> np.ndarray:
+        """Theta_hat^T of eq:estimate through the pseudo-inverse (rank-deficient data)."""
+        return np.stack([np.linalg.lstsq(Gi, Ci, rcond=None)[0] for Gi, Ci in zip(self.G, self.C)])
+
+    def check_actions(self, action: Any) -> np.ndarray:
+        """Validate actions: shape (K, m) (or (m,) for K = 1), finite, inside [-1, 1]."""
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != (self.K, self.m):
+            if self.K == 1 and a.shape == (self.m,):
+                a = a[None]
+            else:
+                want = (self.m,) if self.K == 1 else (self.K, self.m)
+                raise ParameterError(f"action must have shape {want}, got {a.shape}")
+        if not (np.abs(a) <= 1.0 + 1e-6).all():
+            what = "finite" if not np.isfinite(a).all() else "inside the action space [-1, 1]"
+            raise ParameterError(f"action must be {what}, got {np.asarray(action).tolist()}")
+        return np.clip(a, -1.0, 1.0)
+
+    def step(self, action: Any) -> tuple[np.ndarray, bool, bool]:
+        """Apply the actions of all copies. Returns (rewards (K,), terminated, truncated)."""
+        if self.done:
+            raise ParameterError("step() called after the episode ended; call reset() first")
+        p = self.p
+        act = self.check_actions(action)
+        # energy budget: an input that would overdraw the remaining energy is scaled to exhaust it
+        a = act * p.u_max
+        e = (a * a).sum(axis=1)
+        remaining = p.energy_budget - self.energy
+        over = e > remaining
+        if over.any():
+            scale = np.where(over, np.sqrt(np.maximum(remaining, 0.0) / np.where(e > 0, e, 1.0)), 1.0)
+            a = a * scale[:, None]
+            act = act * scale[:, None]
+            e = np.where(over, np.maximum(remaining, 0.0), e)
+        self.energy += e
+        u = self.loop.inject(a)
+        self.U[:, self.collected - 1] = u
+        self.x = self._next_state(self.x, u, self._draw_noise())
+        if p.input_history:
+            self.hist[:, self.m :] = self.hist[:, : -self.m]
+            self.hist[:, : self.m] = act
+        self.loop.tick()
+        before = self._score()
+        ended = self.collected >= p.horizon
+        if not ended:
+            self._collect()
+        self.new = self._deliver(final=ended)
+        self.done = ended
+        reward = self._score() - before
+        return reward, ended and p.budget_limited, ended and not p.budget_limited
+
+    def _score(self) -> np.ndarray:
+        if self.p.reward == "logdet":
+            return self.logdet.copy()
+        return -np.log(self.eps)
+
+    # ----------------------------------------------------------------- observation and info
+    def observation(self) -> np.ndarray:
+        """Observations of all copies, shape (K, obs_dim), float32 (see the class docstring)."""
+        j = self.delivered - 1  # latest delivered sample
+        K = self.K
+        xs = self.X[:, j] if j >= 0 else self._zeros_n
+        us = self.U[:, j - 1] if j >= 1 else self._zeros_m
+        tail = np.empty((K, 3))
+        tail[:, 0] = float(self.new)
+        tail[:, 1] = self._time_frac[self.collected]
+        tail[:, 2] = self.energy / self.p.energy_budget
+        obs = np.concatenate((xs, us, tail[:, :1], self.hist, tail[:, 1:]), axis=1)
+        return obs.astype(np.float32)
+
+    def info_arrays(self) -> dict[str, np.ndarray]:
+        """Info of every copy as arrays of shape (K,) (keys as in :meth:`info`)."""
+        N, K = self.delivered, self.K
+        info = {
+            "epsilon": self.eps.copy(),
+            "gamma": np.full(K, self.gamma_table[N]),
+            "samples_collected": np.full(K, self.collected),
+            "samples_delivered": np.full(K, N),
+            "deciphering_time": np.full(K, self.time_table[self.collected]),
+            "input_energy": self.energy.copy(),
+            "average_power": self.energy / (max(self.collected, 1) * self.m),
+        }
+        if self.has_gamma_opt:
+            info["gamma_opt"] = np.full(K, self.gamma_opt_table[N])
+        return info
+
+    def info(self) -> dict[str, Any]:
+        """Info of copy 0 as Python scalars (single environment).
+
+        ``epsilon`` is the error (Definition def:error) of the attacker's current estimate: the
+        least squares estimate once ``n + m`` columns are delivered, ``[A B] = 0`` before.
+        """
+        N = self.delivered
+        info = {
+            "epsilon": float(self.eps[0]),
+            "gamma": float(self.gamma_table[N]),
+            "samples_collected": self.collected,
+            "samples_delivered": N,
+            "deciphering_time": float(self.time_table[self.collected]),
+            "input_energy": float(self.energy[0]),
+            "average_power": float(self.energy[0]) / (max(self.collected, 1) * self.m),
+        }
+        if self.has_gamma_opt:
+            info["gamma_opt"] = float(self.gamma_opt_table[N])
+        return info

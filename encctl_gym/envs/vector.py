@@ -1,0 +1,92 @@
+"""Native batched vector environment for ``EncryptedLTIAttack-v0`` (ideal backend).
+
+Steps ``num_envs`` copies at once in numpy through the same :class:`EpisodeCore` as the single
+environment. Copy ``i`` seeded by ``reset(seed=s)`` draws from ``np_random(s + i)``, as
+gymnasium's ``SyncVectorEnv`` would seed it, so it reproduces a single environment reset with
+``seed = s + i`` bit for bit. All copies share the horizon, so their episodes end together;
+autoreset follows gymnasium's default next-step mode (the step after an episode ends resets
+every copy and returns reward 0).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from .._validation import check_int
+from ..errors import ParameterError
+from ..loop import make_loop
+from .config import AttackParams, resolve_params
+from .episode import EpisodeCore, attack_design_for
+
+__all__ = ["EncryptedLTIAttackVectorEnv"]
+
+
+class EncryptedLTIAttackVectorEnv(VectorEnv):
+    """``num_envs`` copies of :class:`~encctl_gym.envs.EncryptedLTIAttackEnv` stepped in numpy.
+
+    Parameters
+    ----------
+    num_envs : int
+        Number of copies.
+    config, **kwargs
+        As for the single environment; only ``crypto="ideal"`` is batched.
+
+    ``info`` holds one array of shape ``(num_envs,)`` per key of the single environment's info.
+    """
+
+    metadata = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(self, num_envs: int = 1, config: dict[str, Any] | None = None, max_episode_steps: int | None = None, **kwargs: Any) -> None:
+        self.num_envs = check_int("num_envs", num_envs, minimum=1)
+        self.params: AttackParams = resolve_params(config, **kwargs)
+        if self.params.crypto != "ideal":
+            raise ParameterError(f"the vector environment batches the ideal backend only, got crypto={self.params.crypto!r}")
+        if max_episode_steps is not None:
+            raise ParameterError("the attack length is set by tau_c or max_samples, not max_episode_steps")
+        p = self.params
+        self.single_action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
+        self.single_observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.design = attack_design_for(p) if p.gamma_opt else None
+        self._core = EpisodeCore(p, make_loop(p), self.design, num_envs=self.num_envs)
+        self._rngs: list[np.random.Generator] | None = None
+        self._needs_reset = False
+
+    def reset(self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+        if seed is not None or self._rngs is None:
+            if isinstance(seed, (list, tuple)):
+                if len(seed) != self.num_envs:
+                    raise ParameterError(f"expected {self.num_envs} seeds, got {len(seed)}")
+                seeds = list(seed)
+            else:
+                seeds = [None if seed is None else seed + i for i in range(self.num_envs)]
+            self._rngs = [seeding.np_random(s)[0] for s in seeds]
+            self._np_random, self._np_random_seed = seeding.np_random(seed if isinstance(seed, int) else None)
+        obs = self._core.reset(self._rngs)
+        self._needs_reset = False
+        return obs, self._core.info_arrays()
+
+    def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        if self._rngs is None:
+            raise ParameterError("call reset() before step()")
+        if self._needs_reset:  # next-step autoreset: every copy ended on the previous step
+            obs, info = self.reset()
+            zeros = np.zeros(self.num_envs, dtype=bool)
+            return obs, np.zeros(self.num_envs), zeros, zeros.copy(), info
+        reward, terminated, truncated = self._core.step(actions)
+        self._needs_reset = terminated or truncated
+        K = self.num_envs
+        return (
+            self._core.observation(),
+            reward,
+            np.full(K, terminated),
+            np.full(K, truncated),
+            self._core.info_arrays(),
+        )
