@@ -46,6 +46,7 @@ imported on first use.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -197,7 +198,10 @@ def _solve(prob: Any, solver: str | None) -> str:
             errors.append(f"{name}: not installed")
             continue
         try:
-            prob.solve(solver=name, **_SOLVER_OPTIONS.get(name, {}))
+            with warnings.catch_warnings():
+                # "Solution may be inaccurate": such solutions are checked by _validate instead.
+                warnings.simplefilter("ignore", UserWarning)
+                prob.solve(solver=name, **_SOLVER_OPTIONS.get(name, {}))
         except (cp.error.SolverError, ArithmeticError, ValueError) as exc:
             errors.append(f"{name}: {exc}")
             continue
