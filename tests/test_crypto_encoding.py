@@ -1,0 +1,208 @@
+"""Tests of the encoder/decoder of Definition def:ec (crypto.encoding)."""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import gmpy2
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from encctl_gym.crypto.arith import PowmodCounter
+from encctl_gym.crypto.elgamal import decrypt, encrypt, keygen
+from encctl_gym.crypto.encoding import (
+    DEFAULT_MAX_SHIFT,
+    Encoder,
+    decode_int,
+    default_max_shift,
+    encode_int,
+    nearest_member,
+)
+from encctl_gym.crypto.group import GroupParams, shipped_group
+from encctl_gym.errors import EncodingOverflowError, ParameterError, PlaintextError
+
+TOY = GroupParams(23, 11, 4)  # G = {1, 2, 3, 4, 6, 8, 9, 12, 13, 16, 18}
+G64, G128 = shipped_group(64), shipped_group(128)
+
+
+def test_known_answers_toy_group():
+    # Delta = 1, max_shift = 2: representable |round(x)| <= 11 - 2 = 9.
+    enc = Encoder(TOY, 1.0, max_shift=2)
+    cases = {
+        # x: (signed w, plaintext, shift)
+        5: (6, 6, 1),  # 5 not in G; 6 is
+        -5: (-5, 18, 0),  # -5 = 18 mod 23 is in G: stored as p - |v|
+        0: (1, 1, 1),  # 0 is never in G; +1 is tried first
+        7: (8, 8, 1),
+        9: (9, 9, 0),
+        -1: (1, 1, 2),  # -1 = 22 no, 0 excluded, -2 = 21 no, 1 yes
+        -9: (-10, 13, 1),  # -9 = 14 no, -8 = 15 no, -10 = 13 yes
+        2.4: (2, 2, 0),  # round(2.4) = 2
+        2.5: (2, 2, 0),  # round half to even
+        3.5: (4, 4, 0),
+    }
+    for x, (w, m, s) in cases.items():
+        assert enc.encode_signed(x) == w, x
+        assert enc.encode_with_shift(x) == (m, s), x
+        assert enc.encode(x) == m
+        assert enc.decode(m) == float(w)
+    assert decode_int(TOY, 18) == -5 and decode_int(TOY, 11) == 11 and decode_int(TOY, 12) == -11
+    assert encode_int(TOY, -5, max_shift=2) == 18
+    assert nearest_member(TOY, 10, 2) == (9, 1)  # 10 no, 11 no, 9 yes
+
+
+def test_zero_encodes_to_one_in_safe_prime_groups():
+    for grp in (G64, G128, shipped_group(712)):
+        enc = Encoder(grp, 2.0**10)
+        assert enc.encode(0.0) == 1 and enc.decode(1) == 2.0**-10
+
+
+def test_max_shift_exceeded_raises():
+    enc = Encoder(TOY, 1.0, max_shift=0)
+    assert enc.encode(4) == 4
+    with pytest.raises(PlaintextError, match="no element of the order-q subgroup within max_shift = 0 of v = 5"):
+        enc.encode(5)
+    with pytest.raises(PlaintextError, match="max_shift = 1 of v = -1"):
+        nearest_member(TOY, -1, 1)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    x=st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False),
+    log_delta=st.integers(0, 30),
+    big=st.booleans(),
+)
+def test_roundtrip_error_bound(x, log_delta, big):
+    """|Dcd(Ecd(x)) - x| <= (1/2 + s)/Delta, with s the reported shift (exact for Delta = 2^k)."""
+    grp = G128 if big else G64
+    enc = Encoder(grp, 2.0**log_delta)
+    m, s = enc.encode_with_shift(x)
+    assert grp.contains(m) and 0 <= s <= enc.max_shift
+    err = abs(Fraction(enc.decode(m)) - Fraction(x))
+    assert err <= (Fraction(1, 2) + s) / Fraction(enc.delta)
+    assert abs(enc.decode(m) - x) <= enc.error_bound(s)
+
+
+@settings(max_examples=200, deadline=None)
+@given(x=st.floats(-1e3, 1e3, allow_nan=False), delta=st.floats(0.5, 1e6))
+def test_roundtrip_error_bound_any_delta(x, delta):
+    """For a Delta that is not a power of two, the bound holds up to the double rounding of Delta*x."""
+    enc = Encoder(G128, delta)
+    m, s = enc.encode_with_shift(x)
+    slack = 4 * math.ulp(abs(delta * x) + 1.0) / delta
+    assert abs(enc.decode(m) - x) <= (0.5 + s) / delta + slack
+
+
+def test_shift_statistics_are_small():
+    enc = Encoder(shipped_group(712), 2.0**20)
+    xs = np.linspace(-100, 100, 2001)
+    shifts = [enc.encode_with_shift(float(x))[1] for x in xs]
+    assert max(shifts) < 20 and np.mean(shifts) < 2.0
+
+
+def test_membership_uses_jacobi_not_powmod_for_safe_primes():
+    enc = Encoder(shipped_group(712), 2.0**16)
+    with PowmodCounter() as c:
+        enc.encode_array(np.linspace(-5, 5, 101))
+    assert c.count == 0
+
+
+def test_other_cofactor_uses_powmod_membership():
+    # p = 29 = 4 * 7 + 1, g = 16 of order 7: G = {1, 7, 16, 20, 23, 24, 25}.
+    grp = GroupParams(29, 7, 16).verify()
+    members = {m for m in range(1, 29) if pow(m, 7, 29) == 1}
+    assert members == {1, 7, 16, 20, 23, 24, 25}
+    assert default_max_shift(grp) == DEFAULT_MAX_SHIFT * 2
+    enc = Encoder(grp, 1.0, max_shift=6)  # representable |v| <= 14 - 6 = 8
+    with PowmodCounter() as c:
+        w, s = nearest_member(grp, 3, 6)  # 3, 4, 2, 5, 1 -> 1 is the first member
+    assert (w, s) == (1, 2) and c.count == 5
+    for x in range(-8, 9):
+        m = enc.encode(x)
+        assert m in members
+        assert abs(enc.decode(m) - x) <= 0.5 + 6
+    # Full ElGamal round trip in that group.
+    pk, sk = keygen(grp, 4)
+    assert decrypt(sk, encrypt(pk, enc.encode(-3), 5)) == enc.encode(-3)
+    with pytest.raises(ParameterError, match="cofactor"):
+        q = 1009
+        n = next(n for n in range(2000, 4000, 2) if gmpy2.is_prime(n * q + 1))
+        default_max_shift(GroupParams(n * q + 1, q, pow(3, n, n * q + 1)))
+
+
+def test_vectorised_matches_scalar():
+    enc = Encoder(G128, 1000.0)
+    X = np.array([[0.1234, -5.0, 0.0], [1e-9, -1e-3, 7.77]])
+    M = enc.encode_array(X)
+    W = enc.encode_signed_array(X)
+    assert M.shape == X.shape and M.dtype == object
+    for idx in np.ndindex(X.shape):
+        assert M[idx] == enc.encode(X[idx]) and W[idx] == enc.encode_signed(X[idx])
+        assert M[idx] == W[idx] % G128.p
+    assert np.array_equal(enc.decode_array(M), np.vectorize(enc.decode)(M).astype(float))
+    assert np.array_equal(enc.decode_signed_array(W), enc.decode_array(M))
+    assert np.array_equal(enc.quantize_array(X), np.vectorize(enc.quantize)(X))
+    assert enc.decode(enc.encode(2.0) * enc.encode(3.0) % G128.p, power=2) == pytest.approx(6.0, abs=1e-2)
+
+
+def test_decode_is_exact_division():
+    # The decoded float is the correctly rounded quotient w / Delta^k (Fraction arithmetic).
+    enc = Encoder(G128, 0.1)  # 0.1 is not exact in binary; the ratio of the double is used.
+    for w in (1, -3, 12345678901234567, -(G128.half - 5)):
+        exact = Fraction(w) / Fraction(0.1) ** 2
+        assert enc.decode_signed(w, power=2) == float(exact)
+
+
+def test_overflow_is_never_silent():
+    enc = Encoder(G64, 2.0**20, x_bound=100.0)
+    assert abs(enc.decode(enc.encode(-100.0)) + 100.0) <= enc.error_bound()
+    with pytest.raises(EncodingOverflowError, match=r"x = 100.5 is outside the declared input range \|x\| <= 100.0"):
+        enc.encode(100.5)
+    with pytest.raises(EncodingOverflowError, match="x = -1000.0"):
+        enc.encode_array([1.0, -1000.0])
+    # Without a declared bound, the representable range of the group is the limit.
+    free = Encoder(G64, 2.0**40)
+    limit = (G64.half - free.max_shift) / 2.0**40
+    free.encode(limit * 0.999)
+    with pytest.raises(EncodingOverflowError, match="not representable"):
+        free.encode(limit * 1.001)
+    with pytest.raises(EncodingOverflowError, match="x_bound"):
+        Encoder(G64, 2.0**40, x_bound=1e9)
+    with pytest.raises(EncodingOverflowError, match="overflows a float"):
+        Encoder(G64, 1e300).encode(1e10)
+    with pytest.raises(EncodingOverflowError):
+        encode_int(TOY, 11, max_shift=2)  # 11 -> nearest member 12 > (p-1)/2
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf"), "1.0", None, True])
+def test_non_finite_inputs_raise_parameter_error(bad):
+    enc = Encoder(G64, 100.0)
+    with pytest.raises(ParameterError):
+        enc.encode(bad)
+    if bad is not None and not isinstance(bad, (str, bool)):
+        with pytest.raises(ParameterError, match="finite"):
+            enc.encode_array([0.0, bad])
+
+
+@pytest.mark.parametrize("delta", [0, -1.0, float("nan"), float("inf"), "2", None])
+def test_bad_delta(delta):
+    with pytest.raises(ParameterError, match="delta"):
+        Encoder(G64, delta)
+
+
+def test_bad_encoder_arguments():
+    with pytest.raises(ParameterError, match="GroupParams"):
+        Encoder(23, 1.0)
+    with pytest.raises(ParameterError, match="x_bound"):
+        Encoder(G64, 1.0, x_bound=-1.0)
+    with pytest.raises(ParameterError, match="x_bound"):
+        Encoder(G64, 1.0, x_bound=float("nan"))
+    with pytest.raises(ParameterError, match="max_shift"):
+        Encoder(G64, 1.0, max_shift=-1)
+    with pytest.raises(PlaintextError, match="outside"):
+        decode_int(TOY, 23)
+    with pytest.raises(PlaintextError, match="integer"):
+        decode_int(TOY, 2.0)
