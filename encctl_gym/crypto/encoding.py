@@ -332,17 +332,17 @@ class Encoder:
         except (TypeError, ValueError) as exc:
             raise ParameterError(f"x must be numeric, got {x!r}") from exc
         if not np.all(np.isfinite(arr)):
-            bad = arr[~np.isfinite(arr)].flat[0]
+            bad = float(arr[~np.isfinite(arr)].flat[0])
             raise ParameterError(f"x must be finite, got {bad!r}")
         if self.x_bound is not None and arr.size and np.max(np.abs(arr)) > self.x_bound:
-            bad = arr.flat[int(np.argmax(np.abs(arr)))]
+            bad = float(arr.flat[int(np.argmax(np.abs(arr)))])
             raise EncodingOverflowError(
                 f"x = {bad!r} is outside the declared input range |x| <= {self.x_bound!r}"
             )
         with np.errstate(over="ignore"):
             y = np.rint(self.delta * arr)
         out = np.empty(arr.shape, dtype=object)
-        for idx, (xv, yv) in enumerate(zip(arr.flat, y.flat)):
+        for idx, (xv, yv) in enumerate(zip(arr.ravel().tolist(), y.ravel().tolist())):
             if not math.isfinite(yv):
                 raise EncodingOverflowError(f"x = {xv!r}: Delta * x overflows a float")
             v = int(yv)
