@@ -38,6 +38,7 @@ is exactly the float the plant decodes.
 
 from __future__ import annotations
 
+import math
 from typing import Any, Literal, Optional, Sequence, Union
 
 import numpy as np
@@ -675,9 +676,9 @@ def _injection_integers(a: Any, encoder: Encoder, n_cols: int) -> tuple[list[int
     half = encoder.group.half
     ones = n_cols - 1
     w0 = []
-    for ai in arr:
+    for ai in arr.tolist():
         y = float(np.rint(d2 * ai))
-        if not np.isfinite(y) or abs(y) + ones + encoder.max_shift >= half:
+        if not math.isfinite(y) or abs(y) + ones + encoder.max_shift >= half:
             raise EncodingOverflowError(
                 f"injected value a = {ai!r} is not representable: Delta^2 a = {d2 * ai!r} "
                 f"exceeds (p-1)/2 for a {encoder.group.bits}-bit group"
