@@ -191,6 +191,8 @@ class RandomSource:
 
     @staticmethod
     def _check_n(n: int) -> int:
+        if type(n) is int and n >= 1:  # fast path
+            return n
         if isinstance(n, bool) or not isinstance(n, (numbers.Integral, type(mpz(0)))):
             raise ParameterError(f"the bound n must be an integer, got {n!r}")
         if n < 1:

@@ -37,8 +37,16 @@ __all__ = [
 ]
 
 
+_MPZ = type(arith.mpz(0))
+
+
 def _int_field(obj: Any, name: str, err: type) -> None:
     value = getattr(obj, name)
+    if type(value) is int:  # fast path (hot in the control loop)
+        return
+    if type(value) is _MPZ:
+        object.__setattr__(obj, name, int(value))
+        return
     if isinstance(value, bool) or not (
         isinstance(value, (numbers.Integral, np.integer)) or type(value).__name__ == "mpz"
     ):
@@ -49,6 +57,8 @@ def _int_field(obj: Any, name: str, err: type) -> None:
 def _step_field(obj: Any, name: str, err: type, optional: bool) -> None:
     value = getattr(obj, name)
     if value is None and optional:
+        return
+    if type(value) is int and value >= 0:  # fast path
         return
     if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)) or value < 0:
         raise err(f"{type(obj).__name__}.{name} must be a time step >= 0, got {value!r}")
@@ -148,11 +158,12 @@ def check_plaintext(group: GroupParams, m: Any) -> int:
     PlaintextError
         If ``m`` is not an integer, is 0, lies outside [1, p) or outside the order-q subgroup.
     """
-    if isinstance(m, bool) or not (
-        isinstance(m, (numbers.Integral, np.integer)) or type(m).__name__ == "mpz"
-    ):
-        raise PlaintextError(f"plaintext must be an integer element of G, got {m!r}")
-    m = int(m)
+    if type(m) is not int:
+        if isinstance(m, bool) or not (
+            isinstance(m, (numbers.Integral, np.integer)) or type(m) is _MPZ
+        ):
+            raise PlaintextError(f"plaintext must be an integer element of G, got {m!r}")
+        m = int(m)
     if m == 0:
         raise PlaintextError("plaintext m = 0 is not an element of G (0 has no order)")
     if not 0 < m < group.p:

@@ -19,7 +19,7 @@ import dataclasses
 import json
 import sys
 import time
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from pathlib import Path
 from typing import Any, Mapping, Union
 
@@ -123,7 +123,7 @@ class GroupParams:
         """Bit length of p (the paper's key length k; ``GroupParams.bits`` convention)."""
         return self.p.bit_length()
 
-    @property
+    @cached_property
     def cofactor(self) -> int:
         """The cofactor n with p = n q + 1 (2 for safe-prime groups)."""
         return (self.p - 1) // self.q
@@ -133,7 +133,7 @@ class GroupParams:
         """True if p = 2q + 1, so that G is the set of quadratic residues modulo p."""
         return self.cofactor == 2
 
-    @property
+    @cached_property
     def half(self) -> int:
         """(p - 1) // 2: signed plaintexts are lifted to the interval [-half, half]."""
         return (self.p - 1) // 2

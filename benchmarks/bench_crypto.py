@@ -1,0 +1,143 @@
+"""Benchmark of the cryptographic core (encctl_gym.crypto).
+
+For each key length it prints the time of: safe-prime group generation + KeyGen (fresh) and
+KeyGen with the shipped group, Enc, Dec, Eval, Eval_bar/Dec_bar, KeyUpd, CtUpd, and one
+full encrypted control step of each scheme (n = m = 4), with the step time divided by the
+time of one gmpy2.powmod at that size (full-size exponent) measured in the same run, and
+the number of modular exponentiations per step (counted by crypto.arith.powmod).
+
+Usage::
+
+    python benchmarks/bench_crypto.py            # full run (2048-bit generation with timeout)
+    python benchmarks/bench_crypto.py --quick    # fewer repetitions, no fresh 2048-bit group
+"""
+
+from __future__ import annotations
+
+import argparse
+import multiprocessing as mp
+import statistics
+import sys
+import time
+from typing import Callable
+
+import gmpy2
+import numpy as np
+
+from encctl_gym.crypto import arith
+from encctl_gym.crypto.controller import EncryptedLinearController
+from encctl_gym.crypto.dyn_elgamal import ciphertext_update, key_update
+from encctl_gym.crypto.elgamal import decrypt, encrypt, keygen, mult
+from encctl_gym.crypto.group import generate_safe_prime_group, shipped_group
+from encctl_gym.crypto.modified import modified_decrypt, modified_eval
+
+PHI = np.array(
+    [[0.5, -1.2, 0.3, 0.0], [1.0, 2.0, -3.0, 0.25], [0.1, 0.2, 0.3, 0.4], [-1.0, -1.0, -1.0, -1.0]]
+)
+
+
+def timeit(fn: Callable[[], object], reps: int) -> float:
+    """Median wall time of ``fn`` in seconds over ``reps`` calls (after one warm-up call)."""
+    fn()
+    times = []
+    for _ in range(reps):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def _generate(bits: int, queue: "mp.Queue[float]") -> None:
+    t0 = time.perf_counter()
+    grp = generate_safe_prime_group(bits)
+    keygen(grp)
+    queue.put(time.perf_counter() - t0)
+
+
+def fresh_keygen(bits: int, samples: int, timeout: float) -> str:
+    """Time of generate_safe_prime_group + keygen, each sample in a child process with a timeout."""
+    times = []
+    ctx = mp.get_context("spawn" if sys.platform == "win32" else "fork")
+    for _ in range(samples):
+        queue: "mp.Queue[float]" = ctx.Queue()
+        proc = ctx.Process(target=_generate, args=(bits, queue), daemon=True)
+        proc.start()
+        proc.join(timeout)
+        if proc.is_alive():
+            proc.terminate()
+            proc.join()
+            return f"> {timeout:.0f} s (timeout)"
+        times.append(queue.get())
+    if len(times) == 1:
+        return f"{times[0]:.2f} s"
+    return f"{statistics.median(times):.2f} s (median of {len(times)}, {min(times):.2f}-{max(times):.2f})"
+
+
+def bench_size(bits: int, reps: int, fresh_samples: int, fresh_timeout: float, skip_fresh: bool) -> None:
+    grp = shipped_group(bits)
+    rng = arith.seeded_random(bits)
+    p = grp.p
+    base = gmpy2.mpz(rng.between(2, p))
+    exp = gmpy2.mpz(rng.between(p // 2, p))  # full-size exponent (bit length of p)
+    t_pow = timeit(lambda: gmpy2.powmod(base, exp, p), max(reps, 20))
+    t_pow_py = timeit(lambda: pow(int(base), int(exp), int(p)), max(3, reps // 4))
+
+    pk, sk = keygen(grp, rng)
+    m1, m2 = 4, 9
+    ct1, ct2 = encrypt(pk, m1, rng), encrypt(pk, m2, rng)
+    pk1, sk1, tok = key_update(pk, sk, rng)
+    ct2_next = encrypt(pk1, m2, rng)
+    mct = modified_eval(pk, ct1, ct2_next)
+
+    rows: list[tuple[str, str]] = []
+    rows.append(("gmpy2.powmod (full exponent)", f"{t_pow * 1e3:9.3f} ms"))
+    rows.append(("Python pow (same)", f"{t_pow_py * 1e3:9.3f} ms  ({t_pow_py / t_pow:.1f}x gmpy2)"))
+    if skip_fresh:
+        rows.append(("keygen, fresh safe prime", "skipped"))
+    else:
+        rows.append(("keygen, fresh safe prime", fresh_keygen(bits, fresh_samples, fresh_timeout)))
+    rows.append(("keygen, shipped group", f"{timeit(lambda: keygen(grp), reps) * 1e3:9.3f} ms"))
+    rows.append(("encrypt", f"{timeit(lambda: encrypt(pk, m1), reps) * 1e3:9.3f} ms"))
+    rows.append(("decrypt", f"{timeit(lambda: decrypt(sk, ct1), reps) * 1e3:9.3f} ms"))
+    rows.append(("eval (mult)", f"{timeit(lambda: mult(pk, ct1, ct2), reps) * 1e3:9.3f} ms"))
+    rows.append(("modified_eval", f"{timeit(lambda: modified_eval(pk, ct1, ct2_next), reps) * 1e3:9.3f} ms"))
+    rows.append(("modified_decrypt", f"{timeit(lambda: modified_decrypt(sk, sk1, mct), reps) * 1e3:9.3f} ms"))
+    rows.append(("key_update", f"{timeit(lambda: key_update(pk, sk), reps) * 1e3:9.3f} ms"))
+    rows.append(("ciphertext_update", f"{timeit(lambda: ciphertext_update(pk, ct1, tok), reps) * 1e3:9.3f} ms"))
+    for scheme in ("modified", "token"):
+        ctrl = EncryptedLinearController(PHI, grp, 2.0**16, 10.0, scheme=scheme)
+        xs = np.random.default_rng(0).uniform(-10, 10, (reps + 1, 4))
+        it = iter(xs)
+        t_step = timeit(lambda: ctrl.step(next(it)), reps)
+        with arith.PowmodCounter() as c:
+            ctrl.step(xs[0])
+        rows.append(
+            (
+                f"control step, {scheme} (n=m=4)",
+                f"{t_step * 1e3:9.3f} ms  = {t_step / t_pow:6.1f} powmods of time, {c.count} powmods counted",
+            )
+        )
+    print(f"\n== {bits}-bit group (p = 2q + 1) ==")
+    for name, val in rows:
+        print(f"  {name:<34s} {val}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--bits", type=int, nargs="+", default=[256, 712, 1024, 2048])
+    parser.add_argument("--quick", action="store_true", help="fewer repetitions; no fresh 2048-bit group")
+    parser.add_argument("--reps", type=int, default=None, help="repetitions per timing (default 30, quick 8)")
+    parser.add_argument("--skip-fresh-2048", action="store_true", help="skip fresh 2048-bit group generation")
+    parser.add_argument("--fresh-timeout", type=float, default=120.0, help="timeout (s) per fresh generation")
+    args = parser.parse_args(argv)
+    reps = args.reps or (8 if args.quick else 30)
+    fresh_samples = 1 if args.quick else 3
+    print(f"gmpy2 {gmpy2.version()}, {gmpy2.mp_version()}; reps = {reps}; times are medians")
+    for bits in args.bits:
+        skip = bits >= 2048 and (args.quick or args.skip_fresh_2048)
+        bench_size(bits, reps, 1 if bits >= 2048 else fresh_samples, args.fresh_timeout, skip)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
