@@ -28,6 +28,7 @@ member is 1).
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -35,7 +36,7 @@ import scipy.linalg
 
 from .errors import ParameterError
 
-__all__ = ["lqr_gain", "IdealLoop", "ElGamalLoop", "make_loop", "table_limit"]
+__all__ = ["lqr_gain", "IdealLoop", "ElGamalLoop", "make_loop", "loop_group", "table_limit"]
 
 
 def lqr_gain(A: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -93,11 +94,33 @@ class IdealLoop:
         pass
 
 
-def make_loop(params: Any) -> Any:
-    """The loop backend selected by ``params.crypto``."""
-    from .crypto.group import get_group
+def loop_group(key_length: int) -> Any:
+    """The group both backends use for a key length k (same group: same quantisation).
 
-    group = get_group(params.key_length)
+    The smallest shipped group with at least ``k`` bits (``p`` of 64, 128, 256, 512, 712, 1024 or
+    2048 bits), so that the loop is set up instantly and every run uses the same public
+    parameters; beyond 2048 bits a safe-prime group generated from the seed ``k``, so it too is
+    the same in every run (group parameters are public: a fixed seed costs no security).
+    """
+    from .crypto.group import SHIPPED_BITS, shipped_group
+
+    for bits in SHIPPED_BITS:
+        if bits >= key_length:
+            return shipped_group(bits)
+    return _generated_group(int(key_length))
+
+
+@lru_cache(maxsize=4)
+def _generated_group(bits: int) -> Any:
+    from .crypto.arith import seeded_random
+    from .crypto.group import generate_safe_prime_group
+
+    return generate_safe_prime_group(bits, rng=seeded_random(bits))
+
+
+def make_loop(params: Any) -> Any:
+    """The loop backend selected by ``params.crypto``, on the group of :func:`loop_group`."""
+    group = loop_group(params.key_length)
     if params.crypto == "ideal":
         return IdealLoop(params, group)
     if params.crypto == "elgamal":
@@ -105,6 +128,89 @@ def make_loop(params: Any) -> Any:
     raise ParameterError(f"unknown crypto backend {params.crypto!r}")
 
 
-class ElGamalLoop:  # filled in below once the crypto controller API is fixed
+class ElGamalLoop:
+    """Real dynamic-key ElGamal ciphertexts through the loop (one copy).
+
+    The plant side (:class:`~encctl_gym.crypto.controller.PlantCryptoSide`) holds the keys,
+    encrypts the state under ``pk_t``, decrypts (two-key ``Dec_bar(sk_0, sk_t, .)`` in the
+    modified scheme, ``Dec(sk_t, .)`` otherwise), sums and decodes; the controller server holds
+    public keys and ciphertexts only. ``"modified"``: Phi encrypted once under ``pk_0``, keys
+    updated every period, no token leaves the plant. ``"token"``: the server receives every
+    update token and CtUpds Phi's ciphertexts. ``"static"``: one key pair, never updated.
+
+    The adversary's break of a state ciphertext (paid for in time by the environment) is
+    simulated by decrypting with the plant's key of that period.
+    """
+
     def __init__(self, params: Any, group: Any) -> None:
-        raise ParameterError("the elgamal backend is not available yet")
+        from .crypto.arith import as_random_source
+        from .crypto.encoding import Encoder
+
+        self.params = params
+        self.group = group
+        self.n, self.m = params.n, params.m
+        self.scheme = params.scheme
+        self.encoder = Encoder(group, float(params.delta))
+        self.Phi = -lqr_gain(params.A, params.B)
+        self._rng = as_random_source(params.crypto_seed)
+        self.plant: Any = None
+        self.server: Any = None
+        self.last_state_ciphertexts: list[Any] | None = None
+        self.last_output_ciphertexts: list[list[Any]] | None = None
+
+    def start_episode(self) -> None:
+        """Fresh keys (KeyGen) and Phi encrypted under ``pk_0``; the server is set up."""
+        from .crypto.controller import ControllerServer, PlantCryptoSide, QuantizedLinearController, TokenControllerServer
+
+        quant = QuantizedLinearController(self.Phi, self.encoder, self.params.x_bound)
+        self.plant = PlantCryptoSide(quant, "modified" if self.scheme == "modified" else "token", self._rng)
+        ct_phi = self.plant.encrypt_parameter()
+        if self.scheme == "modified":
+            self.server = ControllerServer(self.plant.pk0, ct_phi)
+        else:
+            self.server = TokenControllerServer(self.plant.pk0, ct_phi, self._rng)
+
+    @staticmethod
+    def _single(v: np.ndarray) -> np.ndarray:
+        if v.shape[0] != 1:
+            raise ParameterError(f"the elgamal backend runs one copy, got a batch of {v.shape[0]}")
+        return v[0]
+
+    def collect_state(self, x: np.ndarray) -> np.ndarray:
+        """Encrypt ``x_t`` under ``pk_t`` (what the server and an eavesdropper receive) and
+        return what breaking those ciphertexts reveals: ``Dcd(Dec(sk_t, ct))``."""
+        from .crypto.elgamal import decrypt
+
+        self.last_state_ciphertexts = self.plant.encrypt_state(self._single(x))
+        sk_t = self.plant.secret_key
+        return np.array([[self.encoder.decode(decrypt(sk_t, ct)) for ct in self.last_state_ciphertexts]])
+
+    def control(self, x: np.ndarray) -> np.ndarray:
+        """A full period of normal operation: encrypt, server evaluation (eq:ec), decrypt, Sum,
+        decode, key update."""
+        ct_x = self.plant.encrypt_state(self._single(x))
+        out = self.server.evaluate(ct_x)
+        u = self.plant.decrypt_output(out)
+        self.tick()
+        return u[None]
+
+    def inject(self, a: np.ndarray) -> np.ndarray:
+        """The adversary forges the input ciphertexts from public keys only; the plant decrypts."""
+        from .crypto.controller import forge_injection, forge_injection_token
+
+        a0 = self._single(a)
+        if self.scheme == "modified":
+            out = forge_injection(self.plant.pk0, self.plant.pk, a0, self.encoder, self.n, self._rng)
+        else:
+            out = forge_injection_token(self.plant.pk, a0, self.encoder, self.n, self._rng)
+        self.last_output_ciphertexts = out
+        return self.plant.decrypt_output(out)[None]
+
+    def tick(self) -> None:
+        """KeyUpd at the end of the period (none for static keys); the token scheme sends the
+        token to the server, which CtUpds Phi's ciphertexts."""
+        if self.scheme == "static":
+            return
+        token = self.plant.update_keys()
+        if self.scheme == "token":
+            self.server.receive_token(token)
