@@ -238,9 +238,13 @@ def encrypt(pk: PublicKey, m: int, rng: RngLike = None) -> Ciphertext:
         If ``m`` is 0 or not in G.
     """
     _check_key(pk, PublicKey, "pk")
+    return _encrypt_member(pk, check_plaintext(pk.group, m), arith.as_random_source(rng))
+
+
+def _encrypt_member(pk: PublicKey, m: int, src: arith.RandomSource) -> Ciphertext:
+    # Enc for a plaintext already known to lie in G (e.g. produced by the encoder).
     grp = pk.group
-    m = check_plaintext(grp, m)
-    r = arith.as_random_source(rng).between(1, grp.q)
+    r = src.between(1, grp.q)
     c1 = arith.powmod(grp.g, r, grp.p)
     c2 = arith.mulmod(m, arith.powmod(pk.h, r, grp.p), grp.p)
     return Ciphertext(int(c1), int(c2), pk.t)
