@@ -210,7 +210,7 @@ class GroupParams:
         except (KeyError, TypeError) as exc:
             raise GroupError(f"group data must have fields p, q, g, got {data!r}") from exc
         for name in ("bits", "cofactor"):
-            if name in data and int(data[name]) != getattr(group, name):
+            if name in data and _as_int(name, data[name]) != getattr(group, name):
                 raise GroupError(
                     f"declared {name} = {data[name]} does not match the parameters "
                     f"({name} = {getattr(group, name)})"
