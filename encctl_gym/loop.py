@@ -64,6 +64,8 @@ class IdealLoop:
         self.Phi_int = self.encode_int(self.Phi)
         self._one = int(self.encode_int(np.array(1.0)))
         self._zero2 = int(self.encode_int(np.array(0.0))) ** 2
+        #: what the fused compiled step needs (encctl_gym.envs._kernels.step_ideal)
+        self.fused_parameters = (self.delta, self.table.offsets, self.table.limit, self._one, self._zero2, self.n)
 
     def encode_int(self, v: np.ndarray) -> np.ndarray:
         """Signed integer of the subgroup element that encodes ``v`` (Definition def:ec).

@@ -297,7 +297,10 @@ def test_injection_from_public_keys_is_decoded_exactly(a, seed, steps_before, sc
     u = ctrl.step(_x(99), inject=forged)
     expected = injection_value(a, ctrl.encoder, ctrl.beta)
     assert np.array_equal(u, expected)  # bit for bit
-    assert np.all(np.abs(u - a) <= (0.5 + ctrl.encoder.max_shift) / ctrl.encoder.delta**2)
+    # Delta = 2^12 is a perfect square, so Ecd(1) = Delta: a quantised at 1/Delta plus 3 Ecd(0)^2/Delta^2
+    enc = ctrl.encoder
+    assert enc.encode_signed(1.0) == enc.delta
+    assert np.all(np.abs(u - a) <= (0.5 + enc.max_shift) / enc.delta + 3 / enc.delta**2)
     assert ctrl.last_output_ciphertexts == forged
     # The loop carries on normally afterwards.
     x = _x(5)
@@ -306,11 +309,13 @@ def test_injection_from_public_keys_is_decoded_exactly(a, seed, steps_before, sc
 
 def test_injection_known_answer_small_case():
     enc = Encoder(G64, 4.0)
-    # Delta^2 = 16; a = 1.0 -> round(16) - 3 = 13, nearest member w0 (near 13); value (w0 + 3)/16.
-    val = injection_value([1.0], enc, 4)
-    w0 = (enc.encode_signed(13 / 4.0))  # same integer 13 at scale Delta
-    assert val[0] == (w0 + 3) / 16
-    assert abs(val[0] - 1.0) <= (0.5 + enc.max_shift) / 16
+    # Delta = 4 = 2^2 is a square, so Ecd(1) = 4; Ecd(0) = 1 (0 is not in G, 1 is its nearest member).
+    # a = 1.3: round(5.2) = 5 -> w = nearest member of G to 5; value (4 w + 3 * 1^2) / 16.
+    assert enc.encode_signed(1.0) == 4 and enc.encode_signed(0.0) == 1
+    w = enc.encode_signed(1.3)
+    val = injection_value([1.3], enc, 4)
+    assert val[0] == (4 * w + 3) / 16
+    assert abs(val[0] - 1.3) <= (0.5 + enc.max_shift) / 4 + 3 / 16
 
 
 def test_injection_bad_input():

@@ -446,6 +446,12 @@ class PlantCryptoSide:
         # The encoder only returns members of G, so the plaintext check can be skipped.
         return [_encrypt_member(self.pk, w % p, self._rng) for w in self.quantization.encode_state(x)]
 
+    @property
+    def secret_key(self) -> SecretKey:
+        """The current secret key ``sk_t``. The plant's own; the attack environment uses it to
+        simulate an adversary's break of a ciphertext whose deciphering time it has charged."""
+        return self._sk
+
     def decrypt_products(self, out: Sequence[Sequence[Any]]) -> list[list[int]]:
         """Decrypt the server's alpha x beta output and lift every product to a signed integer.
 
@@ -669,35 +675,41 @@ class EncryptedLinearController:
 
 
 # ---------------------------------------------------------------------- injection
-def _injection_integers(a: Any, encoder: Encoder, n_cols: int) -> tuple[list[int], int]:
+def _injection_integers(a: Any, encoder: Encoder, n_cols: int) -> list[list[int]]:
+    """Signed integers of the forged products: row i is ``[Ecd(a_i) Ecd(1), Ecd(0)^2, ...]``."""
     if not isinstance(encoder, Encoder):
         raise ParameterError(f"encoder must be an Encoder, got {encoder!r}")
     n_cols = check_int("n_cols", n_cols, minimum=1)
-    arr = as_finite_array("a", a)
-    if arr.ndim != 1:
-        arr = arr.reshape(-1)
-    d2 = encoder.delta * encoder.delta
+    arr = as_finite_array("a", a).reshape(-1)
+    one = encoder.encode_signed(1.0)
+    zero2 = encoder.encode_signed(0.0) ** 2
     half = encoder.group.half
-    ones = n_cols - 1
-    w0 = []
-    for ai in arr.tolist():
-        y = float(np.rint(d2 * ai))
-        if not math.isfinite(y) or abs(y) + ones + encoder.max_shift >= half:
+    rows = []
+    for ai in arr:
+        try:
+            w = encoder.encode_signed(float(ai)) * one
+        except EncodingOverflowError as exc:
+            raise EncodingOverflowError(f"injected value a = {float(ai)!r} is not representable: {exc}") from None
+        if abs(w) + (n_cols - 1) * zero2 >= half:
             raise EncodingOverflowError(
-                f"injected value a = {ai!r} is not representable: Delta^2 a = {d2 * ai!r} "
+                f"injected value a = {float(ai)!r} is not representable: |Ecd(a) Ecd(1)| = {abs(w)} "
                 f"exceeds (p-1)/2 for a {encoder.group.bits}-bit group"
             )
-        w, _ = nearest_member(encoder.group, int(y) - ones, encoder.max_shift)
-        w0.append(w)
-    return w0, ones
+        rows.append([w] + [zero2] * (n_cols - 1))
+    return rows
 
 
 def injection_value(a: Any, encoder: Encoder, n_cols: int) -> np.ndarray:
     """Exactly the float the plant decodes from :func:`forge_injection` ``(..., a, encoder, n_cols)``.
 
-    Row i decodes to ``(w_i + n_cols - 1) / Delta**2``, where ``w_i`` is the nearest element
-    of G to ``round(Delta^2 a_i) - (n_cols - 1)`` (Definition def:ec's encoding at scale
-    ``Delta**2``), so ``|value - a_i| <= (1/2 + shift)/Delta^2``.
+    The forged row i holds the products ``Ecd(a_i) Ecd(1)`` (column 0) and ``Ecd(0)^2`` (the
+    other ``n_cols - 1`` columns), as if the controller had multiplied ``Phi = e_i`` by
+    ``xi = (a_i, 0, ..., 0)``: every factor is an encoding at scale Delta (Definition def:ec),
+    so the plant's ``Dcd(Sum(Dec(.)); Delta^2)`` gives
+    ``(Ecd(a_i) Ecd(1) + (n_cols - 1) Ecd(0)^2) / Delta^2``: ``a_i`` quantised at ``1/Delta``
+    (``|Ecd(a) - Delta a| <= 1/2 + shift``), times ``Ecd(1)/Delta`` (exactly 1 when Delta is
+    a quadratic residue, e.g. a perfect square such as 4096), plus ``(n_cols - 1) Ecd(0)^2 /
+    Delta^2`` (0 is not in the group; ``Ecd(0) = 1``).
 
     Parameters
     ----------
@@ -708,14 +720,13 @@ def injection_value(a: Any, encoder: Encoder, n_cols: int) -> np.ndarray:
     n_cols : int
         beta, the number of columns of the controller's output matrix.
     """
-    w0, ones = _injection_integers(a, encoder, n_cols)
-    return encoder.decode_signed_array(np.asarray([w + ones for w in w0], dtype=object), power=2)
+    rows = _injection_integers(a, encoder, n_cols)
+    return encoder.decode_signed_array(np.asarray([sum(r) for r in rows], dtype=object), power=2)
 
 
 def _injection_plaintexts(a: Any, encoder: Encoder, n_cols: int) -> list[list[int]]:
-    w0, ones = _injection_integers(a, encoder, n_cols)
     p = encoder.group.p
-    return [[w % p] + [1] * ones for w in w0]
+    return [[w % p for w in row] for row in _injection_integers(a, encoder, n_cols)]
 
 
 def forge_injection(
@@ -728,8 +739,8 @@ def forge_injection(
 ) -> ModMatrix:
     """Forge, from public keys only, a modified-scheme output that the plant decodes to ``a``.
 
-    Entry (i, 0) encrypts ``Ecd`` of ``round(Delta^2 a_i) - (n_cols - 1)`` at scale
-    ``Delta**2``; entries (i, j >= 1) encrypt the element 1. Each entry is
+    Entry (i, 0) encrypts the product ``Ecd(a_i) Ecd(1)`` and entries (i, j >= 1) encrypt
+    ``Ecd(0)^2`` (see :func:`injection_value`). Each entry is
     ``(g^r, g^r', m h_0^r h_t^r')``, which ``Dec_bar(sk_0, sk_t, .)`` maps to m
     (Definition def:modification), so ``Dcd(Sum(Dec_bar(.)); Delta^2)`` equals
     :func:`injection_value` bit for bit.
@@ -755,7 +766,7 @@ def forge_injection(
     KeyMismatchError
         If the public keys (or the encoder) belong to different groups.
     EncodingOverflowError
-        If some ``a_i`` is not representable at scale ``Delta**2``.
+        If some ``a_i`` is not representable.
     """
     _check_key(pk_0, PublicKey, "pk_0")
     _check_key(pk_t, PublicKey, "pk_t")
@@ -794,7 +805,7 @@ def forge_injection_token(
     KeyMismatchError
         If the encoder's group differs from the key's.
     EncodingOverflowError
-        If some ``a_i`` is not representable at scale ``Delta**2``.
+        If some ``a_i`` is not representable.
     """
     _check_key(pk_t, PublicKey, "pk_t")
     if isinstance(encoder, Encoder) and encoder.group != pk_t.group:

@@ -108,6 +108,11 @@ class ResidueTable:
             raise EncodingOverflowError(f"value {int(bad)} lies outside the quantisation table range +-{self.limit}")
         return v + self._offset[v + self.limit]
 
+    @property
+    def offsets(self) -> np.ndarray:
+        """The offset table: ``nearest(v) = v + offsets[v + limit]`` for ``|v| <= limit``."""
+        return self._offset
+
     def offset_at(self, v: np.ndarray) -> np.ndarray:
         """Offsets to the nearest members for int64 ``v`` already known to satisfy ``|v| <= limit``."""
         return self._offset[v + self.limit]

@@ -25,13 +25,18 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import EncodingOverflowError, ParameterError
+from . import _kernels as kern
 from .config import AttackParams
 
 __all__ = ["EpisodeCore", "attack_design_for"]
 
 #: noise is drawn from each copy's generator in chunks of this many periods
 _CHUNK = 256
+#: every copy's recursive least squares is re-anchored to the exact solve after this many columns
+_REFRESH = 256
+#: a copy starts its recursion once the condition number of its scaled Gram matrix is below this
+_COND_LIMIT = 1e8
 
 
 def attack_design_for(p: AttackParams) -> Any:
@@ -90,7 +95,8 @@ class EpisodeCore:
         self.G = np.zeros((K, self.d, self.d))  # regressor Gram matrix of the delivered data
         self.C = np.zeros((K, self.d, n))  # cross term sum z x_next^T
         self.Q = np.zeros((K, self.d, self.d + n))  # recursive least squares: [P | Theta_hat^T]
-        self.rls_ready = False
+        self.ready = np.zeros(K, dtype=bool)  # recursion started (well-conditioned Gram matrix)
+        self._since_refresh = 0
         self.x = np.zeros((K, n))
         self.hist = np.zeros((K, p.input_history * m))
         self.energy = np.zeros(K)
@@ -100,8 +106,13 @@ class EpisodeCore:
         self.delivered = 0  # samples delivered to the agent
         self.new = False
         self.done = False
-        self._zeros_n = np.zeros((K, n))
-        self._zeros_m = np.zeros((K, m))
+        self._obs = np.zeros((K, p.obs_dim), dtype=np.float32)
+        self._a = np.zeros((K, m))
+        self._qa = np.zeros((K, m), dtype=np.int64)
+        self._qx = np.zeros((K, n), dtype=np.int64)
+        self._theta_true_T = np.ascontiguousarray(self._theta_true.T)
+        # the ideal backend's step is one fused compiled call
+        self._fused = getattr(loop, "fused_parameters", None)
         self._noise = np.zeros((K, _CHUNK, n))
         self._noise_pos = _CHUNK
         self._rngs: list[np.random.Generator] = []
@@ -134,12 +145,13 @@ class EpisodeCore:
         self._noise_pos = _CHUNK
         self.loop.start_episode()
         for _ in range(self.p.warmup_steps):  # normal operation under the encrypted controller (eq:ec)
-            self.x = self._next_state(self.x, self.loop.control(self.x), self._draw_noise())
+            kern.plant_step(self.x, self.loop.control(self.x), self._draw_noise(), self._A, self._B)
         self.X[:] = 0.0
         self.U[:] = 0.0
         self.G[:] = 0.0
         self.C[:] = 0.0
-        self.rls_ready = False
+        self.ready[:] = False
+        self._since_refresh = 0
         self.hist[:] = 0.0
         self.energy[:] = 0.0
         self.eps[:] = self._eps0
@@ -152,10 +164,6 @@ class EpisodeCore:
         return self.observation()
 
     # ----------------------------------------------------------------- step
-    def _next_state(self, x: np.ndarray, u: np.ndarray, w: np.ndarray) -> np.ndarray:
-        # eq:system, row-wise (no BLAS blocking), so every copy is bit-identical to a lone env
-        return (x[:, None, :] * self._A).sum(-1) + (u[:, None, :] * self._B).sum(-1) + w
-
     def _collect(self) -> None:
         """Collect and pay for the state ciphertext of the current period."""
         self.X[:, self.collected] = self.loop.collect_state(self.x)
@@ -172,67 +180,70 @@ class EpisodeCore:
             target = max(self.collected - delay, 0)
         if target <= self.delivered:
             return False
-        for j in range(max(self.delivered, 1), target):
-            # regression column (x_{j-1}, u_{j-1}) -> x_j, available once x_j is delivered
-            self._add_column(np.concatenate((self.X[:, j - 1], self.U[:, j - 1]), axis=1), self.X[:, j])
+        first = max(self.delivered, 1)
+        if target > first:
+            kern.add_columns(self.X, self.U, first, target, self.G, self.C, self.Q, self.ready)
         self.delivered = target
         if self.p.reward == "logdet":
             self.logdet = np.linalg.slogdet(self.G + self._reg)[1]
         if self.delivered - 1 >= self.d:
-            if not self.rls_ready:
-                self._start_rls()
-            theta_hat_T = self.Q[:, :, self.d :] if self.rls_ready else self._pinv_estimate()
-            self.eps = ((theta_hat_T - self._theta_true.T) ** 2).sum(axis=(1, 2)) / self._c
+            self._since_refresh += target - first
+            if final or self._since_refresh >= _REFRESH:  # exact solve: bounds drift; final = eq:estimate
+                stale = np.ones(self.K, dtype=bool)
+                self._since_refresh = 0
+            else:
+                stale = ~self.ready
+            if stale.any():
+                rows = np.nonzero(stale)[0]
+                theta_hat_T = self._refresh(rows)
+                self.eps[rows] = ((theta_hat_T - self._theta_true_T) ** 2).sum(axis=(1, 2)) / self._c
+            kern.estimation_error(self.Q, self._theta_true_T, float(self._c), self.ready & ~stale, self.eps)
         self.history.append((self.delivered, float(self.eps[0])))
         return True
 
-    def _add_column(self, z: np.ndarray, y: np.ndarray) -> None:
-        """One regression column: Gram update and the recursive least squares step.
+    def _refresh(self, rows: np.ndarray) -> np.ndarray:
+        """Exact least squares (eq:estimate) for the copies ``rows`` from the running Gram matrices.
 
-        With ``Q = [P | Theta_hat^T]`` (``P = G^{-1}``), ``r = z^T Q = [(P z)^T, (Theta_hat z)^T]``
-        and ``k = P z / (1 + z^T P z)``, the Sherman-Morrison update of ``P`` and the RLS update
-        ``Theta_hat += (y - Theta_hat z) k^T`` are together ``Q -= k (r - [0, y^T])``.
+        Solves ``G [P | Theta_hat^T] = [I | C]`` with Jacobi scaling. A copy whose scaled Gram
+        matrix is well conditioned (re)starts its recursion from the solution; an exactly
+        singular one gets the pseudo-inverse solution of eq:estimate. Called for copies that
+        are not yet recursive, and for every copy each ``_REFRESH`` columns to bound rounding
+        drift. Returns Theta_hat^T of those copies, shape (len(rows), n + m, n).
         """
-        self.G += z[:, :, None] * z[:, None, :]
-        self.C += z[:, :, None] * y[:, None, :]
-        if self.rls_ready:
-            d = self.d
-            r = (z[:, :, None] * self.Q).sum(axis=1)
-            r[:, d:] -= y
-            k = r[:, :d] / (1.0 + (r[:, :d] * z).sum(axis=1))[:, None]
-            self.Q -= k[:, :, None] * r[:, None, :]
-
-    def _start_rls(self) -> None:
-        """Initialise P = G^{-1} and Theta_hat (eq:estimate) once the Gram matrix is invertible."""
-        G = self.G
-        s = 1.0 / np.sqrt(np.maximum(np.einsum("kii->ki", G), 1e-300))  # Jacobi scaling
+        d = self.d
+        G, C = self.G[rows], self.C[rows]
+        s = 1.0 / np.sqrt(np.maximum(np.einsum("kii->ki", G), 1e-300))
         Gs = G * s[:, :, None] * s[:, None, :]
+        rhs = np.concatenate((np.broadcast_to(np.eye(d), G.shape) * s[:, :, None], C * s[:, :, None]), axis=2)
+        out = np.empty((len(rows), d, self.n))
         try:
-            sol = np.linalg.solve(Gs, np.concatenate((np.eye(self.d)[None] * s[:, :, None], self.C * s[:, :, None]), axis=2))
-        except np.linalg.LinAlgError:  # rank-deficient data so far: keep the pseudo-inverse estimate
-            return
-        if np.linalg.cond(Gs).max() > 1e12:
-            return
-        self.Q = sol * s[:, :, None]
-        self.rls_ready = True
-
-    def _pinv_estimate(self) -> np.ndarray:
-        """Theta_hat^T of eq:estimate through the pseudo-inverse (rank-deficient data)."""
-        return np.stack([np.linalg.lstsq(Gi, Ci, rcond=None)[0] for Gi, Ci in zip(self.G, self.C)])
+            sol = np.linalg.solve(Gs, rhs) * s[:, :, None]
+            ok = np.linalg.cond(Gs) < _COND_LIMIT
+        except np.linalg.LinAlgError:  # some copy exactly singular: one by one
+            sol = np.zeros_like(rhs)
+            ok = np.zeros(len(rows), dtype=bool)
+            for i in range(len(rows)):
+                try:
+                    sol[i] = np.linalg.solve(Gs[i], rhs[i]) * s[i, :, None]
+                    ok[i] = np.linalg.cond(Gs[i]) < _COND_LIMIT
+                except np.linalg.LinAlgError:
+                    sol[i, :, d:] = np.linalg.lstsq(G[i], C[i], rcond=None)[0]  # pseudo-inverse
+        out[:] = sol[:, :, d:]
+        self.Q[rows[ok]] = sol[ok]
+        self.ready[rows] = ok
+        return out
 
     def check_actions(self, action: Any) -> np.ndarray:
         """Validate actions: shape (K, m) (or (m,) for K = 1), finite, inside [-1, 1]."""
-        a = np.asarray(action, dtype=np.float64)
+        a = np.array(action, dtype=np.float64, ndmin=2)
         if a.shape != (self.K, self.m):
-            if self.K == 1 and a.shape == (self.m,):
-                a = a[None]
-            else:
-                want = (self.m,) if self.K == 1 else (self.K, self.m)
-                raise ParameterError(f"action must have shape {want}, got {a.shape}")
-        if not (np.abs(a) <= 1.0 + 1e-6).all():
-            what = "finite" if not np.isfinite(a).all() else "inside the action space [-1, 1]"
+            want = (self.m,) if self.K == 1 else (self.K, self.m)
+            raise ParameterError(f"action must have shape {want}, got {np.shape(action)}")
+        code = kern.check_actions(a)
+        if code:
+            what = "finite" if code == 1 else "inside the action space [-1, 1]"
             raise ParameterError(f"action must be {what}, got {np.asarray(action).tolist()}")
-        return np.clip(a, -1.0, 1.0)
+        return a
 
     def step(self, action: Any) -> tuple[np.ndarray, bool, bool]:
         """Apply the actions of all copies. Returns (rewards (K,), terminated, truncated)."""
@@ -240,28 +251,31 @@ class EpisodeCore:
             raise ParameterError("step() called after the episode ended; call reset() first")
         p = self.p
         act = self.check_actions(action)
-        # energy budget: an input that would overdraw the remaining energy is scaled to exhaust it
-        a = act * p.u_max
-        e = (a * a).sum(axis=1)
-        remaining = p.energy_budget - self.energy
-        over = e > remaining
-        if over.any():
-            scale = np.where(over, np.sqrt(np.maximum(remaining, 0.0) / np.where(e > 0, e, 1.0)), 1.0)
-            a = a * scale[:, None]
-            act = act * scale[:, None]
-            e = np.where(over, np.maximum(remaining, 0.0), e)
-        self.energy += e
-        u = self.loop.inject(a)
-        self.U[:, self.collected - 1] = u
-        self.x = self._next_state(self.x, u, self._draw_noise())
-        if p.input_history:
-            self.hist[:, self.m :] = self.hist[:, : -self.m]
-            self.hist[:, : self.m] = act
-        self.loop.tick()
-        before = self._score()
+        w = self._draw_noise()
         ended = self.collected >= p.horizon
-        if not ended:
-            self._collect()
+        if self._fused is not None:  # ideal backend: one compiled call
+            status = kern.step_ideal(
+                act, p.u_max, self.energy, p.energy_budget, *self._fused, self.x, self._A, self._B, w,
+                self.X, self.U, self.collected - 1, -1 if ended else self.collected, self.hist,
+                self._a, self._qa, self._qx,
+            )
+            if status == kern.STATE_OVERFLOW:
+                raise EncodingOverflowError(
+                    f"state {self.x.tolist()} leaves the encoder's declared range |x| <= {p.x_bound} (x_bound)"
+                )
+            if not ended:
+                self.collected += 1
+        else:
+            kern.energy_budget(act, p.u_max, self.energy, p.energy_budget, self._a)
+            u = self.loop.inject(self._a)
+            self.U[:, self.collected - 1] = u
+            kern.plant_step(self.x, u, w, self._A, self._B)
+            if p.input_history:
+                kern.shift_history(self.hist, act)
+            self.loop.tick()
+            if not ended:
+                self._collect()
+        before = self._score()
         self.new = self._deliver(final=ended)
         self.done = ended
         reward = self._score() - before
@@ -275,16 +289,11 @@ class EpisodeCore:
     # ----------------------------------------------------------------- observation and info
     def observation(self) -> np.ndarray:
         """Observations of all copies, shape (K, obs_dim), float32 (see the class docstring)."""
-        j = self.delivered - 1  # latest delivered sample
-        K = self.K
-        xs = self.X[:, j] if j >= 0 else self._zeros_n
-        us = self.U[:, j - 1] if j >= 1 else self._zeros_m
-        tail = np.empty((K, 3))
-        tail[:, 0] = float(self.new)
-        tail[:, 1] = self._time_frac[self.collected]
-        tail[:, 2] = self.energy / self.p.energy_budget
-        obs = np.concatenate((xs, us, tail[:, :1], self.hist, tail[:, 1:]), axis=1)
-        return obs.astype(np.float32)
+        kern.fill_observation(
+            self._obs, self.X, self.U, self.delivered - 1, float(self.new), self.hist,
+            float(self._time_frac[self.collected]), self.energy, float(self.p.energy_budget),
+        )
+        return self._obs.copy()
 
     def info_arrays(self) -> dict[str, np.ndarray]:
         """Info of every copy as arrays of shape (K,) (keys as in :meth:`info`)."""
