@@ -1,0 +1,223 @@
+"""Run attackers through the environment and record the identification error along the way.
+
+:func:`rollout` plays ``episodes`` episodes of one attacker. On the ideal backend it steps them
+in batches through the native vector environment (one ``act`` per step for the whole batch);
+on the ElGamal backend it plays them one at a time through the single environment (real
+ciphertexts, one copy). Episode ``e`` is always seeded with ``seed + e``, so two attackers
+evaluated with the same ``seed`` face the same initial states and the same process noise.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from encctl_gym._validation import check_int
+from encctl_gym.envs.config import AttackParams, resolve_params
+from encctl_gym.errors import ParameterError
+
+from .base import Attacker
+
+__all__ = ["Rollout", "rollout", "env_config", "budget_config"]
+
+
+def env_config(config: dict[str, Any] | None = None, **overrides: Any) -> dict[str, Any]:
+    """An environment configuration with ``gamma_opt`` off unless asked for (it costs an SDP)."""
+    cfg = {"gamma_opt": False}
+    cfg.update(config or {})
+    cfg.update(overrides)
+    return cfg
+
+
+def budget_config(config: dict[str, Any], N: int) -> dict[str, Any]:
+    """``config`` with an attack of exactly ``N`` samples set by the deciphering budget.
+
+    Keeps the security parameter (and so the cost of a sample) of ``config`` and shortens the
+    defense period to ``tau_c = (N + 1/2) 2^lambda / Upsilon``, so the episode ends by
+    *termination* after ``N`` samples and the observed budget fraction is the fraction of the
+    attack elapsed, as in a full attack. (``max_samples`` would cut the episode instead, with
+    the budget fraction stuck near 0.) Schemes where one break reveals every sample have no
+    deciphering budget: there ``max_samples = N`` is used.
+
+    Parameters
+    ----------
+    config : dict
+        Environment configuration.
+    N : int
+        Attack length (>= n + m + 1).
+
+    Returns
+    -------
+    dict
+    """
+    N = check_int("N", N, minimum=2)
+    base = resolve_params(env_config(config))
+    cfg = dict(config)
+    if not base.independent_keys:
+        cfg["max_samples"] = N
+        return cfg
+    cfg.pop("max_samples", None)
+    cfg.pop("key_length", None)
+    cfg["security_parameter"] = base.security_parameter
+    cfg["tau_c"] = (N + 0.5) * base.sample_cost
+    got = resolve_params(env_config(cfg)).horizon
+    if got != N:  # pragma: no cover - guards the arithmetic above
+        raise ParameterError(f"budget_config: expected a horizon of {N}, got {got}")
+    return cfg
+
+
+@dataclass
+class Rollout:
+    """The record of ``E`` episodes of one attacker (all of the same length ``T`` steps).
+
+    Attributes
+    ----------
+    attacker : str
+        The attacker's name.
+    N : ndarray (T,)
+        Samples delivered after each step (the ``N`` of ``epsilon(N)``).
+    epsilon : ndarray (E, T)
+        ``info["epsilon"]`` after each step (the error of the current estimate, Definition
+        def:error; with ``decipher_delay="end"`` it changes only at the last step).
+    final_epsilon, average_power, input_energy : ndarray (E,)
+        At the end of each episode.
+    gamma : ndarray (T,)
+        ``gamma(N)`` of eq:sic at ``N``.
+    seconds : float
+        Wall time.
+    """
+
+    attacker: str
+    N: np.ndarray
+    epsilon: np.ndarray
+    final_epsilon: np.ndarray
+    average_power: np.ndarray
+    input_energy: np.ndarray
+    gamma: np.ndarray
+    seconds: float
+    crypto: str = "ideal"
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def episodes(self) -> int:
+        return int(self.final_epsilon.size)
+
+    def mean_final(self) -> float:
+        return float(self.final_epsilon.mean())
+
+    def se_final(self) -> float:
+        return float(self.final_epsilon.std(ddof=1) / np.sqrt(self.episodes)) if self.episodes > 1 else float("nan")
+
+
+def rollout(
+    attacker: Attacker,
+    config: dict[str, Any] | AttackParams,
+    *,
+    episodes: int,
+    seed: int = 0,
+    batch: int | None = None,
+    record: bool = True,
+    progress: Any = None,
+) -> Rollout:
+    """Play ``episodes`` episodes of ``attacker`` and record ``epsilon`` after every step.
+
+    Parameters
+    ----------
+    attacker : Attacker
+        Built for the same parameters (observation layout) as ``config``.
+    config : dict
+        Environment configuration (see :func:`encctl_gym.envs.config.default_config`).
+    episodes : int
+        Number of episodes (>= 1).
+    seed : int
+        Episode ``e`` resets the environment with ``seed + e``; the attacker's own randomness is
+        seeded from ``seed`` and the batch index.
+    batch : int, optional
+        Copies stepped at once on the ideal backend (default: all episodes at once, at most 64).
+    record : bool
+        Keep ``epsilon`` after every step (else only the final values; ``epsilon`` is then
+        ``(E, 1)``).
+    progress : tqdm-like, optional
+        ``progress.update(k)`` is called with the number of environment steps done.
+
+    Returns
+    -------
+    Rollout
+    """
+    from encctl_gym.envs import EncryptedLTIAttackEnv
+    from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
+
+    episodes = check_int("episodes", episodes, minimum=1)
+    cfg = dict(config)
+    params = resolve_params(cfg)
+    if (params.n, params.m, params.input_history) != (attacker.params.n, attacker.params.m, attacker.params.input_history):
+        raise ParameterError("the attacker was built for a different observation layout than this environment")
+    t0 = time.perf_counter()
+    eps_rows, finals, powers, energies = [], [], [], []
+    N_steps: np.ndarray | None = None
+    if params.crypto == "ideal":
+        B = min(episodes, 64) if batch is None else check_int("batch", batch, minimum=1)
+        env = EncryptedLTIAttackVectorEnv(B, config=cfg)
+        done_eps = 0
+        chunk = 0
+        while done_eps < episodes:
+            obs, info = env.reset(seed=seed + done_eps)
+            attacker.reset(seed=np.random.SeedSequence([seed, chunk]))
+            eps_t, Ns = [], []
+            while True:
+                obs, _, te, tr, info = env.step(attacker.act(obs))
+                if record:
+                    eps_t.append(info["epsilon"])
+                    Ns.append(int(info["samples_delivered"][0]))
+                if progress is not None:
+                    progress.update(B)
+                if te[0] or tr[0]:
+                    break
+            take = min(B, episodes - done_eps)
+            eps_rows.append(np.stack(eps_t, axis=1)[:take] if record else info["epsilon"][:take, None])
+            if N_steps is None:
+                N_steps = np.array(Ns if record else [int(info["samples_delivered"][0])])
+            finals.append(info["epsilon"][:take])
+            powers.append(info["average_power"][:take])
+            energies.append(info["input_energy"][:take])
+            done_eps += take
+            chunk += 1
+    else:
+        env1 = EncryptedLTIAttackEnv(config=cfg)
+        for e in range(episodes):
+            obs, info = env1.reset(seed=seed + e)
+            attacker.reset(seed=np.random.SeedSequence([seed, e]))
+            eps_t, Ns = [], []
+            while True:
+                obs, _, te, tr, info = env1.step(attacker.act(obs))
+                if record:
+                    eps_t.append(info["epsilon"])
+                    Ns.append(info["samples_delivered"])
+                if progress is not None:
+                    progress.update(1)
+                if te or tr:
+                    break
+            eps_rows.append(np.array(eps_t if record else [info["epsilon"]])[None])
+            if N_steps is None:
+                N_steps = np.array(Ns if record else [info["samples_delivered"]])
+            finals.append(np.array([info["epsilon"]]))
+            powers.append(np.array([info["average_power"]]))
+            energies.append(np.array([info["input_energy"]]))
+    assert N_steps is not None
+    gamma = np.full(N_steps.shape, np.inf)
+    ok = N_steps >= 2
+    gamma[ok] = params.gamma(N_steps[ok])
+    return Rollout(
+        attacker=attacker.name,
+        N=N_steps,
+        epsilon=np.concatenate(eps_rows, axis=0),
+        final_epsilon=np.concatenate(finals),
+        average_power=np.concatenate(powers),
+        input_energy=np.concatenate(energies),
+        gamma=gamma,
+        seconds=time.perf_counter() - t0,
+        crypto=params.crypto,
+    )

@@ -1,0 +1,179 @@
+"""The hand-written attackers: interface, action space, power, and the optimal design's gain."""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import encctl_gym  # noqa: F401  (registers the environment)
+from agents import (
+    Attacker,
+    ColoredGaussianAttacker,
+    GaussianAttacker,
+    ObsLayout,
+    OptimalDesignAttacker,
+    PRBSAttacker,
+    observation_indices,
+    rollout,
+)
+from agents.evaluate import budget_config
+from encctl_gym.envs import ENV_ID, EncryptedLTIAttackEnv
+from encctl_gym.envs.config import resolve_params
+from encctl_gym.errors import ParameterError
+from encctl_gym.security.attack_design import gaussian_attack_design, optimal_attack_design
+
+SMALL = {"preset": "small", "gamma_opt": False}
+BASELINES = (GaussianAttacker, PRBSAttacker, ColoredGaussianAttacker)
+
+
+def all_attackers(params):
+    return [cls(params) for cls in BASELINES] + [
+        OptimalDesignAttacker(params, feedback=params.decipher_delay is not None)
+    ]
+
+
+@pytest.mark.parametrize("delay", [0, 2, "end"])
+def test_every_attacker_runs_through_the_single_env_inside_the_action_space(delay):
+    env = gym.make(ENV_ID, config={**SMALL, "decipher_delay": delay})
+    for att in all_attackers(env.unwrapped.params):
+        assert isinstance(att, Attacker)
+        obs, info = env.reset(seed=3)
+        att.reset(seed=4)
+        steps = 0
+        while True:
+            a = att.act(obs)
+            assert a.shape == env.action_space.shape and a.dtype == np.float32
+            assert env.action_space.contains(a)
+            obs, r, te, tr, info = env.step(a)
+            steps += 1
+            if te or tr:
+                break
+        assert steps == env.unwrapped.params.horizon
+        assert np.isfinite(info["epsilon"]) and info["epsilon"] < 1.0, att.name
+
+
+def test_from_env_works_on_wrapped_single_and_vector_envs():
+    env = gym.make(ENV_ID, config=SMALL)
+    venv = gym.make_vec(ENV_ID, num_envs=3, config=SMALL)
+    for e in (env, venv):
+        att = GaussianAttacker.from_env(e)
+        assert att.params.horizon == env.unwrapped.params.horizon
+    opt = OptimalDesignAttacker.from_env(gym.make(ENV_ID, config={**SMALL, "gamma_opt": True}))
+    assert opt.design.kind == "closed_loop"
+
+
+def test_batched_act_matches_the_vector_env():
+    params = resolve_params(SMALL)
+    venv = gym.make_vec(ENV_ID, num_envs=5, config=SMALL)
+    obs, _ = venv.reset(seed=0)
+    for att in all_attackers(params):
+        att.reset(seed=1)
+        a = att.act(obs)
+        assert a.shape == (5, params.m) and np.all(np.abs(a) <= 1.0)
+        with pytest.raises(ParameterError):
+            att.act(obs[:2])  # batch size may not change within an episode
+        att.reset(seed=1)
+        assert np.array_equal(att.act(obs), a)  # same seed, same actions
+
+
+def test_attacker_seed_reproduces_and_different_seeds_differ():
+    params = resolve_params(SMALL)
+    obs = np.zeros(ObsLayout.of(params).dim, dtype=np.float32)
+    for cls in BASELINES:
+        a, b = cls(params), cls(params)
+        a.reset(seed=11)
+        b.reset(seed=11)
+        xa = np.stack([a.act(obs) for _ in range(20)])
+        xb = np.stack([b.act(obs) for _ in range(20)])
+        assert np.array_equal(xa, xb)
+        b.reset(seed=12)
+        assert not np.array_equal(xa, np.stack([b.act(obs) for _ in range(20)]))
+
+
+def test_bad_inputs_raise():
+    params = resolve_params(SMALL)
+    att = GaussianAttacker(params)
+    with pytest.raises(ParameterError):
+        att.act(np.zeros(3))
+    with pytest.raises(ParameterError):
+        ColoredGaussianAttacker(params, rho=1.0)
+    with pytest.raises(ParameterError):
+        GaussianAttacker({"preset": "small"})  # type: ignore[arg-type]
+    with pytest.raises(ParameterError):
+        OptimalDesignAttacker(resolve_params({**SMALL, "decipher_delay": "end"}), feedback=True)
+    with pytest.raises(ParameterError):
+        observation_indices(params, "everything")
+
+
+def test_observation_modes_select_the_documented_columns():
+    params = resolve_params(SMALL)
+    lay = ObsLayout.of(params)
+    assert lay.dim == EncryptedLTIAttackEnv(config=SMALL).observation_space.shape[0]
+    assert observation_indices(params, "full").tolist() == list(range(lay.dim))
+    assert observation_indices(params, "no_budget").tolist() == list(range(lay.dim - 2))
+    blind = observation_indices(params, "blind").tolist()
+    assert blind == list(range(lay.history.start, lay.history.stop)) + [lay.dim - 2, lay.dim - 1]
+    assert not set(blind) & set(range(lay.n + lay.m + 1))  # no delivered data in the blind view
+
+
+# ------------------------------------------------------------------ power
+@pytest.mark.parametrize("cls", BASELINES)
+def test_baseline_input_power_is_sigma_u2(cls):
+    params = resolve_params({"preset": "paper-example", "gamma_opt": False})
+    att = cls(params)
+    att.reset(seed=0)
+    obs = np.zeros((64, ObsLayout.of(params).dim), dtype=np.float32)
+    u = np.concatenate([att.act(obs) for _ in range(300)]) * params.u_max  # 64 * 300 * m draws
+    power = float(np.mean(u**2))
+    tol = 1e-6 if cls is PRBSAttacker else 0.03  # binary: exactly sigma_u^2 (float32 rounding)
+    assert abs(power / params.sigma_u2 - 1.0) < tol, (cls.__name__, power)
+    assert abs(float(u.mean())) < 0.05 * math.sqrt(params.sigma_u2)
+
+
+def test_colored_attacker_has_the_requested_lag_one_correlation():
+    params = resolve_params({"preset": "paper-example", "gamma_opt": False})
+    att = ColoredGaussianAttacker(params, rho=0.7)
+    att.reset(seed=2)
+    obs = np.zeros((32, ObsLayout.of(params).dim), dtype=np.float32)
+    u = np.stack([att.act(obs) for _ in range(2000)])  # (T, K, m)
+    c = np.mean(u[1:] * u[:-1]) / np.mean(u * u)
+    assert abs(c - 0.7) < 0.03
+
+
+def test_average_power_through_the_env_matches_sigma_u2():
+    cfg = budget_config({"preset": "paper-example", "gamma_opt": False}, 400)
+    params = resolve_params(cfg)
+    for cls in BASELINES:
+        r = rollout(cls(params), cfg, episodes=16, seed=0, record=False)
+        assert np.all(r.average_power <= params.sigma_u2 * (1 + 1e-9))  # the energy budget holds
+        assert r.average_power.mean() > 0.95 * params.sigma_u2, cls.__name__
+
+
+# ------------------------------------------------------------------ the optimal design
+@pytest.mark.parametrize("delay", [0, "end"])
+def test_optimal_design_attacker_beats_gaussian_where_the_design_predicts_a_gain(delay):
+    # Figure 2's Psi_u = 0.1 I system: the design predicts a 37 % lower asymptotic error.
+    preset = "fig2-psi0.1"
+    cfg = budget_config({"preset": preset, "gamma_opt": False, "decipher_delay": delay}, 300)
+    params = resolve_params(cfg)
+    design = optimal_attack_design(params.A, params.B, sigma_u2=params.sigma_u2, sigma_w2=params.sigma_w2, feedback=delay == 0)
+    gauss = gaussian_attack_design(params.A, params.B, sigma_u2=params.sigma_u2, sigma_w2=params.sigma_w2)
+    assert design.rate / gauss.rate < 0.7  # check the prediction first
+    g = rollout(GaussianAttacker(params), cfg, episodes=40, seed=100, record=False)
+    o = rollout(OptimalDesignAttacker(params, design=design, feedback=delay == 0), cfg, episodes=40, seed=100, record=False)
+    d = np.log(o.final_epsilon) - np.log(g.final_epsilon)  # paired: same environment seeds
+    se = d.std(ddof=1) / math.sqrt(d.size)
+    assert d.mean() + 3 * se < 0, (d.mean(), se)
+    assert o.mean_final() < 0.85 * g.mean_final()
+    assert abs(o.average_power.mean() / params.sigma_u2 - 1) < 0.05  # at (about) the same power
+
+
+def test_optimal_design_attacker_with_a_delay_uses_the_model_prediction():
+    cfg = budget_config({"preset": "fig2-psi0.1", "gamma_opt": False, "decipher_delay": 3}, 300)
+    params = resolve_params(cfg)
+    g = rollout(GaussianAttacker(params), cfg, episodes=30, seed=7, record=False)
+    o = rollout(OptimalDesignAttacker(params), cfg, episodes=30, seed=7, record=False)
+    assert o.mean_final() < g.mean_final()
