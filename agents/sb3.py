@@ -1,0 +1,308 @@
+"""stable-baselines3 glue: a VecEnv over the native vector environment, and learned attackers.
+
+* :class:`SB3VecEnv` adapts :class:`~encctl_gym.envs.vector.EncryptedLTIAttackVectorEnv` (K
+  copies stepped at once in numpy) to stable-baselines3's ``VecEnv`` API: same-step autoreset
+  with ``info["terminal_observation"]`` and ``info["TimeLimit.truncated"]``, seeding through
+  ``VecEnv.seed``, and an observation *mode* (:func:`agents.base.observation_indices`) that
+  selects the columns the policy sees. It is several times faster than a ``DummyVecEnv`` over
+  single environments.
+* :class:`SB3Attacker` wraps a trained model (PPO, SAC, RecurrentPPO; with its
+  ``VecNormalize`` statistics) as an :class:`~agents.base.Attacker`.
+* :func:`load_attacker` loads a training run written by :mod:`agents.train`.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+
+from encctl_gym.envs.config import AttackParams, resolve_params
+from encctl_gym.errors import ParameterError
+
+from .base import Attacker, observation_indices
+
+try:  # stable-baselines3 is the optional [rl] extra
+    from stable_baselines3.common.vec_env import VecEnv
+except ModuleNotFoundError:  # pragma: no cover
+    VecEnv = object  # type: ignore[misc,assignment]
+
+__all__ = ["SB3VecEnv", "SB3Attacker", "load_attacker", "ALGORITHMS", "algorithm_class", "INFO_KEYS"]
+
+#: Algorithm names accepted by :func:`algorithm_class` and the ``train`` command.
+ALGORITHMS = ("ppo", "sac", "recurrent_ppo")
+
+#: Info keys copied into the SB3 info dicts at the end of an episode.
+INFO_KEYS = ("epsilon", "gamma", "samples_delivered", "input_energy", "average_power")
+
+
+def algorithm_class(algo: str) -> Any:
+    """The stable-baselines3 (or sb3-contrib) class of ``algo``."""
+    if algo == "ppo":
+        from stable_baselines3 import PPO
+
+        return PPO
+    if algo == "sac":
+        from stable_baselines3 import SAC
+
+        return SAC
+    if algo == "recurrent_ppo":
+        from sb3_contrib import RecurrentPPO
+
+        return RecurrentPPO
+    raise ParameterError(f"unknown algorithm {algo!r}; choose one of {', '.join(ALGORITHMS)}")
+
+
+class SB3VecEnv(VecEnv):  # type: ignore[misc]
+    """``num_envs`` copies of the attack environment as a stable-baselines3 ``VecEnv``.
+
+    Parameters
+    ----------
+    config : dict
+        Environment configuration (ideal backend).
+    num_envs : int
+        Number of copies.
+    observation : str
+        Observation mode (``"full"``, ``"no_budget"``, ``"blind"``).
+    reward_scaling : {"none", "samples"}
+        ``"samples"`` multiplies the reward of a step by the number of samples delivered,
+        ``N_t (log eps_{t-1} - log eps_t)`` for ``reward="log_error"``: the relative error
+        decrease per sample, whose scale does not shrink like ``1/N`` along the episode (the
+        return is then no longer the telescoped ``log eps_0 - log eps_N``).
+
+    All copies share the horizon, so they end together; the step that ends them returns the
+    first observation of the next episodes, and every copy's info carries
+    ``terminal_observation``, ``TimeLimit.truncated`` and the environment's final
+    :data:`INFO_KEYS`. Other steps return empty info dicts (building K dicts per step would
+    cost more than the step itself).
+    """
+
+    def __init__(self, config: dict[str, Any], num_envs: int, observation: str = "full", reward_scaling: str = "none") -> None:
+        from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
+
+        self.venv = EncryptedLTIAttackVectorEnv(num_envs, config=config)
+        self.params: AttackParams = self.venv.params
+        self.observation = observation
+        if reward_scaling not in ("none", "samples"):
+            raise ParameterError(f"reward_scaling must be 'none' or 'samples', got {reward_scaling!r}")
+        self.reward_scaling = reward_scaling
+        self.obs_idx = observation_indices(self.params, observation)
+        low, high = self.params.observation_bounds()
+        obs_space = spaces.Box(low[self.obs_idx], high[self.obs_idx], dtype=np.float32)
+        self.num_envs = num_envs
+        self.render_mode = None
+        self._actions = np.zeros((num_envs, self.params.m), dtype=np.float32)
+        super().__init__(num_envs, obs_space, self.venv.single_action_space)
+
+    def _obs(self, obs: np.ndarray) -> np.ndarray:
+        return np.ascontiguousarray(obs[:, self.obs_idx], dtype=np.float32)
+
+    def reset(self) -> np.ndarray:
+        seeds = self._seeds
+        if seeds[0] is not None:
+            obs, _ = self.venv.reset(seed=[int(s) for s in seeds])  # type: ignore[arg-type]
+        else:
+            obs, _ = self.venv.reset()
+        self._reset_seeds()
+        self._reset_options()
+        return self._obs(obs)
+
+    def step_async(self, actions: np.ndarray) -> None:
+        self._actions = np.clip(np.asarray(actions, dtype=np.float32).reshape(self.num_envs, -1), -1.0, 1.0)
+
+    def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict[str, Any]]]:
+        obs, reward, terminated, truncated, info = self.venv.step(self._actions)
+        dones = np.logical_or(terminated, truncated)
+        if self.reward_scaling == "samples":
+            reward = reward * info["samples_delivered"]
+        if dones.any():
+            final = self._obs(obs)
+            infos = [
+                {
+                    "terminal_observation": final[i],
+                    "TimeLimit.truncated": bool(truncated[i] and not terminated[i]),
+                    **{k: float(info[k][i]) for k in INFO_KEYS},
+                }
+                for i in range(self.num_envs)
+            ]
+            obs, _ = self.venv.reset()
+        else:
+            infos = [{} for _ in range(self.num_envs)]
+        return self._obs(obs), np.asarray(reward, dtype=np.float32), dones, infos
+
+    def close(self) -> None:
+        pass
+
+    def get_attr(self, attr_name: str, indices: Any = None) -> list[Any]:
+        value = getattr(self, attr_name) if attr_name in ("render_mode", "params", "observation") else getattr(self.venv, attr_name)
+        return [value for _ in self._get_indices(indices)]
+
+    def set_attr(self, attr_name: str, value: Any, indices: Any = None) -> None:
+        raise ParameterError("SB3VecEnv copies share one batched core; attributes cannot be set per copy")
+
+    def env_method(self, method_name: str, *method_args: Any, indices: Any = None, **method_kwargs: Any) -> list[Any]:
+        raise ParameterError(f"SB3VecEnv does not forward {method_name}() to single copies (they are one batched core)")
+
+    def env_is_wrapped(self, wrapper_class: Any, indices: Any = None) -> list[bool]:
+        return [False for _ in self._get_indices(indices)]
+
+
+class SB3Attacker(Attacker):
+    """A trained stable-baselines3 policy as an :class:`~agents.base.Attacker`.
+
+    Parameters
+    ----------
+    model : BaseAlgorithm
+        PPO, SAC or RecurrentPPO (recurrent state handled per copy, reset with the episode).
+    vecnormalize : VecNormalize, optional
+        Observation statistics saved with the model (applied in evaluation mode).
+    deterministic : bool, default False
+        Use the policy's mean action. Off by default, on purpose: identification needs
+        excitation, and a stochastic policy's noise *is* its excitation; the mean of a policy
+        that feeds back the state (``u = mu(x)``) leaves the regressor ``[x; u]`` nearly
+        rank-deficient.
+    params : AttackParams, optional
+        Parameters of the environment it will run in (for the observation layout); without
+        them only ``observation="full"`` is possible and the layout is not checked.
+    observation : str
+        The observation mode the model was trained with.
+    name : str, optional
+        Label (default: the algorithm's name).
+    """
+
+    def __init__(
+        self,
+        model: Any,
+        vecnormalize: Any = None,
+        deterministic: bool = False,
+        *,
+        params: AttackParams | None = None,
+        observation: str = "full",
+        name: str | None = None,
+    ) -> None:
+        if params is None:
+            if observation != "full":
+                raise ParameterError("an SB3Attacker with observation mode other than 'full' needs the environment's params")
+            dim = int(np.prod(model.observation_space.shape))
+            self.params = None  # type: ignore[assignment]
+            self._obs_idx = np.arange(dim)
+            self._dim = dim
+        else:
+            super().__init__(params)
+            self._obs_idx = observation_indices(params, observation)
+            self._dim = self.layout.dim
+        if len(self._obs_idx) != int(np.prod(model.observation_space.shape)):
+            raise ParameterError(
+                f"the model expects {model.observation_space.shape} observations, the {observation!r} mode gives {len(self._obs_idx)}"
+            )
+        self.model = model
+        self.vecnormalize = vecnormalize
+        if vecnormalize is not None:
+            vecnormalize.training = False
+            vecnormalize.norm_reward = False
+        self.deterministic = bool(deterministic)
+        self.observation = observation
+        self.needs_states = observation in ("full", "no_budget")
+        self.recurrent = hasattr(model.policy, "lstm_actor")
+        self.name = name or type(model).__name__.lower()
+        self.rng = np.random.default_rng()
+        self._batch = None
+        self._state: Any = None
+        self._episode_start: np.ndarray | None = None
+
+    @classmethod
+    def from_env(cls, env: Any, **kwargs: Any) -> "SB3Attacker":
+        from .base import params_of
+
+        return cls(params=params_of(env), **kwargs)
+
+    def reset(self, seed: Any = None) -> None:
+        super().reset(seed)
+        if seed is not None:  # the policy samples from torch's generator
+            import torch
+
+            ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+            torch.manual_seed(int(ss.generate_state(1)[0]))
+        self._state = None
+
+    def act(self, obs: Any) -> np.ndarray:
+        if self.params is not None:
+            return super().act(obs)
+        o = np.asarray(obs, dtype=np.float64)
+        single = o.ndim == 1
+        o2 = o[None] if single else o
+        if self._batch is None:
+            self._batch = o2.shape[0]
+            self._start(self._batch)
+        a = np.clip(self._act(o2), -1.0, 1.0).astype(np.float32)
+        return a[0] if single else a
+
+    def _start(self, K: int) -> None:
+        self._state = None
+        self._episode_start = np.ones(K, dtype=bool)
+
+    def _act(self, obs: np.ndarray) -> np.ndarray:
+        o = obs[:, self._obs_idx].astype(np.float32)
+        if self.vecnormalize is not None:
+            o = self.vecnormalize.normalize_obs(o)
+        if self.recurrent:
+            a, self._state = self.model.predict(o, state=self._state, episode_start=self._episode_start, deterministic=self.deterministic)
+            self._episode_start = np.zeros(obs.shape[0], dtype=bool)
+        else:
+            a, _ = self.model.predict(o, deterministic=self.deterministic)
+        return np.asarray(a, dtype=np.float64).reshape(obs.shape[0], -1)
+
+
+def load_attacker(
+    run_dir: str | Path,
+    *,
+    which: str = "final",
+    params: AttackParams | None = None,
+    deterministic: bool = False,
+    name: str | None = None,
+) -> SB3Attacker:
+    """Load a training run written by :mod:`agents.train` as an attacker.
+
+    Parameters
+    ----------
+    run_dir : path
+        The run's directory (holds ``run.json``, ``model.zip``, ``best_model.zip`` and, when the
+        observations were normalised, ``vecnormalize.pkl``).
+    which : {"final", "best"}
+        The model at the end of training or the best one of the evaluation callback.
+    params : AttackParams, optional
+        Parameters of the environment to run in (default: the training environment's).
+    deterministic : bool
+        See :class:`SB3Attacker`.
+    name : str, optional
+        Label (default: the run's algorithm name).
+    """
+    run_dir = Path(run_dir)
+    meta_path = run_dir / "run.json"
+    if not meta_path.exists():
+        raise ParameterError(f"{run_dir} is not a training run (no run.json)")
+    meta = json.loads(meta_path.read_text())
+    files = {"final": "model.zip", "best": "best_model.zip"}
+    if which not in files:
+        raise ParameterError(f"which must be 'final' or 'best', got {which!r}")
+    model_path = run_dir / files[which]
+    if not model_path.exists():
+        raise ParameterError(f"no {files[which]} in {run_dir}")
+    cls = algorithm_class(meta["algo"])
+    model = cls.load(str(model_path), device="cpu")
+    env_cfg = dict(meta["env"])
+    env_cfg["gamma_opt"] = False
+    if params is None:
+        params = resolve_params(env_cfg)
+    vecnorm = None
+    vn_path = run_dir / "vecnormalize.pkl"
+    if vn_path.exists():
+        from stable_baselines3.common.vec_env import VecNormalize
+
+        vecnorm = VecNormalize.load(str(vn_path), SB3VecEnv(env_cfg, 1, meta["observation"]))
+    return SB3Attacker(
+        model, vecnorm, deterministic, params=params, observation=meta["observation"], name=name or meta["algo"],
+    )
