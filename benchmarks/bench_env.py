@@ -70,7 +70,7 @@ def powmod_seconds(bits: int, reps: int = 200) -> float:
 
 
 def elgamal_seconds_per_step(steps: int) -> float:
-    env = gym.make(ENV_ID, config={**CONFIG, "crypto": "elgamal", "max_samples": steps + 1})
+    env = gym.make(ENV_ID, config={**CONFIG, "crypto": "elgamal", "max_samples": max(steps + 1, 16)})
     env.reset(seed=0)
     acts = np.clip(np.random.default_rng(1).normal(0, 0.25, (steps, 4)), -1, 1).astype(np.float32)
     t0 = time.perf_counter()

@@ -1,12 +1,19 @@
 """Compiled (numba) per-step kernels of the attack episode.
 
-Every kernel loops over the K copies and, inside a copy, over vector entries in a fixed order,
-so copy ``i`` of a batch computes bit for bit what a lone environment computes. The small
-kernels (energy budget, plant update, regression columns, error) are used one by one by the
-ElGamal backend, between calls into the crypto layer; :func:`step_ideal` fuses them with the
-ideal backend's quantisation (the residue table of :mod:`encctl_gym.crypto.residue_table`), so
-an ideal step is one call. numba inlines the small kernels into the fused one without
-reordering floating-point operations (no fastmath), so both paths give identical numbers.
+The work of one copy in one period is written once, as functions of the copy index ``k``
+(``_*_k``); the batched kernels sweep them over the copies. Inside a copy the floating-point
+operations run in a fixed order (no fastmath), so copy ``k`` of a batch computes bit for bit
+what a lone environment computes.
+
+The small batched kernels (energy budget, plant update, regression columns, error,
+observation) are used one by one by the ElGamal backend, between calls into the crypto layer;
+:func:`step_fused` does a whole ideal-backend period (energy budget, forged input quantised
+through the residue table of :mod:`encctl_gym.crypto.residue_table`, plant, delivery,
+recursive least squares, error, reward, observation) in one call.
+
+Data layout: ``X`` (N, K, n) and ``U`` (N, K, m) are time-major, so the copies' data of one
+period are contiguous; ``G`` (K, d, d), ``C`` (K, d, n) and ``Q = [P | Theta_hat^T]``
+(K, d, d + n) hold each copy's running least squares, ``d = n + m``.
 """
 
 from __future__ import annotations
@@ -14,170 +21,197 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-# status codes of step_ideal
+# status codes
 OK = 0
 STATE_OVERFLOW = 1
 
 
+# ----------------------------------------------------------------------------- one copy
+@njit(cache=True, inline="always")
+def _energy_k(k, act, u_max, energy, budget, a_out):
+    """a = action * u_max, scaled down to exhaust the remaining energy when it would overdraw it
+    (``act`` is scaled too: the agent's own input history records what was applied)."""
+    m = act.shape[1]
+    e = 0.0
+    for j in range(m):
+        v = act[k, j] * u_max
+        a_out[k, j] = v
+        e += v * v
+    remaining = budget - energy[k]
+    if e > remaining:
+        if remaining < 0.0:
+            remaining = 0.0
+        scale = np.sqrt(remaining / e) if e > 0.0 else 1.0
+        for j in range(m):
+            a_out[k, j] *= scale
+            act[k, j] *= scale
+        e = remaining
+    energy[k] += e
+
+
+@njit(cache=True, inline="always")
+def _plant_k(k, x, u, w, A, B, tmp):
+    """x_k <- A x_k + B u_k + w_k (eq:system); ``tmp`` (K, n) is scratch."""
+    n = x.shape[1]
+    m = u.shape[1]
+    for i in range(n):
+        s = 0.0
+        for j in range(n):
+            s += A[i, j] * x[k, j]
+        for j in range(m):
+            s += B[i, j] * u[k, j]
+        tmp[k, i] = s + w[k, i]
+    for i in range(n):
+        x[k, i] = tmp[k, i]
+
+
+@njit(cache=True, inline="always")
+def _history_k(k, hist, act):
+    """Newest own input first; the oldest drops out."""
+    L = hist.shape[1]
+    m = act.shape[1]
+    for i in range(L - 1, m - 1, -1):
+        hist[k, i] = hist[k, i - m]
+    for j in range(min(m, L)):
+        hist[k, j] = act[k, j]
+
+
+@njit(cache=True, inline="always")
+def _quantize_k(k, v, delta, offset, limit, out):
+    """Signed integer of the nearest subgroup member to round(delta v) (Definition def:ec);
+    False if a value lies outside the table range."""
+    for j in range(v.shape[1]):
+        i = np.int64(np.rint(v[k, j] * delta))
+        if i > limit or i < -limit:
+            return False
+        out[k, j] = i + offset[i + limit]
+    return True
+
+
+@njit(cache=True, inline="always")
+def _columns_k(k, X, U, first, target, G, C, Q, gram, recursive, z, r, g):
+    """Regression columns ``([x_{j-1}; u_{j-1}], x_j)``, ``first <= j < target`` (eq:data):
+    if ``gram``, the Gram matrix and cross term; if ``recursive``, recursive least squares on
+    ``Q = [P | Theta_hat^T]``: ``r = z^T Q``, ``r[d:] -= y``, ``g = r[:d] / (1 + r[:d] . z)``,
+    ``Q -= g r`` (Sherman-Morrison on P and the RLS update of Theta_hat together).
+    ``z``, ``g`` (K, d) and ``r`` (K, d + n) are scratch."""
+    n = X.shape[2]
+    m = U.shape[2]
+    d = n + m
+    w = d + n
+    zk, rk, gk = z[k], r[k], g[k]
+    Gk, Ck, Qk = G[k], C[k], Q[k]
+    for j in range(first, target):
+        for i in range(n):
+            zk[i] = X[j - 1, k, i]
+        for i in range(m):
+            zk[n + i] = U[j - 1, k, i]
+        if gram:
+            for a in range(d):
+                za = zk[a]
+                for b in range(d):
+                    Gk[a, b] += za * zk[b]
+                for b in range(n):
+                    Ck[a, b] += za * X[j, k, b]
+        if recursive:
+            for b in range(w):  # r = z^T Q, summed over a in order (inner loop contiguous)
+                rk[b] = 0.0
+            for a in range(d):
+                za = zk[a]
+                for b in range(w):
+                    rk[b] += za * Qk[a, b]
+            for b in range(n):
+                rk[d + b] -= X[j, k, b]
+            den = 1.0
+            for a in range(d):
+                den += rk[a] * zk[a]
+            for a in range(d):
+                gk[a] = rk[a] / den
+            for a in range(d):
+                ga = gk[a]
+                for b in range(w):
+                    Qk[a, b] -= ga * rk[b]
+
+
+@njit(cache=True, inline="always")
+def _error_k(k, Q, theta_true_T, c):
+    """epsilon = ||Theta_hat - Theta||_F^2 / c (Definition def:error)."""
+    d = Q.shape[1]
+    n = Q.shape[2] - d
+    s = 0.0
+    for a in range(d):
+        for b in range(n):
+            e = Q[k, a, d + b] - theta_true_T[a, b]
+            s += e * e
+    return s / c
+
+
+@njit(cache=True, inline="always")
+def _observation_k(k, obs, X, U, j, new, hist, time_frac, energy, budget):
+    """[x_j | u_{j-1} | new | own inputs | deciphering-time fraction | energy fraction]."""
+    n = X.shape[2]
+    m = U.shape[2]
+    H = hist.shape[1]
+    for i in range(n):
+        obs[k, i] = X[j, k, i] if j >= 0 else 0.0
+    for i in range(m):
+        obs[k, n + i] = U[j - 1, k, i] if j >= 1 else 0.0
+    obs[k, n + m] = new
+    for i in range(H):
+        obs[k, n + m + 1 + i] = hist[k, i]
+    obs[k, n + m + 1 + H] = time_frac
+    obs[k, n + m + 2 + H] = energy[k] / budget
+
+
+# ----------------------------------------------------------------------------- batched
 @njit(cache=True)
 def energy_budget(act, u_max, energy, budget, a_out):
-    """a = action * u_max, scaled down to exhaust the remaining energy when it would overdraw it.
-
-    Scales ``act`` in place too (the agent's own input history records what was applied).
-    """
-    K, m = act.shape
-    for k in range(K):
-        e = 0.0
-        for j in range(m):
-            v = act[k, j] * u_max
-            a_out[k, j] = v
-            e += v * v
-        remaining = budget - energy[k]
-        if e > remaining:
-            if remaining < 0.0:
-                remaining = 0.0
-            scale = np.sqrt(remaining / e) if e > 0.0 else 1.0
-            for j in range(m):
-                a_out[k, j] *= scale
-                act[k, j] *= scale
-            e = remaining
-        energy[k] += e
+    for k in range(act.shape[0]):
+        _energy_k(k, act, u_max, energy, budget, a_out)
 
 
 @njit(cache=True)
 def plant_step(x, u, w, A, B):
-    """x <- A x + B u + w (eq:system), in place, one copy at a time."""
-    K, n = x.shape
-    m = u.shape[1]
-    tmp = np.empty(n)
-    for k in range(K):
-        for i in range(n):
-            s = 0.0
-            for j in range(n):
-                s += A[i, j] * x[k, j]
-            for j in range(m):
-                s += B[i, j] * u[k, j]
-            tmp[i] = s + w[k, i]
-        for i in range(n):
-            x[k, i] = tmp[i]
+    tmp = np.empty(x.shape)
+    for k in range(x.shape[0]):
+        _plant_k(k, x, u, w, A, B, tmp)
 
 
 @njit(cache=True)
 def shift_history(hist, act):
-    """Newest own input first; the oldest drops out."""
-    K, L = hist.shape
-    m = act.shape[1]
-    for k in range(K):
-        for i in range(L - 1, m - 1, -1):
-            hist[k, i] = hist[k, i - m]
-        for j in range(m):
-            hist[k, j] = act[k, j]
-
-
-@njit(cache=True)
-def quantize(v, delta, offset, limit, out):
-    """Signed integer of the nearest subgroup member to round(delta v) (Definition def:ec).
-
-    Returns False if some value lies outside the table range (the caller raises)."""
-    K, L = v.shape
-    for k in range(K):
-        for j in range(L):
-            i = np.int64(np.rint(v[k, j] * delta))
-            if i > limit or i < -limit:
-                return False
-            out[k, j] = i + offset[i + limit]
-    return True
+    for k in range(hist.shape[0]):
+        _history_k(k, hist, act)
 
 
 @njit(cache=True)
 def add_columns(X, U, first, target, G, C, Q, ready):
-    """Regression columns ``([x_{j-1}; u_{j-1}], x_j)`` for ``first <= j < target`` (eq:data).
-
-    Accumulates the Gram matrix ``G`` and cross term ``C`` and, for the copies whose recursion
-    has started, runs recursive least squares on ``Q = [P | Theta_hat^T]``:
-    ``r = z^T Q``, ``r[d:] -= y``, ``k = r[:d] / (1 + r[:d] . z)``, ``Q -= k r``.
-    """
-    K, _, n = X.shape
-    m = U.shape[2]
-    d = n + m
-    w = d + n
-    z = np.empty(d)
-    r = np.empty(w)
-    kk = np.empty(d)
+    K, d = G.shape[0], G.shape[1]
+    z, g, r = np.empty((K, d)), np.empty((K, d)), np.empty((K, Q.shape[2]))
     for k in range(K):
-        for j in range(first, target):
-            for i in range(n):
-                z[i] = X[k, j - 1, i]
-            for i in range(m):
-                z[n + i] = U[k, j - 1, i]
-            for a in range(d):
-                for b in range(d):
-                    G[k, a, b] += z[a] * z[b]
-                for b in range(n):
-                    C[k, a, b] += z[a] * X[k, j, b]
-            if ready[k]:
-                for b in range(w):
-                    s = 0.0
-                    for a in range(d):
-                        s += z[a] * Q[k, a, b]
-                    r[b] = s
-                for b in range(n):
-                    r[d + b] -= X[k, j, b]
-                den = 1.0
-                for a in range(d):
-                    den += r[a] * z[a]
-                for a in range(d):
-                    kk[a] = r[a] / den
-                for a in range(d):
-                    for b in range(w):
-                        Q[k, a, b] -= kk[a] * r[b]
+        _columns_k(k, X, U, first, target, G, C, Q, True, ready[k], z, r, g)
+
+
+@njit(cache=True)
+def add_gram(X, U, first, target, G, C):
+    """Only the Gram matrix and cross term of columns ``first <= j < target`` (catch-up)."""
+    K, d = G.shape[0], G.shape[1]
+    z, g, r = np.empty((K, d)), np.empty((K, d)), np.empty((K, d + X.shape[2]))
+    for k in range(K):
+        _columns_k(k, X, U, first, target, G, C, G, True, False, z, r, g)
 
 
 @njit(cache=True)
 def estimation_error(Q, theta_true_T, c, ready, eps):
-    """epsilon = ||Theta_hat - Theta||_F^2 / c (Definition def:error) for the ready copies."""
-    K, d, w = Q.shape
-    n = w - d
-    for k in range(K):
+    """Definition def:error for the copies flagged in ``ready``."""
+    for k in range(Q.shape[0]):
         if ready[k]:
-            s = 0.0
-            for a in range(d):
-                for b in range(n):
-                    e = Q[k, a, d + b] - theta_true_T[a, b]
-                    s += e * e
-            eps[k] = s / c
+            eps[k] = _error_k(k, Q, theta_true_T, c)
 
 
 @njit(cache=True)
-def step_ideal(
-    act, u_max, energy, budget,
-    delta, offset, limit, one, zero2, n_cols,
-    x, A, B, w,
-    X, U, u_at, collect_at, hist,
-    a_buf, q_buf, qx_buf,
-):
-    """One ideal-backend period for every copy: energy budget, forged input (quantised at Delta
-    as the plant decodes it), plant update, own-input history, and, if ``collect_at >= 0``, the
-    collected state ``Dcd(Ecd(x))`` stored at ``X[:, collect_at]``. Returns a status code."""
-    K, m = act.shape
-    n = x.shape[1]
-    energy_budget(act, u_max, energy, budget, a_buf)
-    quantize(a_buf, delta, offset, limit, q_buf)  # |a| <= u_max lies inside the table by construction
-    dd = delta * delta
-    for k in range(K):
-        for j in range(m):
-            a_buf[k, j] = (q_buf[k, j] * one + (n_cols - 1) * zero2) / dd
-            U[k, u_at, j] = a_buf[k, j]
-    plant_step(x, a_buf, w, A, B)
-    if hist.shape[1] > 0:
-        shift_history(hist, act)
-    if collect_at >= 0:
-        if not quantize(x, delta, offset, limit, qx_buf):
-            return STATE_OVERFLOW
-        for k in range(K):
-            for i in range(n):
-                X[k, collect_at, i] = qx_buf[k, i] / delta
-    return OK
+def fill_observation(obs, X, U, j, new, hist, time_frac, energy, budget):
+    for k in range(obs.shape[0]):
+        _observation_k(k, obs, X, U, j, new, hist, time_frac, energy, budget)
 
 
 @njit(cache=True)
@@ -201,18 +235,86 @@ def check_actions(a):
 
 
 @njit(cache=True)
-def fill_observation(obs, X, U, j, new, hist, time_frac, energy, budget):
-    """[x_j | u_{j-1} | new | own inputs | deciphering-time fraction | energy fraction]."""
-    K, _, n = X.shape
-    m = U.shape[2]
-    H = hist.shape[1]
+def log_ratio(before, after, out):
+    """out = log(before / after): the reward, with the same log as the fused kernels."""
+    for k in range(out.shape[0]):
+        out[k] = np.log(before[k] / after[k])
+
+
+@njit(cache=True)
+def step_ideal(
+    act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols,
+    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
+):
+    """The period alone (no delivery): energy budget, forged input, plant, history, collection."""
+    m = act.shape[1]
+    n = x.shape[1]
+    dd = delta * delta
+    tmp = np.empty(x.shape)
+    for k in range(act.shape[0]):
+        _energy_k(k, act, u_max, energy, budget, a_buf)
+        _quantize_k(k, a_buf, delta, offset, limit, q_buf)
+        for j in range(m):
+            a_buf[k, j] = (q_buf[k, j] * one + (n_cols - 1) * zero2) / dd
+            U[u_at, k, j] = a_buf[k, j]
+        _plant_k(k, x, a_buf, w, A, B, tmp)
+        if hist.shape[1] > 0:
+            _history_k(k, hist, act)
+        if collect_at >= 0:
+            if not _quantize_k(k, x, delta, offset, limit, qx_buf):
+                return STATE_OVERFLOW
+            for i in range(n):
+                X[collect_at, k, i] = qx_buf[k, i] / delta
+    return OK
+
+
+@njit(cache=True)
+def step_fused(
+    act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols,
+    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
+    first, target, G, C, Q, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
+    tmp, z, r, g,
+):
+    """A whole steady-state ideal-backend period for every copy, in one call (the Gram
+    matrices are left behind; :func:`add_gram` catches them up when they are needed).
+
+    Stage by stage over all copies (each stage a contiguous sweep of the batch); every copy
+    goes through the same per-copy functions in the same order as :func:`step_ideal` followed
+    by :func:`add_columns` and :func:`estimation_error`, so the numbers are those of the
+    general path.
+    """
+    K, m = act.shape
+    n = x.shape[1]
+    dd = delta * delta
     for k in range(K):
-        for i in range(n):
-            obs[k, i] = X[k, j, i] if j >= 0 else 0.0
-        for i in range(m):
-            obs[k, n + i] = U[k, j - 1, i] if j >= 1 else 0.0
-        obs[k, n + m] = new
-        for i in range(H):
-            obs[k, n + m + 1 + i] = hist[k, i]
-        obs[k, n + m + 1 + H] = time_frac
-        obs[k, n + m + 2 + H] = energy[k] / budget
+        _energy_k(k, act, u_max, energy, budget, a_buf)
+    for k in range(K):
+        _quantize_k(k, a_buf, delta, offset, limit, q_buf)  # |a| <= u_max: inside the table
+    for k in range(K):  # the plant decodes the forged input (crypto.controller.injection_value)
+        for j in range(m):
+            a_buf[k, j] = (q_buf[k, j] * one + (n_cols - 1) * zero2) / dd
+            U[u_at, k, j] = a_buf[k, j]
+    for k in range(K):
+        _plant_k(k, x, a_buf, w, A, B, tmp)
+    if hist.shape[1] > 0:
+        for k in range(K):
+            _history_k(k, hist, act)
+    if collect_at >= 0:
+        for k in range(K):
+            if not _quantize_k(k, x, delta, offset, limit, qx_buf):
+                return STATE_OVERFLOW
+        for k in range(K):
+            for i in range(n):
+                X[collect_at, k, i] = qx_buf[k, i] / delta
+    if target > first:
+        for k in range(K):
+            before = eps[k]
+            _columns_k(k, X, U, first, target, G, C, Q, False, True, z, r, g)
+            eps[k] = _error_k(k, Q, theta_true_T, c)
+            reward[k] = np.log(before / eps[k])
+    else:
+        for k in range(K):
+            reward[k] = 0.0
+    for k in range(K):
+        _observation_k(k, obs, X, U, j_obs, new, hist, time_frac, energy, budget)
+    return OK

@@ -143,8 +143,9 @@ class EncryptedLTIAttackEnv(gym.Env):
         return obs[0], self._core.info()
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        reward, terminated, truncated = self._core.step(action)
-        return self._core.observation()[0], float(reward[0]), terminated, truncated, self._core.info()
+        core = self._core
+        reward, terminated, truncated = core.step(action)
+        return core.observation()[0], float(reward[0]), terminated, truncated, core.info()
 
     def render(self) -> np.ndarray | None:
         if self.render_mode != "rgb_array":

@@ -90,12 +90,14 @@ class EpisodeCore:
         self.time_table = keys * p.sample_cost  # Definition def:sdt
         self._time_frac = self.time_table / p.tau_c
         # per-copy data: collected (deciphered) states and applied inputs
-        self.X = np.zeros((K, N, n))
-        self.U = np.zeros((K, N, m))
+        # time-major: the data of all copies for one period are contiguous
+        self.X = np.zeros((N, K, n))  # collected (deciphered) states x_0 .. x_{N-1}
+        self.U = np.zeros((N, K, m))  # applied inputs u_0 .. u_{N-1}
         self.G = np.zeros((K, self.d, self.d))  # regressor Gram matrix of the delivered data
         self.C = np.zeros((K, self.d, n))  # cross term sum z x_next^T
         self.Q = np.zeros((K, self.d, self.d + n))  # recursive least squares: [P | Theta_hat^T]
         self.ready = np.zeros(K, dtype=bool)  # recursion started (well-conditioned Gram matrix)
+        self._gram_upto = 1  # G and C hold the columns j < _gram_upto (the fused step lets them lag)
         self._since_refresh = 0
         self.x = np.zeros((K, n))
         self.hist = np.zeros((K, p.input_history * m))
@@ -111,6 +113,16 @@ class EpisodeCore:
         self._qa = np.zeros((K, m), dtype=np.int64)
         self._qx = np.zeros((K, n), dtype=np.int64)
         self._theta_true_T = np.ascontiguousarray(self._theta_true.T)
+        self._cf = float(self._c)
+        self._horizon = p.horizon
+        self._reward = np.zeros(K)
+        self._scratch = (np.empty((K, n)), np.empty((K, n + m)), np.empty((K, 2 * n + m)), np.empty((K, n + m)))
+        self._obs_valid = False
+        self._step_fused = kern.step_fused  # one compiled call per steady-state step
+        self._u_max = p.u_max
+        self._budget = p.energy_budget
+        self._logdet = p.reward == "logdet"
+        self._all_ready = False
         # the ideal backend's step is one fused compiled call
         self._fused = getattr(loop, "fused_parameters", None)
         self._noise = np.zeros((K, _CHUNK, n))
@@ -140,6 +152,7 @@ class EpisodeCore:
         if len(rngs) != self.K:
             raise ParameterError(f"expected {self.K} random generators, got {len(rngs)}")
         self._rngs = rngs
+        self._obs_valid = False
         for i, g in enumerate(rngs):
             self.x[i] = g.standard_normal(self.n) * self._sx
         self._noise_pos = _CHUNK
@@ -151,6 +164,8 @@ class EpisodeCore:
         self.G[:] = 0.0
         self.C[:] = 0.0
         self.ready[:] = False
+        self._gram_upto = 1
+        self._all_ready = False
         self._since_refresh = 0
         self.hist[:] = 0.0
         self.energy[:] = 0.0
@@ -166,23 +181,51 @@ class EpisodeCore:
     # ----------------------------------------------------------------- step
     def _collect(self) -> None:
         """Collect and pay for the state ciphertext of the current period."""
-        self.X[:, self.collected] = self.loop.collect_state(self.x)
+        self.X[self.collected] = self.loop.collect_state(self.x)
         self.collected += 1
+
+    def _sync_gram(self, upto: int) -> None:
+        """Bring G and C up to the columns j < ``upto`` (the fused step leaves them behind)."""
+        if upto > self._gram_upto:
+            kern.add_gram(self.X, self.U, self._gram_upto, upto, self.G, self.C)
+            self._gram_upto = upto
+
+    def _overflow(self) -> None:
+        raise EncodingOverflowError(
+            f"state {self.x.tolist()} leaves the encoder's declared range |x| <= {self.p.x_bound} (x_bound)"
+        )
+
+    def _target(self, collected: int) -> int:
+        """Number of samples delivered once ``collected`` are paid for (before the end)."""
+        delay = self.p.decipher_delay
+        if delay is None:  # "end": nothing before the attack ends
+            return 0
+        return max(collected - delay, 0)
 
     def _deliver(self, final: bool) -> bool:
         """Deliver paid samples whose delay has passed; update the estimate and its error."""
-        delay = self.p.decipher_delay
-        if final:
-            target = self.collected
-        elif delay is None:  # "end": nothing before the attack ends
-            target = 0
-        else:
-            target = max(self.collected - delay, 0)
+        target = self.collected if final else self._target(self.collected)
         if target <= self.delivered:
             return False
         first = max(self.delivered, 1)
+        if (
+            self._all_ready
+            and not final
+            and self.p.reward != "logdet"
+            and self._since_refresh + target - first < _REFRESH
+        ):  # steady state: columns, recursive least squares and error in one compiled call
+            self._sync_gram(first)
+            kern.add_columns(self.X, self.U, first, target, self.G, self.C, self.Q, self.ready)
+            self._gram_upto = target
+            kern.estimation_error(self.Q, self._theta_true_T, self._cf, self.ready, self.eps)
+            self._since_refresh += target - first
+            self.delivered = target
+            self.history.append((target, float(self.eps[0])))
+            return True
+        self._sync_gram(first)
         if target > first:
             kern.add_columns(self.X, self.U, first, target, self.G, self.C, self.Q, self.ready)
+            self._gram_upto = target
         self.delivered = target
         if self.p.reward == "logdet":
             self.logdet = np.linalg.slogdet(self.G + self._reg)[1]
@@ -197,7 +240,8 @@ class EpisodeCore:
                 rows = np.nonzero(stale)[0]
                 theta_hat_T = self._refresh(rows)
                 self.eps[rows] = ((theta_hat_T - self._theta_true_T) ** 2).sum(axis=(1, 2)) / self._c
-            kern.estimation_error(self.Q, self._theta_true_T, float(self._c), self.ready & ~stale, self.eps)
+            kern.estimation_error(self.Q, self._theta_true_T, self._cf, self.ready & ~stale, self.eps)
+            self._all_ready = bool(self.ready.all())
         self.history.append((self.delivered, float(self.eps[0])))
         return True
 
@@ -252,46 +296,72 @@ class EpisodeCore:
         p = self.p
         act = self.check_actions(action)
         w = self._draw_noise()
-        ended = self.collected >= p.horizon
+        ended = self.collected >= self._horizon
+        if self._fused is not None and self._all_ready and not ended and not self._logdet:
+            # steady state of the ideal backend: period, delivery, recursive LS and error in one call
+            first = max(self.delivered, 1)
+            target = self._target(self.collected + 1)
+            if self._since_refresh + target - first < _REFRESH:
+                new = target > self.delivered
+                status = self._step_fused(
+                    act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
+                    self.X, self.U, self.collected - 1, self.collected, self.hist,
+                    self._a, self._qa, self._qx,
+                    first, target, self.G, self.C, self.Q, self._theta_true_T, self._cf, self.eps,
+                    self._reward, self._obs, (target if new else self.delivered) - 1, float(new),
+                    float(self._time_frac[self.collected + 1]), *self._scratch,
+                )
+                if status == kern.STATE_OVERFLOW:
+                    self._overflow()
+                self.collected += 1
+                self.new = new
+                if new:
+                    self._since_refresh += target - first
+                    self.delivered = target
+                    self.history.append((target, float(self.eps[0])))
+                self._obs_valid = True
+                return self._reward.copy(), False, False
+        self._obs_valid = False
         if self._fused is not None:  # ideal backend: one compiled call
             status = kern.step_ideal(
-                act, p.u_max, self.energy, p.energy_budget, *self._fused, self.x, self._A, self._B, w,
+                act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
                 self.X, self.U, self.collected - 1, -1 if ended else self.collected, self.hist,
                 self._a, self._qa, self._qx,
             )
             if status == kern.STATE_OVERFLOW:
-                raise EncodingOverflowError(
-                    f"state {self.x.tolist()} leaves the encoder's declared range |x| <= {p.x_bound} (x_bound)"
-                )
+                self._overflow()
             if not ended:
                 self.collected += 1
         else:
-            kern.energy_budget(act, p.u_max, self.energy, p.energy_budget, self._a)
+            kern.energy_budget(act, self._u_max, self.energy, self._budget, self._a)
             u = self.loop.inject(self._a)
-            self.U[:, self.collected - 1] = u
+            self.U[self.collected - 1] = u
             kern.plant_step(self.x, u, w, self._A, self._B)
             if p.input_history:
                 kern.shift_history(self.hist, act)
             self.loop.tick()
             if not ended:
                 self._collect()
-        before = self._score()
-        self.new = self._deliver(final=ended)
+        if p.reward == "logdet":
+            before = self.logdet.copy()
+            self.new = self._deliver(final=ended)
+            reward = self.logdet - before
+        else:  # decrease of log epsilon
+            before = self.eps.copy()
+            self.new = self._deliver(final=ended)
+            reward = np.empty(self.K)
+            kern.log_ratio(before, self.eps, reward)
         self.done = ended
-        reward = self._score() - before
         return reward, ended and p.budget_limited, ended and not p.budget_limited
-
-    def _score(self) -> np.ndarray:
-        if self.p.reward == "logdet":
-            return self.logdet.copy()
-        return -np.log(self.eps)
 
     # ----------------------------------------------------------------- observation and info
     def observation(self) -> np.ndarray:
         """Observations of all copies, shape (K, obs_dim), float32 (see the class docstring)."""
+        if self._obs_valid:  # written by the fused step
+            return self._obs.copy()
         kern.fill_observation(
             self._obs, self.X, self.U, self.delivered - 1, float(self.new), self.hist,
-            float(self._time_frac[self.collected]), self.energy, float(self.p.energy_budget),
+            float(self._time_frac[self.collected]), self.energy, self._budget,
         )
         return self._obs.copy()
 
