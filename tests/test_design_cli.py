@@ -51,7 +51,7 @@ def test_options_override_preset(capsys: pytest.CaptureFixture) -> None:
 
 
 def test_figure1_preset(capsys: pytest.CaptureFixture) -> None:
-    res = _json(capsys, ["design", "--preset", "figure1", "--json"])
+    res = _json(capsys, ["design", "--preset", "fig1-c", "--json"])
     assert res["system"]["tr_psi_u"] == pytest.approx(8, rel=1e-3)
 
 
@@ -117,7 +117,7 @@ def test_bad_inputs(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     np.savez(unstable, A=np.array([[1.2]]), B=np.array([[1.0]]))
     _fails(capsys, ["design", str(unstable)], "spectral radius 1.2")
     _fails(capsys, ["design"], "SYSTEM_FILE")
-    _fails(capsys, ["design", str(shape), "--preset", "figure1"], "not both")
+    _fails(capsys, ["design", str(shape), "--preset", "fig1-c"], "not both")
     _fails(capsys, ["design", "--preset", "paper-example", "--gamma-c", "0"], "gamma_c must be > 0")
     _fails(capsys, ["design", "--preset", "paper-example", "--sigma-w2", "-1"], "sigma_w2")
     _fails(capsys, ["design", "--preset", "paper-example", "--sigma-x2", "-1"], "sigma_x2")

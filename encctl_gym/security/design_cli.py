@@ -32,12 +32,13 @@ import numpy as np
 
 from .._validation import check_nonnegative, check_positive, check_schur_stable, check_system
 from ..errors import ConfigError, ParameterError
+from ..presets import SECONDS_PER_YEAR, get_preset, preset_names
 from .attack_design import gaussian_attack_design, optimal_attack_design, robust_security_design
 from .complexity import input_upper_bound, noise_upper_bound, sic_asymptotic_from_traces, sic_from_traces
 from .design import SecurityDesign, design_from_traces
 from .gramians import controllability_gramian, noise_gramian
 
-__all__ = ["add_arguments", "run", "parse_duration", "load_system", "PRESETS", "DEFAULTS", "compute"]
+__all__ = ["add_arguments", "run", "parse_duration", "load_system", "DEFAULTS", "compute"]
 
 SECONDS_PER_UNIT: dict[str, float] = {
     "s": 1.0,
@@ -45,7 +46,7 @@ SECONDS_PER_UNIT: dict[str, float] = {
     "min": 60.0,
     "h": 3600.0,
     "d": 86400.0,
-    "y": 365 * 86400.0,  # the paper: 10 years = 31536e4 s
+    "y": float(SECONDS_PER_YEAR),  # the paper: 10 years = 31536e4 s
 }
 
 #: Option defaults: the paper's design example.
@@ -58,28 +59,13 @@ DEFAULTS: dict[str, Any] = {
     "sigma_x2": 1.0,
 }
 
-#: Preset plants (and their design parameters, overridden by explicit options).
-PRESETS: dict[str, dict[str, Any]] = {
-    # Section "Numerical Simulation", design example: Psi_w = 2I, Psi_u = 0.5I, R = 100.
-    "paper-example": {
-        "A": np.sqrt(0.5) * np.eye(4),
-        "B": 0.5 * np.eye(4),
-        "description": "paper design example: A = sqrt(1/2) I4, B = 0.5 I4 (Psi_w = 2I, Psi_u = 0.5I)",
-    },
-    # Figure fig:variance_ratio: A = 0.7071 I, B = I (Psi_u = Psi_w ~ 2I), panel (c) R = 100.
-    "figure1": {
-        "A": 0.7071 * np.eye(4),
-        "B": np.eye(4),
-        "description": "Figure 1 system: A = 0.7071 I4, B = I4 (Psi_u = Psi_w ~ 2I)",
-    },
-}
-
-
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the options of ``encctl-gym design``."""
     parser.add_argument("system_file", nargs="?", metavar="SYSTEM_FILE",
                         help="JSON/YAML ({'A': [[...]], 'B': [[...]]}) or NPZ (arrays A, B)")
-    parser.add_argument("--preset", choices=sorted(PRESETS), help="use a preset plant instead of a file")
+    parser.add_argument("--preset", choices=preset_names(), metavar="NAME",
+                        help="use a preset plant (with its variances and design parameters) instead of a file: "
+                        + ", ".join(preset_names()))
     parser.add_argument("--gamma-c", dest="gamma_c", metavar="G",
                         help="acceptable estimation error gamma_c (default 1e-6)")
     parser.add_argument("--tau-c", dest="tau_c", metavar="T",
@@ -305,20 +291,25 @@ def run(args: argparse.Namespace) -> int:
     """Run ``encctl-gym design``: print the table (or JSON); return 0."""
     if args.preset and args.system_file:
         raise ConfigError("give either SYSTEM_FILE or --preset, not both")
+    defaults = dict(DEFAULTS)
     if args.preset:
-        preset = PRESETS[args.preset]
-        A, B = preset["A"], preset["B"]
-        title = f"preset {args.preset}, {preset['description']}"
+        preset = get_preset(args.preset)
+        A, B = preset.A, preset.B
+        title = f"preset {args.preset}, {preset.description}"
+        defaults.update(
+            gamma_c=preset.gamma_c, tau_c=preset.tau_c, upsilon=preset.upsilon,
+            sigma_u2=preset.sigma_u2, sigma_w2=preset.sigma_w2, sigma_x2=preset.sigma_x2,
+        )
     elif args.system_file:
         A, B = load_system(args.system_file)
         title = str(args.system_file)
     else:
-        raise ConfigError("give a SYSTEM_FILE (JSON, YAML or NPZ with A and B) or --preset " + "/".join(sorted(PRESETS)))
+        raise ConfigError("give a SYSTEM_FILE (JSON, YAML or NPZ with A and B) or --preset NAME")
     values = {}
     for key in ("gamma_c", "upsilon", "sigma_u2", "sigma_w2", "sigma_x2"):
         raw = getattr(args, key)
-        values[key] = DEFAULTS[key] if raw is None else _parse_number(key, raw)
-    values["tau_c"] = DEFAULTS["tau_c"] if args.tau_c is None else parse_duration(args.tau_c)
+        values[key] = defaults[key] if raw is None else _parse_number(key, raw)
+    values["tau_c"] = defaults["tau_c"] if args.tau_c is None else parse_duration(args.tau_c)
     for key in ("gamma_c", "upsilon", "sigma_u2", "sigma_w2", "tau_c"):
         check_positive(key, values[key])
     check_nonnegative("sigma_x2", values["sigma_x2"])
