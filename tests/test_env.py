@@ -178,7 +178,7 @@ def test_energy_budget_is_enforced_and_reported():
     assert info["average_power"] == pytest.approx(p.sigma_u2, rel=1e-12)
     # after the budget is spent the injected input is zero: the plant applies the quantised 0
     zero = env.loop.inject(np.zeros((1, p.m)))[0]
-    assert np.array_equal(env._core.U[0, -1], zero) and np.abs(zero).max() < 2 / p.delta
+    assert np.array_equal(env._core.U[-1, 0], zero) and np.abs(zero).max() < 2 / p.delta
 
 
 def test_log_error_return_telescopes():
@@ -205,7 +205,7 @@ def test_final_epsilon_equals_batch_least_squares():
         if te or tr:
             break
     core = env._core
-    A_hat, B_hat = least_squares(core.X[0], core.U[0])
+    A_hat, B_hat = least_squares(core.X[:, 0], core.U[:, 0])
     assert info["epsilon"] == pytest.approx(estimation_error(env.params.A, env.params.B, A_hat, B_hat), rel=1e-8)
 
 
