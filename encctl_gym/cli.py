@@ -25,10 +25,6 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "experiments.reproduce",
         "reproduce the paper's figures and design example (writes PNG and CSV)",
     ),
-    "attack": (
-        "encctl_gym.envs.attack_cli",
-        "run an attacker through the encrypted-control environment and compare with gamma(N)",
-    ),
     "train": (
         "agents.train",
         "train a learned attacker with stable-baselines3 (needs the [rl] extra)",
@@ -40,7 +36,9 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(selected: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser; only the ``selected`` subcommand's module is imported (so that, e.g.,
+    ``design`` does not load torch)."""
     parser = argparse.ArgumentParser(
         prog="encctl-gym",
         description="Adversarial experiments on encrypted control systems "
@@ -49,30 +47,35 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, (module_name, help_text) in SUBCOMMANDS.items():
+        p = sub.add_parser(name, help=help_text, description=help_text)
+        if name != selected:
+            continue
         try:
             module = importlib.import_module(module_name)
         except ModuleNotFoundError as exc:
-            # A subcommand whose optional dependency is missing is still listed, and says why.
             missing = exc.name or module_name
+            if missing == module_name or module_name.startswith(missing + "."):
+                raise  # the subcommand's own module is missing: a packaging error, not a missing extra
 
             def _unavailable(args: argparse.Namespace, _missing: str = missing) -> int:
                 raise EncctlError(
                     f"this subcommand needs the module {_missing!r}; install the extra that provides it "
-                    "(e.g. pip install 'encctl-gym[rl]')"
+                    "(pip install 'encctl-gym[rl]')"
                 )
 
-            p = sub.add_parser(name, help=help_text + " [unavailable]")
             p.set_defaults(_run=_unavailable)
             continue
-        p = sub.add_parser(name, help=help_text, description=(module.__doc__ or help_text).strip().splitlines()[0])
         module.add_arguments(p)
         p.set_defaults(_run=module.run)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    """Entry point of ``encctl-gym``; returns the exit code."""
+    args_list = list(sys.argv[1:] if argv is None else argv)
+    selected = next((a for a in args_list if a in SUBCOMMANDS), None)
+    parser = build_parser(selected)
+    args = parser.parse_args(args_list)
     if not getattr(args, "_run", None):
         parser.print_help()
         return 2
