@@ -10,9 +10,11 @@ from __future__ import annotations
 import argparse
 import csv
 import os
+import sys
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -222,3 +224,38 @@ def plot_panel(ax: Any, s: dict[str, Any], title: str, *, bound: bool = False) -
         ax.loglog(N, s["bound"], ":", color="k", lw=1.6, label=r"$\bar\gamma(N)$ (eq:bound)")
     ax.set_title(title, fontsize=9)
     ax.grid(True, which="major", alpha=0.3)
+
+
+def run_figure(args: argparse.Namespace, compute: Callable[..., "Table"], plot: Callable[..., Path], stem: str, label: str) -> int:
+    """Compute a figure's table, save ``<stem>.csv`` and ``<stem>.png`` under ``args.out``, print the paths."""
+    out = ensure_out_dir(args.out)
+    t0 = time.perf_counter()
+    table = compute(grid_config(args.quick), seed=args.seed, n_jobs=args.n_jobs,
+                    scheduler=args.scheduler, progress=not args.no_progress)
+    elapsed = time.perf_counter() - t0
+    csv_path = table.to_csv(out / f"{stem}.csv")
+    png_path = plot(table, out / f"{stem}.png")
+    print(f"{label}: {len(table)} rows in {elapsed:.1f} s")
+    print(f"  wrote {csv_path}")
+    print(f"  wrote {png_path}")
+    return 0
+
+
+def script_main(
+    name: str,
+    doc: str | None,
+    add_arguments: Callable[[argparse.ArgumentParser], None],
+    run: Callable[[argparse.Namespace], int],
+    argv: Sequence[str] | None = None,
+) -> int:
+    """``main`` of an experiment script: parse, run, and print a package error as one line (exit 2)."""
+    from encctl_gym.errors import EncctlError
+
+    parser = argparse.ArgumentParser(description=(doc or "").strip().splitlines()[0])
+    add_arguments(parser)
+    args = parser.parse_args(argv)
+    try:
+        return run(args)
+    except EncctlError as exc:
+        print(f"{name}: error: {exc}", file=sys.stderr)
+        return 2

@@ -23,7 +23,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 from encctl_gym.presets import get_preset
 from encctl_gym.security.design import SecurityDesign, design_security_parameter, paper_design_example
-from experiments.common import add_common_arguments, ensure_out_dir
+from experiments.common import add_common_arguments, ensure_out_dir, script_main
 
 __all__ = ["PAPER_VALUES", "compute", "format_table", "add_arguments", "run", "main"]
 
@@ -94,16 +94,7 @@ def run(args: argparse.Namespace) -> int:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``python experiments/design_example.py``."""
-    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().splitlines()[0])
-    add_arguments(parser)
-    from encctl_gym.errors import EncctlError
-
-    args = parser.parse_args(argv)
-    try:
-        return run(args)
-    except EncctlError as exc:
-        print(f"design_example: error: {exc}", file=sys.stderr)
-        return 2
+    return script_main("design_example", __doc__, add_arguments, run, argv)
 
 
 if __name__ == "__main__":

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -37,10 +36,10 @@ from experiments.common import (
     GridConfig,
     Table,
     add_common_arguments,
-    ensure_out_dir,
     figure_seed,
-    grid_config,
     plot_panel,
+    run_figure,
+    script_main,
 )
 
 __all__ = ["PANELS", "panel_systems", "compute", "plot", "add_arguments", "run", "main"]
@@ -157,31 +156,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Compute, save ``fig1_variance_ratio.csv`` and ``.png`` under ``args.out``; print the paths."""
-    out = ensure_out_dir(args.out)
-    t0 = time.perf_counter()
-    table = compute(grid_config(args.quick), seed=args.seed, n_jobs=args.n_jobs,
-                    scheduler=args.scheduler, progress=not args.no_progress)
-    elapsed = time.perf_counter() - t0
-    csv_path = table.to_csv(out / "fig1_variance_ratio.csv")
-    png_path = plot(table, out / "fig1_variance_ratio.png")
-    print(f"Figure 1: {len(table)} rows in {elapsed:.1f} s")
-    print(f"  wrote {csv_path}")
-    print(f"  wrote {png_path}")
-    return 0
+    return run_figure(args, compute, plot, "fig1_variance_ratio", "Figure 1")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``python experiments/fig1_variance_ratio.py``."""
-    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().splitlines()[0])
-    add_arguments(parser)
-    from encctl_gym.errors import EncctlError
-
-    args = parser.parse_args(argv)
-    try:
-        return run(args)
-    except EncctlError as exc:
-        print(f"fig1_variance_ratio: error: {exc}", file=sys.stderr)
-        return 2
+    return script_main("fig1_variance_ratio", __doc__, add_arguments, run, argv)
 
 
 if __name__ == "__main__":

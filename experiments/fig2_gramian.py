@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -37,10 +36,10 @@ from experiments.common import (
     GridConfig,
     Table,
     add_common_arguments,
-    ensure_out_dir,
     figure_seed,
-    grid_config,
     plot_panel,
+    run_figure,
+    script_main,
 )
 
 __all__ = ["PSI_U", "PANELS", "panel_systems", "compute", "plot", "add_arguments", "run", "main"]
@@ -164,31 +163,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Compute, save ``fig2_gramian.csv`` and ``.png`` under ``args.out``; print the paths."""
-    out = ensure_out_dir(args.out)
-    t0 = time.perf_counter()
-    table = compute(grid_config(args.quick), seed=args.seed, n_jobs=args.n_jobs,
-                    scheduler=args.scheduler, progress=not args.no_progress)
-    elapsed = time.perf_counter() - t0
-    csv_path = table.to_csv(out / "fig2_gramian.csv")
-    png_path = plot(table, out / "fig2_gramian.png")
-    print(f"Figure 2: {len(table)} rows in {elapsed:.1f} s")
-    print(f"  wrote {csv_path}")
-    print(f"  wrote {png_path}")
-    return 0
+    return run_figure(args, compute, plot, "fig2_gramian", "Figure 2")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``python experiments/fig2_gramian.py``."""
-    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().splitlines()[0])
-    add_arguments(parser)
-    from encctl_gym.errors import EncctlError
-
-    args = parser.parse_args(argv)
-    try:
-        return run(args)
-    except EncctlError as exc:
-        print(f"fig2_gramian: error: {exc}", file=sys.stderr)
-        return 2
+    return script_main("fig2_gramian", __doc__, add_arguments, run, argv)
 
 
 if __name__ == "__main__":

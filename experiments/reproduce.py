@@ -18,7 +18,7 @@ from typing import Sequence
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from experiments.common import add_common_arguments
+from experiments.common import add_common_arguments, script_main
 
 __all__ = ["STEPS", "add_arguments", "run", "main"]
 
@@ -55,17 +55,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``python -m experiments.reproduce``."""
-    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().splitlines()[0])
-    add_arguments(parser)
-    from encctl_gym.errors import EncctlError
-
-    args = parser.parse_args(argv)
-    try:
-        return run(args)
-    except EncctlError as exc:
-        print(f"reproduce: error: {exc}", file=sys.stderr)
-        return 2
+    """Entry point of ``python experiments/reproduce.py``."""
+    return script_main("reproduce", __doc__, add_arguments, run, argv)
 
 
 if __name__ == "__main__":

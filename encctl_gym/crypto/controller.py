@@ -38,7 +38,6 @@ is exactly the float the plant decodes.
 
 from __future__ import annotations
 
-import math
 from typing import Any, Literal, Optional, Sequence, Union
 
 import numpy as np
@@ -59,7 +58,7 @@ from .elgamal import (
     encrypt,
     keygen,
 )
-from .encoding import Encoder, lift, nearest_member
+from .encoding import Encoder, lift
 from .group import GroupParams, as_group
 from .modified import ModifiedCiphertext, check_modified_ciphertext
 

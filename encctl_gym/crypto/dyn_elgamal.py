@@ -133,7 +133,7 @@ def ciphertext_update(
     if not grp.contains(token.h):
         raise KeyMismatchError(f"update token h = {token.h} is not an element of the group")
     if not 0 <= token.d < grp.q:
-        raise KeyMismatchError(f"update token d is outside [0, q) for this group")
+        raise KeyMismatchError(f"update token d = {token.d} is outside [0, q) for this group")
     if ct.t is not None and token.t is not None and ct.t != token.t:
         raise KeyMismatchError(
             f"ciphertext is of step t = {ct.t} but the token updates step t = {token.t}"

@@ -51,7 +51,6 @@ import numpy as np
 
 from .._validation import check_int, check_nonnegative, check_positive, check_system
 from ..errors import ParameterError
-from .complexity import sic_asymptotic_from_traces, sic_from_traces
 from .deciphering import (
     check_security_parameter,
     exact_number,
