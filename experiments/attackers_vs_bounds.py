@@ -10,7 +10,9 @@ environment seeds and the same energy budget ``m sigma_u2 N``:
 * the A-optimal design (:class:`agents.OptimalDesignAttacker`; closed loop for delay 0, open
   loop for "end"; an oracle that knows (A, B)),
 * the learned attackers of the training runs found under ``--runs`` for that system
-  (policies reading states only with delay 0; "blind" policies in both settings).
+  (policies reading states only with delay 0; "blind" policies in both settings); by default
+  the best model of the training's evaluation callback (selected on its own episodes, so the
+  comparison here, on other seeds, is not biased by the selection).
 
 Error against N. With delay 0, ``info["epsilon"]`` after each step is the error of the
 attacker's current estimate, so one episode gives the whole curve. With "end" nothing is
@@ -243,7 +245,7 @@ def find_runs(roots: Sequence[str | Path]) -> list[Path]:
     return out
 
 
-def _learned(setting: Setting, runs: Sequence[Path]) -> list[Attacker]:
+def _learned(setting: Setting, runs: Sequence[Path], which: str = "best") -> list[Attacker]:
     from agents.sb3 import load_attacker
 
     atts = []
@@ -254,11 +256,12 @@ def _learned(setting: Setting, runs: Sequence[Path]) -> list[Attacker]:
         if setting.delay == "end" and meta["observation"] != "blind":
             continue  # a policy reading states has nothing to read before the end
         name = f"{meta['algo']}" + ("-blind" if meta["observation"] == "blind" else "")
-        atts.append(load_attacker(d, which="final", params=setting.params, name=name))
+        w = which if which == "final" or (d / "best_model.zip").exists() else "final"
+        atts.append(load_attacker(d, which=w, params=setting.params, name=name))
     return atts
 
 
-def attackers_for(setting: Setting, runs: Sequence[Path]) -> list[Attacker]:
+def attackers_for(setting: Setting, runs: Sequence[Path], which: str = "best") -> list[Attacker]:
     """The attackers evaluated in one setting (baselines, the oracle design, learned ones)."""
     p = setting.params
     return [
@@ -266,7 +269,7 @@ def attackers_for(setting: Setting, runs: Sequence[Path]) -> list[Attacker]:
         PRBSAttacker(p),
         ColoredGaussianAttacker(p, rho=0.5),
         OptimalDesignAttacker(p, design=setting.design, feedback=setting.delay != "end"),
-        *_learned(setting, runs),
+        *_learned(setting, runs, which),
     ]
 
 
@@ -344,12 +347,13 @@ def compute(
     cap: int | None = DEFAULT_CAP,
     points: int = 10,
     runs: Sequence[Path] = (),
+    which: str = "best",
     progress: bool = False,
 ) -> Result:
     """Run the experiment; every number of the tables and plots comes from here."""
     t0 = time.perf_counter()
     settings = [make_setting(s, d, cap) for s in systems for d in delays]
-    plan = [(s, attackers_for(s, runs)) for s in settings]
+    plan = [(s, attackers_for(s, runs, which)) for s in settings]
     total = sum(planned_steps(s, len(a), episodes, points) for s, a in plan)
     bar = None
     if progress:
@@ -548,6 +552,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--points", type=int, default=None, help="grid points of the blind (delay end) curves (default 10)")
     parser.add_argument("--runs", action="append", default=[], help="training run directory or a parent of runs (repeatable; "
                         "default results/train if it exists)")
+    parser.add_argument("--which", choices=("best", "final"), default="best",
+                        help="learned model: the best of the training's evaluation callback (default) or the final one")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
@@ -569,11 +575,11 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     result = compute(systems, delays=delays, episodes=episodes, seed=args.seed, cap=cap, points=points, runs=runs,
-                     progress=not args.no_progress)
+                     which=args.which, progress=not args.no_progress)
     files = write_csvs(result, out)
     plots = plot(result, out)
     cmd = ["encctl-gym compare", f"--seed {args.seed}", f"--episodes {episodes}", f"--systems {','.join(systems)}",
-           f"--max-samples {cap}"] + [f"--runs {r}" for r in roots] + (["--quick"] if quick else [])
+           f"--max-samples {cap}", f"--which {args.which}"] + [f"--runs {r}" for r in roots] + (["--quick"] if quick else [])
     md = summary_markdown(result, command=" ".join(cmd), plots=plots)
     (out / "summary.md").write_text(md)
     print(md)

@@ -177,3 +177,19 @@ def test_optimal_design_attacker_with_a_delay_uses_the_model_prediction():
     g = rollout(GaussianAttacker(params), cfg, episodes=30, seed=7, record=False)
     o = rollout(OptimalDesignAttacker(params), cfg, episodes=30, seed=7, record=False)
     assert o.mean_final() < g.mean_final()
+
+
+@pytest.mark.parametrize("delay", [0, "end"])
+def test_every_attacker_runs_through_real_elgamal_ciphertexts(delay):
+    """A small key (64 bits) keeps it fast; the same attackers, the same interface."""
+    cfg = budget_config({"preset": "small", "gamma_opt": False, "decipher_delay": delay, "key_length": 64}, 15)
+    cfg.update(crypto="elgamal", crypto_seed=0)
+    params = resolve_params(cfg)
+    assert params.crypto == "elgamal" and params.key_length <= 64
+    ideal = {k: v for k, v in cfg.items() if k not in ("crypto", "crypto_seed")}
+    for att in all_attackers(params):
+        r = rollout(att, cfg, episodes=1, seed=2, record=True)
+        assert r.crypto == "elgamal" and r.N[-1] == 15 and np.isfinite(r.final_epsilon).all()
+        # the ideal backend computes the same arithmetic without big integers: same episode
+        r_ideal = rollout(att, ideal, episodes=1, seed=2, record=True)
+        assert np.allclose(r.epsilon, r_ideal.epsilon, rtol=1e-9), att.name
