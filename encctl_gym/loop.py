@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
-from .errors import ParameterError
+from .errors import EncodingOverflowError, ParameterError
 
 __all__ = ["lqr_gain", "IdealLoop", "ElGamalLoop", "make_loop", "loop_group", "table_limit"]
 
@@ -58,6 +58,7 @@ class IdealLoop:
         from .crypto.residue_table import residue_table
 
         self.delta = float(params.delta)
+        self.x_bound = float(params.x_bound)
         self.n, self.m = params.n, params.m
         self.Phi = -lqr_gain(params.A, params.B)
         self.table = residue_table(int(group.p), table_limit(params, self.Phi))
@@ -65,7 +66,9 @@ class IdealLoop:
         self._one = int(self.encode_int(np.array(1.0)))
         self._zero2 = int(self.encode_int(np.array(0.0))) ** 2
         #: what the fused compiled step needs (encctl_gym.envs._kernels.step_ideal)
-        self.fused_parameters = (self.delta, self.table.offsets, self.table.limit, self._one, self._zero2, self.n)
+        self.fused_parameters = (
+            self.delta, self.table.offsets, self.table.limit, self._one, self._zero2, self.n, self.x_bound,
+        )
 
     def encode_int(self, v: np.ndarray) -> np.ndarray:
         """Signed integer of the subgroup element that encodes ``v`` (Definition def:ec).
@@ -82,6 +85,8 @@ class IdealLoop:
         pass
 
     def collect_state(self, x: np.ndarray) -> np.ndarray:
+        if not (np.abs(x) <= self.x_bound).all():  # the encoder's declared range (crypto raises alike)
+            raise EncodingOverflowError(f"state {x.tolist()} leaves the declared range |x| <= {self.x_bound} (x_bound)")
         return self.encode_int(x) / self.delta
 
     def control(self, x: np.ndarray) -> np.ndarray:

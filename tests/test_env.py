@@ -325,3 +325,19 @@ def test_errors_belong_to_the_hierarchy():
     assert issubclass(BudgetError, EncctlError) and issubclass(UnstableSystemError, EncctlError)
     p = resolve_params(SMALL)
     assert p.horizon >= p.n + p.m + 1
+
+
+def test_both_backends_refuse_a_state_outside_x_bound_at_the_same_step():
+    from encctl_gym.errors import EncodingOverflowError
+
+    cfg = {**SMALL, "x_bound": 1.5, "key_length": 128, "max_samples": 40}
+    acts = np.ones((40, 2), dtype=np.float32)  # drives the state out of range
+    steps = {}
+    for crypto in ("ideal", "elgamal"):
+        env = EncryptedLTIAttackEnv(config={**cfg, "crypto": crypto})
+        env.reset(seed=3)
+        with pytest.raises(EncodingOverflowError, match="1.5"):
+            for k, a in enumerate(acts):
+                steps[crypto] = k
+                env.step(a)
+    assert steps["ideal"] == steps["elgamal"]

@@ -77,6 +77,15 @@ def _history_k(k, hist, act):
 
 
 @njit(cache=True, inline="always")
+def _in_range_k(k, v, bound):
+    """|v_j| <= bound for every entry of copy k (the encoder's declared range; NaN fails)."""
+    for j in range(v.shape[1]):
+        if not abs(v[k, j]) <= bound:
+            return False
+    return True
+
+
+@njit(cache=True, inline="always")
 def _quantize_k(k, v, delta, offset, limit, out):
     """Signed integer of the nearest subgroup member to round(delta v) (Definition def:ec);
     False if a value lies outside the table range."""
@@ -243,7 +252,7 @@ def log_ratio(before, after, out):
 
 @njit(cache=True)
 def step_ideal(
-    act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols,
+    act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
     x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
 ):
     """The period alone (no delivery): energy budget, forged input, plant, history, collection."""
@@ -261,7 +270,7 @@ def step_ideal(
         if hist.shape[1] > 0:
             _history_k(k, hist, act)
         if collect_at >= 0:
-            if not _quantize_k(k, x, delta, offset, limit, qx_buf):
+            if not _in_range_k(k, x, x_bound) or not _quantize_k(k, x, delta, offset, limit, qx_buf):
                 return STATE_OVERFLOW
             for i in range(n):
                 X[collect_at, k, i] = qx_buf[k, i] / delta
@@ -270,7 +279,7 @@ def step_ideal(
 
 @njit(cache=True)
 def step_fused(
-    act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols,
+    act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
     x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
     first, target, G, C, Q, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
     tmp, z, r, g,
@@ -301,7 +310,7 @@ def step_fused(
             _history_k(k, hist, act)
     if collect_at >= 0:
         for k in range(K):
-            if not _quantize_k(k, x, delta, offset, limit, qx_buf):
+            if not _in_range_k(k, x, x_bound) or not _quantize_k(k, x, delta, offset, limit, qx_buf):
                 return STATE_OVERFLOW
         for k in range(K):
             for i in range(n):

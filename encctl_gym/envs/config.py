@@ -143,11 +143,13 @@ class AttackParams:
 
     def observation_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Finite bounds of the observation: states within the encoder's declared range
-        ``x_bound`` (encoding beyond it raises), inputs within the actuator bound plus the
-        forged input's quantisation offset, flag and fractions within [0, 1]."""
+        ``x_bound`` (encoding beyond it raises) plus the encoder's largest shift to the group
+        (64/Delta), inputs within the actuator bound plus the forged input's quantisation,
+        flag and fractions within [0, 1]."""
         n, m, H = self.n, self.m, self.input_history
-        u_hi = self.u_max + (1.0 + n) / self.delta
-        high = np.concatenate([np.full(n, self.x_bound), np.full(m, u_hi), [1.0], np.ones(H * m), [1.0, 1.0]])
+        x_hi = self.x_bound + 65.0 / self.delta
+        u_hi = (self.u_max + 65.0 / self.delta) * (1.0 + 65.0 / self.delta) + n / self.delta**2
+        high = np.concatenate([np.full(n, x_hi), np.full(m, u_hi), [1.0], np.ones(H * m), [1.0, 1.0]])
         low = np.concatenate([-high[: n + m], [0.0], -np.ones(H * m), [0.0, 0.0]])
         return low.astype(np.float32), high.astype(np.float32)
 
