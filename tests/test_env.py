@@ -330,7 +330,7 @@ def test_errors_belong_to_the_hierarchy():
 def test_both_backends_refuse_a_state_outside_x_bound_at_the_same_step():
     from encctl_gym.errors import EncodingOverflowError
 
-    cfg = {**SMALL, "x_bound": 1.5, "key_length": 128, "max_samples": 40}
+    cfg = {**SMALL, "x_bound": 1.5, "sigma_x2": 0.01, "key_length": 128, "max_samples": 40}
     acts = np.ones((40, 2), dtype=np.float32)  # drives the state out of range
     steps = {}
     for crypto in ("ideal", "elgamal"):
