@@ -150,8 +150,7 @@ def test_train_quick_ppo_saves_loads_and_evaluates(tmp_path, capsys):
     _check_run(run_dir, "ppo", capsys)
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("algo", ["sac", "recurrent_ppo"])
+@pytest.mark.parametrize("algo", ["sac", "recurrent_ppo"])  # ~10 s each
 def test_train_quick_sac_and_recurrent_ppo(tmp_path, capsys, algo):
     rc = cli.main(["train", "--algo", algo, "--preset", "paper-example", "--quick", "--out", str(tmp_path), "--no-progress"])
     assert rc == 0
