@@ -21,7 +21,7 @@ from encctl_gym.errors import ParameterError
 
 from .base import Attacker
 
-__all__ = ["Rollout", "rollout", "env_config", "budget_config"]
+__all__ = ["Rollout", "rollout", "env_config", "budget_config", "elgamal_config"]
 
 
 def env_config(config: dict[str, Any] | None = None, **overrides: Any) -> dict[str, Any]:
@@ -66,6 +66,21 @@ def budget_config(config: dict[str, Any], N: int) -> dict[str, Any]:
     got = resolve_params(env_config(cfg)).horizon
     if got != N:  # pragma: no cover - guards the arithmetic above
         raise ParameterError(f"budget_config: expected a horizon of {N}, got {got}")
+    return cfg
+
+
+def elgamal_config(config: dict[str, Any], N: int, *, key_length: int = 64, crypto_seed: int | None = 0) -> dict[str, Any]:
+    """``config`` on the real ElGamal backend with a small key, for an attack of ``N`` samples.
+
+    The key length sets lambda (eq:opt_key read backwards), so the deciphering budget is set
+    again for ``N`` samples (:func:`budget_config`): the attack has the same length and the
+    observed budget fractions the same meaning as on the ideal backend. ``crypto_seed`` makes
+    the ciphertexts reproducible (unsafe for deployment; this is a simulation).
+    """
+    cfg = {k: v for k, v in config.items() if k not in ("security_parameter", "tau_c", "max_samples", "crypto", "crypto_seed")}
+    cfg["key_length"] = check_int("key_length", key_length, minimum=16)
+    cfg = budget_config(cfg, N)
+    cfg.update(crypto="elgamal", crypto_seed=crypto_seed)
     return cfg
 
 

@@ -351,7 +351,7 @@ def final_evaluation(run_dir: str | Path, *, seed: int = 10_000, progress: bool 
 
     run_dir = Path(run_dir)
     meta = json.loads((run_dir / "run.json").read_text())
-    from .evaluate import budget_config
+    from .evaluate import budget_config, elgamal_config
 
     ev = meta["config"]["eval"]
     env_cfg = dict(meta["env"])
@@ -378,12 +378,8 @@ def final_evaluation(run_dir: str | Path, *, seed: int = 10_000, progress: bool 
         out[which] = s
     el = ev.get("elgamal") or {}
     if el.get("episodes", 0) > 0:
-        # a small key for speed; the attack length and the budget fractions as in training
-        # (the key length sets lambda; budget_config keeps it and sets tau_c for the length)
-        el_cfg = {k: v for k, v in meta["env"].items() if k not in ("security_parameter", "tau_c", "max_samples")}
-        el_cfg["key_length"] = int(el.get("key_length", 64))
-        el_cfg = budget_config(el_cfg, int(el.get("max_samples", 40)))
-        el_cfg.update({"crypto": "elgamal", "crypto_seed": seed})
+        # a small key for speed; short attacks whose budget fractions mean what they meant in training
+        el_cfg = elgamal_config(meta["env"], int(el.get("max_samples", 40)), key_length=int(el.get("key_length", 64)), crypto_seed=seed)
         try:
             el_params = resolve_params(el_cfg)
             att = load_attacker(run_dir, which="final", params=el_params)

@@ -30,9 +30,12 @@ The security parameter that would have been needed against it is ``lam = floor(l
 tau_c / N_c)) + 1`` (Theorem thm:opt_sec, :func:`optimal_security_parameter`) and the key length
 ``k`` of eq:opt_key (:func:`minimum_key_length`), next to the paper's ``N*``, ``lam*`` and ``k*``.
 
+ElGamal. Every attacker also plays ``--elgamal-episodes`` short episodes (N = 40) through real
+ciphertexts with a 64-bit key, next to the same episode on the ideal backend (``elgamal.csv``).
+
 Outputs under ``--out`` (default ``results/compare``): ``curves.csv`` (tidy: system, delay,
 attacker, N, mean, standard error, 95 % band, gamma, gamma_opt), ``episodes.csv`` (final error
-and average power of every episode), ``security.csv``, one PNG per system, and ``summary.md``
+and average power of every episode), ``security.csv``, ``elgamal.csv``, one PNG per system, and ``summary.md``
 (the tables and the finding in words, with the command that reproduces it).
 
 Usage: ``encctl-gym compare [--quick] [--out DIR] [--seed S] [--episodes E] [--systems a,b]
@@ -47,7 +50,7 @@ import json
 import math
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -57,7 +60,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 import numpy as np
 
 from agents import Attacker, ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker, PRBSAttacker, rollout
-from agents.evaluate import budget_config
+from agents.evaluate import budget_config, elgamal_config
 from encctl_gym.envs.config import AttackParams, resolve_params
 from encctl_gym.errors import ParameterError
 from encctl_gym.security.attack_design import AttackDesign, gaussian_attack_design, optimal_attack_design
@@ -329,6 +332,24 @@ def _padded(episodes: int) -> int:
     return B * math.ceil(episodes / B)
 
 
+def elgamal_check(setting: Setting, attacker: Attacker, *, episodes: int, N: int, seed: int, key_length: int = 64) -> list[dict[str, Any]]:
+    """A few short episodes through real ElGamal ciphertexts (small key), each next to the same
+    episode on the ideal backend (same environment and attacker seeds): the attacker works
+    through real ciphertexts and the ideal backend computes the same arithmetic."""
+    rows = []
+    el_cfg = elgamal_config(setting.config, N, key_length=key_length, crypto_seed=seed)
+    ideal_cfg = {k: v for k, v in el_cfg.items() if k not in ("crypto", "crypto_seed")}
+    for e in range(episodes):
+        r_el = rollout(attacker, el_cfg, episodes=1, seed=seed + e, record=False)
+        r_id = rollout(attacker, ideal_cfg, episodes=1, seed=seed + e, record=False, batch=1)
+        rows.append({
+            "system": setting.system, "delay": setting.delay, "attacker": attacker.name, "episode": e, "N": N,
+            "key_length": resolve_params(el_cfg).key_length, "error_elgamal": float(r_el.final_epsilon[0]),
+            "error_ideal_same_seed": float(r_id.final_epsilon[0]), "seconds_elgamal": round(r_el.seconds, 3),
+        })
+    return rows
+
+
 @dataclass
 class Result:
     settings: list[Setting]
@@ -336,6 +357,7 @@ class Result:
     security: list[dict[str, Any]]
     bounds: list[dict[str, Any]]
     seconds: float
+    elgamal: list[dict[str, Any]] = field(default_factory=list)
 
 
 def compute(
@@ -348,6 +370,8 @@ def compute(
     points: int = 10,
     runs: Sequence[Path] = (),
     which: str = "best",
+    elgamal_episodes: int = 1,
+    elgamal_N: int = 40,
     progress: bool = False,
 ) -> Result:
     """Run the experiment; every number of the tables and plots comes from here."""
@@ -364,6 +388,7 @@ def compute(
     curves: dict[tuple[str, Any], list[Curve]] = {}
     security: list[dict[str, Any]] = []
     bounds: list[dict[str, Any]] = []
+    elgamal: list[dict[str, Any]] = []
     try:
         for setting, atts in plan:
             key = (setting.system, setting.delay)
@@ -374,11 +399,13 @@ def compute(
                 c = evaluate(setting, att, episodes=episodes, seed=seed, points=points, progress=bar)
                 curves[key].append(c)
                 security.append(security_row(setting, c))
+                if elgamal_episodes > 0:
+                    elgamal.extend(elgamal_check(setting, att, episodes=elgamal_episodes, N=elgamal_N, seed=seed))
             bounds.extend(bound_rows(setting))
     finally:
         if bar is not None:
             bar.close()
-    return Result(settings, curves, security, bounds, time.perf_counter() - t0)
+    return Result(settings, curves, security, bounds, time.perf_counter() - t0, elgamal)
 
 
 # --------------------------------------------------------------------------- outputs
@@ -424,6 +451,14 @@ def write_csvs(result: Result, out: Path) -> list[Path]:
         for row in result.security + result.bounds:
             w.writerow(_fmt(row.get(k, "")) for k in SECURITY_COLUMNS)
     paths.append(out / "security.csv")
+    if result.elgamal:
+        cols = list(result.elgamal[0])
+        with (out / "elgamal.csv").open("w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(cols)
+            for row in result.elgamal:
+                w.writerow(_fmt(row[k]) for k in cols)
+        paths.append(out / "elgamal.csv")
     return paths
 
 
@@ -510,6 +545,12 @@ def summary_markdown(result: Result, *, command: str, plots: Sequence[Path]) -> 
                      f"{r['N_to_gamma_c']} | {r['lambda_needed']} | {r['k_needed']} |")
     lines.append("")
     lines.append("N marked * is an evaluation cap (the tau_c budget allows more). " + findings(result))
+    if result.elgamal:
+        same = sum(abs(r["error_elgamal"] - r["error_ideal_same_seed"]) <= 1e-9 * r["error_ideal_same_seed"] for r in result.elgamal)
+        lines.append("")
+        lines.append(f"Through real ElGamal ciphertexts ({result.elgamal[0]['key_length']}-bit key, N = {result.elgamal[0]['N']}): "
+                     f"{len(result.elgamal)} episodes of every attacker; {same} of them give the same final error as the ideal "
+                     "backend on the same seeds (elgamal.csv).")
     return "\n".join(lines) + "\n"
 
 
@@ -554,6 +595,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "default results/train if it exists)")
     parser.add_argument("--which", choices=("best", "final"), default="best",
                         help="learned model: the best of the training's evaluation callback (default) or the final one")
+    parser.add_argument("--elgamal-episodes", type=int, default=1,
+                        help="episodes of each attacker through real ElGamal ciphertexts (64-bit key, N = 40; default 1, 0: none)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
@@ -575,7 +618,8 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     result = compute(systems, delays=delays, episodes=episodes, seed=args.seed, cap=cap, points=points, runs=runs,
-                     which=args.which, progress=not args.no_progress)
+                     which=args.which, elgamal_episodes=args.elgamal_episodes, elgamal_N=min(40, cap),
+                     progress=not args.no_progress)
     files = write_csvs(result, out)
     plots = plot(result, out)
     cmd = ["encctl-gym compare", f"--seed {args.seed}", f"--episodes {episodes}", f"--systems {','.join(systems)}",
