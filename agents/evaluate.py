@@ -97,6 +97,9 @@ class Rollout:
     epsilon : ndarray (E, T)
         ``info["epsilon"]`` after each step (the error of the current estimate, Definition
         def:error; with ``decipher_delay="end"`` it changes only at the last step).
+    energy : ndarray (E, T)
+        ``info["input_energy"]`` after each step: the input energy spent so far (the budget is
+        ``m sigma_u2 N`` for the whole attack, so an attacker may spend it unevenly).
     final_epsilon, average_power, input_energy : ndarray (E,)
         At the end of each episode.
     gamma : ndarray (T,)
@@ -108,6 +111,7 @@ class Rollout:
     attacker: str
     N: np.ndarray
     epsilon: np.ndarray
+    energy: np.ndarray
     final_epsilon: np.ndarray
     average_power: np.ndarray
     input_energy: np.ndarray
@@ -171,7 +175,7 @@ def rollout(
     if (params.n, params.m, params.input_history) != (attacker.params.n, attacker.params.m, attacker.params.input_history):
         raise ParameterError("the attacker was built for a different observation layout than this environment")
     t0 = time.perf_counter()
-    eps_rows, finals, powers, energies = [], [], [], []
+    eps_rows, en_rows, finals, powers, energies = [], [], [], [], []
     N_steps: np.ndarray | None = None
     if params.crypto == "ideal":
         B = min(episodes, 64) if batch is None else check_int("batch", batch, minimum=1)
@@ -181,11 +185,12 @@ def rollout(
         while done_eps < episodes:
             obs, info = env.reset(seed=seed + done_eps)
             attacker.reset(seed=np.random.SeedSequence([seed, chunk]))
-            eps_t, Ns = [], []
+            eps_t, en_t, Ns = [], [], []
             while True:
                 obs, _, te, tr, info = env.step(attacker.act(obs))
                 if record:
                     eps_t.append(info["epsilon"])
+                    en_t.append(info["input_energy"])
                     Ns.append(int(info["samples_delivered"][0]))
                 if progress is not None:
                     progress.update(B)
@@ -193,6 +198,7 @@ def rollout(
                     break
             take = min(B, episodes - done_eps)
             eps_rows.append(np.stack(eps_t, axis=1)[:take] if record else info["epsilon"][:take, None])
+            en_rows.append(np.stack(en_t, axis=1)[:take] if record else info["input_energy"][:take, None])
             if N_steps is None:
                 N_steps = np.array(Ns if record else [int(info["samples_delivered"][0])])
             finals.append(info["epsilon"][:take])
@@ -205,17 +211,19 @@ def rollout(
         for e in range(episodes):
             obs, info = env1.reset(seed=seed + e)
             attacker.reset(seed=np.random.SeedSequence([seed, e]))
-            eps_t, Ns = [], []
+            eps_t, en_t, Ns = [], [], []
             while True:
                 obs, _, te, tr, info = env1.step(attacker.act(obs))
                 if record:
                     eps_t.append(info["epsilon"])
+                    en_t.append(info["input_energy"])
                     Ns.append(info["samples_delivered"])
                 if progress is not None:
                     progress.update(1)
                 if te or tr:
                     break
             eps_rows.append(np.array(eps_t if record else [info["epsilon"]])[None])
+            en_rows.append(np.array(en_t if record else [info["input_energy"]])[None])
             if N_steps is None:
                 N_steps = np.array(Ns if record else [info["samples_delivered"]])
             finals.append(np.array([info["epsilon"]]))
@@ -229,6 +237,7 @@ def rollout(
         attacker=attacker.name,
         N=N_steps,
         epsilon=np.concatenate(eps_rows, axis=0),
+        energy=np.concatenate(en_rows, axis=0),
         final_epsilon=np.concatenate(finals),
         average_power=np.concatenate(powers),
         input_energy=np.concatenate(energies),

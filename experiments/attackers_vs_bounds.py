@@ -14,13 +14,17 @@ environment seeds and the same energy budget ``m sigma_u2 N``:
   the best model of the training's evaluation callback (selected on its own episodes, so the
   comparison here, on other seeds, is not biased by the selection).
 
-Error against N. With delay 0, ``info["epsilon"]`` after each step is the error of the
-attacker's current estimate, so one episode gives the whole curve. With "end" nothing is
-delivered before the end, so the curve is measured on a log grid of attack lengths (one set of
-episodes per grid point). Attack lengths below the tau_c budget (the evaluation cap
-``--max-samples`` and the grid) are set by a shorter defense period at the same lambda
-(:func:`agents.evaluate.budget_config`), so the budget fractions an attacker observes keep their
-meaning; the security table uses the preset's own tau_c.
+Error against N, at equal energy. The environment's energy budget ``m sigma_u2 N`` holds for
+the whole attack, not per step, so the error of the running estimate within one long attack
+(``info["epsilon"]`` along the way) compares attackers at *unequal* energy whenever one of them
+paces its energy unevenly (a learned policy may spend it early and beat gamma(N) at small N for
+that reason alone). The curves are therefore measured on a log grid of attack lengths, one set
+of episodes of exactly N samples (budget ``m sigma_u2 N``) per grid point. With delay 0 the
+running error and the energy spent along one full-length attack are also recorded
+(``protocol = along`` in ``curves.csv`` and ``pacing_<system>.png``). Attack lengths below the
+tau_c budget (the grid and the evaluation cap ``--max-samples``) are set by a shorter defense
+period at the same lambda (:func:`agents.evaluate.budget_config`), so the budget fractions an
+attacker observes keep their meaning; the security table uses the preset's own tau_c.
 
 Security consequence. For each attacker the sample size it needs to reach ``gamma_c`` is read
 from its mean curve when it gets there within the horizon, else extrapolated from a fit
@@ -81,6 +85,7 @@ __all__ = [
     "samples_to_reach",
     "security_row",
     "find_runs",
+    "length_grid",
     "compute",
     "plot",
     "add_arguments",
@@ -129,6 +134,11 @@ class Curve:
     final: np.ndarray  # (E,) error at the horizon
     power: np.ndarray  # (E,) average power
     seconds: float
+    # delay 0 only: the running estimate within one full-length attack, and the energy spent
+    along_N: np.ndarray | None = None
+    along_mean: np.ndarray | None = None
+    along_se: np.ndarray | None = None
+    along_energy: np.ndarray | None = None  # mean fraction of the episode's energy budget spent
 
 
 def _stats(eps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -289,41 +299,52 @@ def make_setting(system: str, delay: Any, cap: int | None) -> Setting:
     return Setting(system, delay, cfg, p, base, design, gauss, capped)
 
 
-def end_grid(params: AttackParams, points: int) -> np.ndarray:
-    """Attack lengths for the blind setting: log grid from ``2 (n + m) + 1`` to the horizon."""
+def length_grid(params: AttackParams, points: int) -> np.ndarray:
+    """Attack lengths of the curves: log grid from ``2 (n + m) + 1`` to the horizon."""
     return log_grid(min(2 * (params.n + params.m) + 1, params.horizon), params.horizon, points)
 
 
 def evaluate(setting: Setting, attacker: Attacker, *, episodes: int, seed: int, points: int, progress: Any = None) -> Curve:
-    """The mean error curve of one attacker in one setting (see the module docstring)."""
-    if setting.delay == "end":
-        grid = end_grid(setting.params, points)
-        cols, t = [], 0.0
-        final = power = None
-        for N in grid:
-            cfg = budget_config(setting.config, int(N))
-            r = rollout(attacker, cfg, episodes=episodes, seed=seed, record=False, progress=progress)
-            cols.append(r.final_epsilon)
-            final, power, t = r.final_epsilon, r.average_power, t + r.seconds
-        eps = np.stack(cols, axis=1)
-        mean, se = _stats(eps)
-        assert final is not None and power is not None
-        return Curve(attacker.name, attacker.oracle, grid, mean, se, episodes, final, power, t)
-    r = rollout(attacker, setting.config, episodes=episodes, seed=seed, record=True, progress=progress)
-    d = setting.params.n + setting.params.m
-    first = int(np.argmax(r.N >= min(2 * d + 1, int(r.N[-1]))))  # well past the first identifiable N = d + 1
-    grid = log_grid(int(r.N[first]), int(r.N[-1]), 60)
-    idx = np.searchsorted(r.N, grid)
-    mean, se = _stats(r.epsilon[:, idx])
-    return Curve(attacker.name, attacker.oracle, r.N[idx], mean, se, r.episodes, r.final_epsilon, r.average_power, r.seconds)
+    """The mean error curve of one attacker in one setting (see the module docstring).
+
+    Main curve ("fresh"): for every N of :func:`length_grid`, ``episodes`` attacks of exactly
+    N samples with the energy budget ``m sigma_u2 N``, so every point compares attackers at
+    equal energy. With delay 0 also the error of the running estimate within one full-length
+    attack ("along", with the energy spent so far), which shows how an attacker paces its
+    energy.
+    """
+    grid = length_grid(setting.params, points)
+    cols, t = [], 0.0
+    along = None
+    if setting.delay != "end":
+        along = rollout(attacker, setting.config, episodes=episodes, seed=seed, record=True, progress=progress)
+    final = power = None
+    for N in grid:
+        if along is not None and N == setting.params.horizon:
+            r = along  # the same attack, same seeds
+        else:
+            r = rollout(attacker, budget_config(setting.config, int(N)), episodes=episodes, seed=seed, record=False, progress=progress)
+            t += r.seconds
+        cols.append(r.final_epsilon)
+        final, power = r.final_epsilon, r.average_power
+    mean, se = _stats(np.stack(cols, axis=1))
+    assert final is not None and power is not None
+    c = Curve(attacker.name, attacker.oracle, grid, mean, se, episodes, final, power, t)
+    if along is not None:
+        d = setting.params.n + setting.params.m
+        first = int(np.argmax(along.N >= min(2 * d + 1, int(along.N[-1]))))
+        g = log_grid(int(along.N[first]), int(along.N[-1]), 60)
+        idx = np.searchsorted(along.N, g)
+        c.along_N = along.N[idx]
+        c.along_mean, c.along_se = _stats(along.epsilon[:, idx])
+        c.along_energy = along.energy[:, idx].mean(axis=0) / setting.params.energy_budget
+        c.seconds += along.seconds
+    return c
 
 
 def planned_steps(setting: Setting, n_attackers: int, episodes: int, points: int) -> int:
     """Environment steps of one setting (for the progress bar)."""
-    if setting.delay == "end":
-        per = int(end_grid(setting.params, points).sum())
-    else:
-        per = setting.params.horizon
+    per = int(length_grid(setting.params, points).sum())
     return n_attackers * per * _padded(episodes)
 
 
@@ -409,8 +430,8 @@ def compute(
 
 
 # --------------------------------------------------------------------------- outputs
-CURVE_COLUMNS = ("system", "delay", "attacker", "oracle", "N", "mean_error", "se", "ci95_low", "ci95_high", "episodes",
-                 "gamma", "gamma_opt", "gaussian_design")
+CURVE_COLUMNS = ("system", "delay", "attacker", "oracle", "protocol", "N", "mean_error", "se", "ci95_low", "ci95_high",
+                 "episodes", "gamma", "gamma_opt", "gaussian_design", "energy_fraction")
 SECURITY_COLUMNS = ("system", "delay", "attacker", "oracle", "episodes", "horizon", "capped", "mean_error_at_horizon",
                     "se_error_at_horizon", "gamma_at_horizon", "gamma_opt_at_horizon", "average_power", "sigma_u2", "rate_c",
                     "rate_over_gaussian_design", "gamma_c", "N_to_gamma_c", "N_how", "lambda_needed", "k_needed")
@@ -432,10 +453,14 @@ def write_csvs(result: Result, out: Path) -> list[Path]:
         for key, cs in result.curves.items():
             s = by_key[key]
             for c in cs:
-                for N, m, se in zip(c.N, c.mean, c.se):
-                    w.writerow(_fmt(v) for v in (s.system, s.delay, c.attacker, c.oracle, int(N), m, se, m - 1.96 * se,
-                                                 m + 1.96 * se, c.episodes, s.params.gamma(int(N)), s.design.gamma(int(N)),
-                                                 s.gauss.gamma(int(N))))
+                parts = [("fresh", c.N, c.mean, c.se, np.full(c.N.shape, np.nan))]
+                if c.along_N is not None:
+                    parts.append(("along", c.along_N, c.along_mean, c.along_se, c.along_energy))
+                for protocol, Ns, means, ses, efrac in parts:
+                    for N, m, se, ef in zip(Ns, means, ses, efrac):
+                        w.writerow(_fmt(v) for v in (s.system, s.delay, c.attacker, c.oracle, protocol, int(N), m, se,
+                                                     m - 1.96 * se, m + 1.96 * se, c.episodes, s.params.gamma(int(N)),
+                                                     s.design.gamma(int(N)), s.gauss.gamma(int(N)), ef))
     paths.append(out / "curves.csv")
     with (out / "episodes.csv").open("w", newline="") as fh:
         w = csv.writer(fh)
@@ -487,10 +512,10 @@ def plot(result: Result, out: Path) -> list[Path]:
             for c in result.curves[(s.system, s.delay)]:
                 pw = c.power.mean()
                 lab = f"{c.attacker}{' (oracle)' if c.oracle else ''}, power {pw:.3g}"
-                top.plot(c.N, c.mean, color=color[c.attacker], lw=1.4, label=lab)
+                top.plot(c.N, c.mean, color=color[c.attacker], lw=1.4, marker="o", ms=2.5, label=lab)
                 top.fill_between(c.N, np.maximum(c.mean - 1.96 * c.se, 0.05 * c.mean), c.mean + 1.96 * c.se, color=color[c.attacker], alpha=0.2, lw=0)
                 y = (c.N - 1) * c.mean
-                bot.plot(c.N, y, color=color[c.attacker], lw=1.4, marker="o" if s.delay == "end" else None, ms=3)
+                bot.plot(c.N, y, color=color[c.attacker], lw=1.4, marker="o", ms=3)
                 bot.fill_between(c.N, (c.N - 1) * (c.mean - 1.96 * c.se), (c.N - 1) * (c.mean + 1.96 * c.se), color=color[c.attacker], alpha=0.2, lw=0)
             for ax, f in ((top, lambda N: N * 0 + 1), (bot, lambda N: N - 1)):
                 ax.plot(Nline, s.params.gamma(Nline) * f(Nline), "k--", lw=1.2, label="gamma(N), eq:sic (paper)")
@@ -515,13 +540,42 @@ def plot(result: Result, out: Path) -> list[Path]:
             ref = [s.params.gamma(int(Nline[-1])) * (Nline[-1] - 1), s.design.rate, s.gauss.rate]
             bot.set_ylim(0.85 * min([lo, *ref]), 1.15 * max([hi, *ref]))
         fig.suptitle(f"Attackers against the sample identifying complexity: {system} "
-                     f"({result.curves[(sets[0].system, sets[0].delay)][0].episodes} episodes per attacker, same seeds, equal energy)", fontsize=11)
+                     f"({result.curves[(sets[0].system, sets[0].delay)][0].episodes} episodes per attacker and N, same seeds, "
+                     "energy budget m sigma_u2 N at every N)", fontsize=11)
         fig.tight_layout()
         path = out / f"compare_{system}.png"
         fig.savefig(path, dpi=110)
         plt.close(fig)
         paths.append(path)
+        along = [(s, c) for s in sets for c in result.curves[(s.system, s.delay)] if c.along_N is not None]
+        if along:
+            paths.append(_plot_pacing(plt, system, along, color, out))
     return paths
+
+
+def _plot_pacing(plt: Any, system: str, along: list[tuple[Setting, Curve]], color: dict[str, str], out: Path) -> Path:
+    """Delay 0: the running error within one full-length attack and the energy spent so far."""
+    s0 = along[0][0]
+    fig, (top, bot) = plt.subplots(2, 1, figsize=(7.0, 7.5), sharex=True)
+    for s, c in along:
+        top.plot(c.along_N, c.along_mean, color=color[c.attacker], lw=1.3, label=c.attacker)
+        bot.plot(c.along_N, c.along_energy, color=color[c.attacker], lw=1.3)
+    Nl = np.asarray(along[0][1].along_N)
+    top.plot(Nl, s0.params.gamma(Nl), "k--", lw=1.1, label="gamma(N), eq:sic")
+    top.plot(Nl, s0.design.gamma(Nl), "k:", lw=1.5, label="gamma_opt(N)")
+    bot.plot(Nl, Nl / s0.params.horizon, "k-", lw=0.8, alpha=0.6, label="uniform pacing")
+    top.set(xscale="log", yscale="log", ylabel="mean error of the running estimate",
+            title=f"{system}, delay 0: within one attack of N = {s0.params.horizon} (budget for the whole attack)")
+    bot.set(xscale="log", xlabel="samples so far", ylabel="fraction of the energy budget spent")
+    top.legend(fontsize=7)
+    bot.legend(fontsize=7)
+    for ax in (top, bot):
+        ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    path = out / f"pacing_{system}.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
 
 
 def summary_markdown(result: Result, *, command: str, plots: Sequence[Path]) -> str:

@@ -84,9 +84,10 @@ def _rows(path: Path) -> list[dict[str, str]]:
 
 
 def test_compare_quick_writes_png_csv_and_summary(quick_run):
-    png = quick_run / "compare_paper-example.png"
-    assert png.exists() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    for name in ("curves.csv", "episodes.csv", "security.csv", "summary.md"):
+    for name in ("compare_paper-example.png", "pacing_paper-example.png"):
+        png = quick_run / name
+        assert png.exists() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    for name in ("curves.csv", "episodes.csv", "security.csv", "elgamal.csv", "summary.md"):
         assert (quick_run / name).stat().st_size > 0
     md = (quick_run / "summary.md").read_text()
     assert "compare_paper-example.png" in md and "--seed 3" in md and "--quick" in md
@@ -95,7 +96,11 @@ def test_compare_quick_writes_png_csv_and_summary(quick_run):
 def test_compare_quick_covers_every_attacker_in_both_settings(quick_run):
     curves = _rows(quick_run / "curves.csv")
     assert list(curves[0]) == list(avb.CURVE_COLUMNS)
-    seen = {(r["delay"], r["attacker"]) for r in curves}
+    seen = {(r["delay"], r["attacker"]) for r in curves if r["protocol"] == "fresh"}
+    assert {(r["delay"], r["protocol"]) for r in curves} == {("0", "fresh"), ("0", "along"), ("end", "fresh")}
+    for r in curves:
+        if r["protocol"] == "along":
+            assert 0.0 <= float(r["energy_fraction"]) <= 1.0 + 1e-9
     base = {"gaussian", "prbs", "colored(rho=0.5)"}
     assert {a for d, a in seen if d == "0"} == base | {"optimal-cl", "ppo", "recurrent_ppo-blind"}
     # a policy that reads states is not run blind; the blind one is
@@ -121,3 +126,10 @@ def test_compare_quick_security_table(quick_run):
         assert int(r["lambda_needed"]) == optimal_security_parameter(N_c, tau_c=31536e4, upsilon=442e15)
     paper = [r for r in sec if r["attacker"] == "paper gamma (eq:sic2)"]
     assert paper and all((r["N_to_gamma_c"], r["lambda_needed"], r["k_needed"]) == ("13159", "74", "712") for r in paper)
+
+
+def test_compare_quick_elgamal_episodes_match_the_ideal_backend(quick_run):
+    rows = _rows(quick_run / "elgamal.csv")
+    assert len(rows) == 6 + 5 and all(int(r["key_length"]) <= 64 for r in rows)
+    for r in rows:
+        assert float(r["error_elgamal"]) == pytest.approx(float(r["error_ideal_same_seed"]), rel=1e-9)
