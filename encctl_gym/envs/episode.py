@@ -1,11 +1,12 @@
 """The attack episode, batched over K independent copies.
 
 One implementation serves both :class:`~encctl_gym.envs.EncryptedLTIAttackEnv` (K = 1) and the
-native vector environment (K copies stepped at once in numpy), so the two have the same
-semantics by construction. All copies share the horizon and the delivery schedule, so they run
-in lockstep: time indices are plain integers, only the data differ. Every array operation is
-row-wise (elementwise products and sums over the last axis, batched LAPACK solves), so copy
-``i`` of a batch computes bit for bit what a single environment seeded the same way computes.
+native vector environment (K copies stepped at once), so the two have the same semantics by
+construction. All copies share the horizon and the delivery schedule, so they run in lockstep:
+time indices are plain integers, only the data differ. The per-step arithmetic is in the
+compiled kernels of :mod:`encctl_gym.envs._kernels`, written per copy, so copy ``i`` of a
+batch computes bit for bit what a single environment seeded the same way computes; the rare
+exact re-solves (batched LAPACK) are per matrix too.
 
 Per sampling period ``k`` of the attack (Definition def:adversary):
 
@@ -13,7 +14,8 @@ Per sampling period ``k`` of the attack (Definition def:adversary):
    seconds, Definition def:sdt, when the scheme gives every sample its own key);
 2. samples whose delay has passed are delivered: state ``x_j`` with the input ``u_{j-1}``;
    each delivered state adds the regression column ``([x_{j-1}; u_{j-1}], x_j)`` of eq:data
-   to the running Gram matrices, and the least squares estimate (eq:estimate) is re-solved;
+   to recursive least squares (Sherman-Morrison), which is re-anchored to the exact solve of
+   eq:estimate from the running Gram matrices every ``_REFRESH`` columns and at the end;
 3. the agent acts; its input is held to the energy budget, forged into the input ciphertext,
    decrypted by the plant (``u_k``) and applied: ``x_{k+1} = A x_k + B u_k + w_k``.
 """
@@ -118,7 +120,6 @@ class EpisodeCore:
         self._reward = np.zeros(K)
         self._scratch = (np.empty((K, n)), np.empty((K, n + m)), np.empty((K, 2 * n + m)), np.empty((K, n + m)))
         self._obs_valid = False
-        self._step_fused = kern.step_fused  # one compiled call per steady-state step
         self._u_max = p.u_max
         self._budget = p.energy_budget
         self._logdet = p.reward == "logdet"
@@ -303,7 +304,7 @@ class EpisodeCore:
             target = self._target(self.collected + 1)
             if self._since_refresh + target - first < _REFRESH:
                 new = target > self.delivered
-                status = self._step_fused(
+                status = kern.step_fused(
                     act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
                     self.X, self.U, self.collected - 1, self.collected, self.hist,
                     self._a, self._qa, self._qx,
