@@ -48,7 +48,11 @@ class EncryptedLTIAttackEnv(gym.Env):
     **energy budget**: over the episode ``sum_t ||a_t||^2 <= m sigma_u2 N`` (average power
     ``sigma_u2`` per channel, as in Theorem thm:sic). An input that would overdraw the remaining
     energy is scaled down to exhaust it exactly; afterwards inputs are zero. Every attacker is
-    thus held to the same input energy. Actions outside the box (beyond float32 rounding) or
+    thus held to the same input energy over the attack. The budget covers the whole attack, so
+    an attacker may front-load its energy: ``info["epsilon"]`` part-way through one attack
+    compares attackers at unequal energy; to compare them at a sample size N, run attacks of
+    length N (``agents.evaluate.budget_config``), as ``encctl-gym compare`` does. The energy
+    used is ``info["input_energy"]``. Actions outside the box (beyond float32 rounding) or
     NaN raise :class:`~encctl_gym.errors.ParameterError`.
 
     | index | meaning                    | range   |
