@@ -5,7 +5,7 @@ Prints:
 1. the single environment's steps per second (ideal backend, through ``gymnasium.make``)
    against gymnasium's ``Pendulum-v1`` under the same wrappers (target: ratio >= 1);
 2. the native vector environment's environment-steps per second at 1024 copies against the
-   single environment's (target: >= 50x);
+   single environment's (target: >= 50x), on one core and with ``parallel=True`` (all cores);
 3. the ElGamal backend's time per step at 712 bits against the crypto floor: the time of one
    ``gmpy2.powmod`` with a full-size exponent at that size, measured in the same run.
 
@@ -43,8 +43,8 @@ def steps_per_second(env: gym.Env, actions: np.ndarray, repeats: int) -> float:
     return best
 
 
-def vector_steps_per_second(num_envs: int, steps: int, repeats: int) -> float:
-    venv = EncryptedLTIAttackVectorEnv(num_envs=num_envs, config=CONFIG)
+def vector_steps_per_second(num_envs: int, steps: int, repeats: int, parallel: bool = False) -> float:
+    venv = EncryptedLTIAttackVectorEnv(num_envs=num_envs, config=CONFIG, parallel=parallel)
     rng = np.random.default_rng(0)
     acts = np.clip(rng.normal(0, 0.25, (steps, num_envs, venv.params.m)), -1, 1).astype(np.float32)
     best = 0.0
@@ -100,8 +100,11 @@ def main(argv: list[str] | None = None) -> int:
     print(f"ratio ours / Pendulum               : {our_sps / pend_sps:12.2f}   (target >= 1)")
 
     vec_sps = vector_steps_per_second(1024, n_vec, repeats)
-    print(f"vector env, 1024 copies             : {vec_sps:12,.0f} env-steps/s")
+    print(f"vector env, 1024 copies (1 core)    : {vec_sps:12,.0f} env-steps/s")
     print(f"ratio vector / single               : {vec_sps / our_sps:12.1f}   (target >= 50)")
+    par_sps = vector_steps_per_second(1024, n_vec, repeats, parallel=True)
+    print(f"vector env, 1024 copies, parallel   : {par_sps:12,.0f} env-steps/s  (all cores)")
+    print(f"ratio parallel vector / single      : {par_sps / our_sps:12.1f}")
 
     floor = powmod_seconds(712)
     per_step = elgamal_seconds_per_step(5 if args.quick else 30)

@@ -341,3 +341,17 @@ def test_both_backends_refuse_a_state_outside_x_bound_at_the_same_step():
                 steps[crypto] = k
                 env.step(a)
     assert steps["ideal"] == steps["elgamal"]
+
+
+def test_parallel_vector_env_gives_the_same_numbers():
+    K = 16
+    serial = EncryptedLTIAttackVectorEnv(num_envs=K, config=SMALL)
+    parallel = EncryptedLTIAttackVectorEnv(num_envs=K, config=SMALL, parallel=True)
+    o1, _ = serial.reset(seed=5)
+    o2, _ = parallel.reset(seed=5)
+    rng = np.random.default_rng(2)
+    for _ in range(serial.params.horizon + 2):
+        acts = random_actions(rng, K, serial.params.m)
+        a = serial.step(acts)
+        b = parallel.step(acts)
+        assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1]) and np.array_equal(a[2], b[2])

@@ -471,6 +471,7 @@ class PlantCryptoSide:
             rows = _ct_matrix("server output", out, ModifiedCiphertext, shape)
             s0, st, t = self._sk0.s, self._sk.s, self._sk.t
             col: dict[int, Any] = {}
+            other: dict[int, Any] = {}  # c1 parts of ciphertexts that are not Phi's (e.g. injected)
             res = []
             for row in rows:
                 lifted = []
@@ -487,10 +488,12 @@ class PlantCryptoSide:
                     # c1 and c2 are checked for membership when first seen (the cached
                     # c1 of Phi's ciphertexts were made by the plant itself).
                     a = self._mask0.get(c.c1)
+                    if a is None:
+                        a = other.get(c.c1)
                     if a is None:  # not one of Phi's ciphertexts (e.g. an injected one)
                         if not grp.contains(c.c1):
                             check_modified_ciphertext(grp, c)  # raises, naming c1
-                        a = arith.powmod(c.c1, q - s0, p)
+                        a = other[c.c1] = arith.powmod(c.c1, q - s0, p)
                     b = col.get(c.c2)
                     if b is None:
                         if not grp.contains(c.c2):
@@ -502,6 +505,7 @@ class PlantCryptoSide:
             return res
         rows = _ct_matrix("server output", out, Ciphertext, shape)
         st, t = self._sk.s, self._sk.t
+        masks: dict[int, Any] = {}  # c1^(-s_t) per distinct c1
         res = []
         for row in rows:
             lifted = []
@@ -511,7 +515,10 @@ class PlantCryptoSide:
                     raise KeyMismatchError(
                         f"output ciphertext is of step t = {c.t}, the plant's key of step t = {t}"
                     )
-                m = int(arith.mulmod(arith.powmod(c.c1, q - st, p), c.c2, p))
+                a = masks.get(c.c1)
+                if a is None:
+                    a = masks[c.c1] = arith.powmod(c.c1, q - st, p)
+                m = int(arith.mulmod(a, c.c2, p))
                 lifted.append(lift(grp, m))
             res.append(lifted)
         return res
@@ -775,21 +782,16 @@ def forge_injection(
     plain = _injection_plaintexts(a, encoder, n_cols)
     src = arith.as_random_source(rng)
     p, q, g = grp.p, grp.q, grp.g
-    out: ModMatrix = []
-    for row in plain:
-        cts = []
-        for m in row:
-            r, r2 = src.between(1, q), src.between(1, q)
-            c3 = arith.mulmod(
-                arith.mulmod(m, arith.powmod(pk_0.h, r, p), p), arith.powmod(pk_t.h, r2, p), p
-            )
-            cts.append(
-                ModifiedCiphertext(
-                    int(arith.powmod(g, r, p)), int(arith.powmod(g, r2, p)), int(c3), pk_0.t, pk_t.t
-                )
-            )
-        out.append(cts)
-    return out
+    # One pair (r, r') for the whole matrix: 4 exponentiations per forgery. Every entry is still
+    # a valid ciphertext of its plaintext; how an attacker randomises its own forgeries does not
+    # change what the plant decodes.
+    r, r2 = src.between(1, q), src.between(1, q)
+    c1, c2 = int(arith.powmod(g, r, p)), int(arith.powmod(g, r2, p))
+    mask = arith.mulmod(arith.powmod(pk_0.h, r, p), arith.powmod(pk_t.h, r2, p), p)
+    return [
+        [ModifiedCiphertext(c1, c2, int(arith.mulmod(m, mask, p)), pk_0.t, pk_t.t) for m in row]
+        for row in plain
+    ]
 
 
 def forge_injection_token(
@@ -811,4 +813,8 @@ def forge_injection_token(
         raise KeyMismatchError("the encoder's group differs from the public key's group")
     plain = _injection_plaintexts(a, encoder, n_cols)
     src = arith.as_random_source(rng)
-    return [[encrypt(pk_t, m, src) for m in row] for row in plain]
+    grp = pk_t.group
+    p = grp.p
+    r = src.between(1, grp.q)  # one r for the matrix (see forge_injection): 2 exponentiations
+    c1, mask = int(arith.powmod(grp.g, r, p)), arith.powmod(pk_t.h, r, p)
+    return [[Ciphertext(c1, int(arith.mulmod(m, mask, p)), pk_t.t) for m in row] for row in plain]

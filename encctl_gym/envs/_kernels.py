@@ -19,7 +19,7 @@ period are contiguous; ``G`` (K, d, d), ``C`` (K, d, n) and ``Q = [P | Theta_hat
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 # status codes
 OK = 0
@@ -327,3 +327,45 @@ def step_fused(
     for k in range(K):
         _observation_k(k, obs, X, U, j_obs, new, hist, time_frac, energy, budget)
     return OK
+
+
+@njit(cache=True, parallel=True)
+def step_fused_parallel(
+    act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
+    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
+    first, target, G, C, Q, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
+    tmp, z, r, g,
+):
+    """:func:`step_fused` with the copies spread over the cores (``prange``).
+
+    Each copy goes through the same stages in the same order as in :func:`step_fused` (stages
+    of different copies do not interact), so the numbers are identical.
+    """
+    K, m = act.shape
+    n = x.shape[1]
+    dd = delta * delta
+    status = np.zeros(K, dtype=np.int64)
+    for k in prange(K):
+        _energy_k(k, act, u_max, energy, budget, a_buf)
+        _quantize_k(k, a_buf, delta, offset, limit, q_buf)
+        for j in range(m):
+            a_buf[k, j] = (q_buf[k, j] * one + (n_cols - 1) * zero2) / dd
+            U[u_at, k, j] = a_buf[k, j]
+        _plant_k(k, x, a_buf, w, A, B, tmp)
+        if hist.shape[1] > 0:
+            _history_k(k, hist, act)
+        if collect_at >= 0:
+            if not _in_range_k(k, x, x_bound) or not _quantize_k(k, x, delta, offset, limit, qx_buf):
+                status[k] = STATE_OVERFLOW
+                continue
+            for i in range(n):
+                X[collect_at, k, i] = qx_buf[k, i] / delta
+        if target > first:
+            before = eps[k]
+            _columns_k(k, X, U, first, target, G, C, Q, False, True, z, r, g)
+            eps[k] = _error_k(k, Q, theta_true_T, c)
+            reward[k] = np.log(before / eps[k])
+        else:
+            reward[k] = 0.0
+        _observation_k(k, obs, X, U, j_obs, new, hist, time_frac, energy, budget)
+    return status.max()

@@ -63,9 +63,13 @@ class EpisodeCore:
         Source of ``gamma_opt`` in the info.
     num_envs : int
         K.
+    parallel : bool
+        Spread the copies of a steady-state step over the cores (same numbers).
     """
 
-    def __init__(self, params: AttackParams, loop: Any, design: Any = None, num_envs: int = 1) -> None:
+    def __init__(
+        self, params: AttackParams, loop: Any, design: Any = None, num_envs: int = 1, parallel: bool = False
+    ) -> None:
         p = self.p = params
         self.loop = loop
         self.K = K = int(num_envs)
@@ -118,6 +122,7 @@ class EpisodeCore:
         self._cf = float(self._c)
         self._horizon = p.horizon
         self._reward = np.zeros(K)
+        self._step_fused = kern.step_fused_parallel if parallel else kern.step_fused
         self._scratch = (np.empty((K, n)), np.empty((K, n + m)), np.empty((K, 2 * n + m)), np.empty((K, n + m)))
         self._obs_valid = False
         self._u_max = p.u_max
@@ -304,7 +309,7 @@ class EpisodeCore:
             target = self._target(self.collected + 1)
             if self._since_refresh + target - first < _REFRESH:
                 new = target > self.delivered
-                status = kern.step_fused(
+                status = self._step_fused(
                     act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
                     self.X, self.U, self.collected - 1, self.collected, self.hist,
                     self._a, self._qa, self._qx,
