@@ -27,7 +27,7 @@ STATE_OVERFLOW = 1
 
 
 # ----------------------------------------------------------------------------- one copy
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _energy_k(k, act, u_max, energy, budget, a_out):
     """a = action * u_max, scaled down to exhaust the remaining energy when it would overdraw it
     (``act`` is scaled too: the agent's own input history records what was applied)."""
@@ -49,7 +49,7 @@ def _energy_k(k, act, u_max, energy, budget, a_out):
     energy[k] += e
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _plant_k(k, x, u, w, A, B, tmp):
     """x_k <- A x_k + B u_k + w_k (eq:system); ``tmp`` (K, n) is scratch."""
     n = x.shape[1]
@@ -65,7 +65,7 @@ def _plant_k(k, x, u, w, A, B, tmp):
         x[k, i] = tmp[k, i]
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _history_k(k, hist, act):
     """Newest own input first; the oldest drops out."""
     L = hist.shape[1]
@@ -76,7 +76,7 @@ def _history_k(k, hist, act):
         hist[k, j] = act[k, j]
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _in_range_k(k, v, bound):
     """|v_j| <= bound for every entry of copy k (the encoder's declared range; NaN fails)."""
     for j in range(v.shape[1]):
@@ -85,7 +85,7 @@ def _in_range_k(k, v, bound):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _quantize_k(k, v, delta, offset, limit, out):
     """Signed integer of the nearest subgroup member to round(delta v) (Definition def:ec);
     False if a value lies outside the table range."""
@@ -97,7 +97,7 @@ def _quantize_k(k, v, delta, offset, limit, out):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _columns_k(k, X, U, first, target, G, C, Q, gram, recursive, z, r, g):
     """Regression columns ``([x_{j-1}; u_{j-1}], x_j)``, ``first <= j < target`` (eq:data):
     if ``gram``, the Gram matrix and cross term; if ``recursive``, recursive least squares on
@@ -142,7 +142,7 @@ def _columns_k(k, X, U, first, target, G, C, Q, gram, recursive, z, r, g):
                     Qk[a, b] -= ga * rk[b]
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _error_k(k, Q, theta_true_T, c):
     """epsilon = ||Theta_hat - Theta||_F^2 / c (Definition def:error)."""
     d = Q.shape[1]
@@ -155,7 +155,7 @@ def _error_k(k, Q, theta_true_T, c):
     return s / c
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _observation_k(k, obs, X, U, j, new, hist, time_frac, energy, budget):
     """[x_j | u_{j-1} | new | own inputs | deciphering-time fraction | energy fraction]."""
     n = X.shape[2]
