@@ -637,6 +637,8 @@ def findings(result: Result) -> str:
         for c in result.curves[(s.system, s.delay)]:
             if c.along_N is None or c.along_energy is None:
                 continue
+            if 0.1 * s.params.horizon < c.along_N[0]:
+                continue  # the energy is recorded from N = 2 (n + m) + 1 on; no extrapolation
             tenth = float(np.interp(0.1 * s.params.horizon, c.along_N, c.along_energy))
             if abs(tenth - 0.1) > 0.1:
                 out.append(f"{c.attacker} ({s.system}, delay {s.delay}) paces its energy unevenly: {100 * tenth:.0f}% of the "
