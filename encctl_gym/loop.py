@@ -84,13 +84,16 @@ class IdealLoop:
     def start_episode(self) -> None:
         pass
 
-    def collect_state(self, x: np.ndarray) -> np.ndarray:
+    def _encode_state(self, x: np.ndarray) -> np.ndarray:
         if not (np.abs(x) <= self.x_bound).all():  # the encoder's declared range (crypto raises alike)
             raise EncodingOverflowError(f"state {x.tolist()} leaves the declared range |x| <= {self.x_bound} (x_bound)")
-        return self.encode_int(x) / self.delta
+        return self.encode_int(x)
+
+    def collect_state(self, x: np.ndarray) -> np.ndarray:
+        return self._encode_state(x) / self.delta
 
     def control(self, x: np.ndarray) -> np.ndarray:
-        xi = self.encode_int(x)  # (K, n)
+        xi = self._encode_state(x)  # (K, n)
         return (self.Phi_int[None] * xi[:, None, :]).sum(-1) / (self.delta * self.delta)
 
     def inject(self, a: np.ndarray) -> np.ndarray:
