@@ -250,48 +250,16 @@ def log_ratio(before, after, out):
         out[k] = np.log(before[k] / after[k])
 
 
-@njit(cache=True)
-def step_ideal(
+@njit(inline="always")
+def _period_all(
     act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
+    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, tmp,
 ):
-    """The period alone (no delivery): energy budget, forged input, plant, history, collection."""
-    m = act.shape[1]
-    n = x.shape[1]
-    dd = delta * delta
-    tmp = np.empty(x.shape)
-    for k in range(act.shape[0]):
-        _energy_k(k, act, u_max, energy, budget, a_buf)
-        _quantize_k(k, a_buf, delta, offset, limit, q_buf)
-        for j in range(m):
-            a_buf[k, j] = (q_buf[k, j] * one + (n_cols - 1) * zero2) / dd
-            U[u_at, k, j] = a_buf[k, j]
-        _plant_k(k, x, a_buf, w, A, B, tmp)
-        if hist.shape[1] > 0:
-            _history_k(k, hist, act)
-        if collect_at >= 0:
-            if not _in_range_k(k, x, x_bound) or not _quantize_k(k, x, delta, offset, limit, qx_buf):
-                return STATE_OVERFLOW
-            for i in range(n):
-                X[collect_at, k, i] = qx_buf[k, i] / delta
-    return OK
-
-
-@njit(cache=True)
-def step_fused(
-    act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
-    first, target, G, C, Q, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
-    tmp, z, r, g,
-):
-    """A whole steady-state ideal-backend period for every copy, in one call (the Gram
-    matrices are left behind; :func:`add_gram` catches them up when they are needed).
-
-    Stage by stage over all copies (each stage a contiguous sweep of the batch); every copy
-    goes through the same per-copy functions in the same order as :func:`step_ideal` followed
-    by :func:`add_columns` and :func:`estimation_error`, so the numbers are those of the
-    general path.
-    """
+    """One ideal-backend period for every copy, stage by stage over the batch (contiguous
+    sweeps): energy budget, the forged input as the plant decodes it
+    (``crypto.controller.injection_value``: ``(Ecd(a) Ecd(1) + (n - 1) Ecd(0)^2) / Delta^2``),
+    plant update, own-input history and, if ``collect_at >= 0``, the collected state
+    ``Dcd(Ecd(x))``. Returns a status code."""
     K, m = act.shape
     n = x.shape[1]
     dd = delta * delta
@@ -299,7 +267,7 @@ def step_fused(
         _energy_k(k, act, u_max, energy, budget, a_buf)
     for k in range(K):
         _quantize_k(k, a_buf, delta, offset, limit, q_buf)  # |a| <= u_max: inside the table
-    for k in range(K):  # the plant decodes the forged input (crypto.controller.injection_value)
+    for k in range(K):
         for j in range(m):
             a_buf[k, j] = (q_buf[k, j] * one + (n_cols - 1) * zero2) / dd
             U[u_at, k, j] = a_buf[k, j]
@@ -315,6 +283,39 @@ def step_fused(
         for k in range(K):
             for i in range(n):
                 X[collect_at, k, i] = qx_buf[k, i] / delta
+    return OK
+
+
+@njit(cache=True)
+def step_ideal(
+    act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
+    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
+):
+    """The period alone (no delivery): see :func:`_period_all`."""
+    return _period_all(
+        act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
+        x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, np.empty(x.shape),
+    )
+
+
+@njit(cache=True)
+def step_fused(
+    act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
+    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
+    first, target, G, C, Q, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
+    tmp, z, r, g,
+):
+    """A whole steady-state ideal-backend period for every copy in one call: the period
+    (:func:`_period_all`), the delivery by recursive least squares, the error, the reward and
+    the observation (the Gram matrices are left behind; :func:`add_gram` catches them up when
+    they are needed)."""
+    status = _period_all(
+        act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
+        x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, tmp,
+    )
+    if status != OK:
+        return status
+    K = act.shape[0]
     if target > first:
         for k in range(K):
             before = eps[k]
@@ -338,8 +339,9 @@ def step_fused_parallel(
 ):
     """:func:`step_fused` with the copies spread over the cores (``prange``).
 
-    Each copy goes through the same stages in the same order as in :func:`step_fused` (stages
-    of different copies do not interact), so the numbers are identical.
+    The same per-copy functions in the same order as :func:`_period_all` and
+    :func:`step_fused`, written copy by copy because ``prange`` distributes copies (stages of
+    different copies do not interact), so the numbers are identical.
     """
     K, m = act.shape
     n = x.shape[1]
