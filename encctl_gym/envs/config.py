@@ -256,10 +256,10 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     delay = cfg["decipher_delay"]
     if delay == "end":
         delay_v: int | None = None
+    elif isinstance(delay, str):
+        raise ParameterError(f"decipher_delay must be a non-negative integer or 'end', got {delay!r}")
     else:
-        delay_v = check_int("decipher_delay", delay, minimum=0) if not isinstance(delay, str) else None
-        if isinstance(delay, str):
-            raise ParameterError(f"decipher_delay must be a non-negative integer or 'end', got {delay!r}")
+        delay_v = check_int("decipher_delay", delay, minimum=0)
 
     delta = check_int("delta", cfg["delta"], minimum=2)
     action_scale = check_positive("action_scale", cfg["action_scale"])
