@@ -96,7 +96,7 @@ def test_observations_never_contain_undelivered_data(delay):
         for k, a in enumerate(acts):
             if k == s0 and perturb:
                 core = env._core
-                core._noise[:, core._noise_pos :] += 5.0  # every future noise sample changes
+                core._noise[core._noise_pos :] += 5.0  # every future noise sample changes
             obs, _, te, tr, _ = env.step(a)
             obs_list.append(obs)
             if te or tr:

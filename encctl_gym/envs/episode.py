@@ -41,6 +41,15 @@ _REFRESH = 256
 _COND_LIMIT = 1e8
 
 
+def _condition(Gs: np.ndarray) -> np.ndarray:
+    """2-norm condition numbers of symmetric positive semidefinite matrices (..., d, d), from
+    their eigenvalues (``inf`` where singular)."""
+    lam = np.linalg.eigvalsh(Gs)
+    lo, hi = lam[..., 0], lam[..., -1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(lo > 0.0, hi / np.where(lo > 0.0, lo, 1.0), np.inf)
+
+
 def attack_design_for(p: AttackParams) -> Any:
     """The optimal attack design behind ``info["gamma_opt"]`` (security.attack_design): closed
     loop when states are delivered in time (``decipher_delay = 0``), open loop otherwise."""
@@ -107,6 +116,7 @@ class EpisodeCore:
         self._since_refresh = 0
         self.x = np.zeros((K, n))
         self.hist = np.zeros((K, p.input_history * m))
+        self._dims = kern.dims(n, m, p.input_history * m)  # the sizes, as the kernels take them
         self.energy = np.zeros(K)
         self.eps = np.full(K, self._eps0)
         self.logdet = np.full(K, self._logdet0)
@@ -123,7 +133,6 @@ class EpisodeCore:
         self._horizon = p.horizon
         self._reward = np.zeros(K)
         self._step_fused = kern.step_fused_parallel if parallel else kern.step_fused
-        self._scratch = (np.empty((K, n)), np.empty((K, n + m)), np.empty((K, 2 * n + m)), np.empty((K, n + m)))
         self._obs_valid = False
         self._u_max = p.u_max
         self._budget = p.energy_budget
@@ -131,7 +140,8 @@ class EpisodeCore:
         self._all_ready = False
         # the ideal backend's step is one fused compiled call
         self._fused = getattr(loop, "fused_parameters", None)
-        self._noise = np.zeros((K, _CHUNK, n))
+        self._noise_draws = np.zeros((K, _CHUNK, n))  # each copy's chunk, as its generator draws it
+        self._noise = np.zeros((_CHUNK, K, n))  # period-major, like X: one period's noise is contiguous
         self._noise_pos = _CHUNK
         self._rngs: list[np.random.Generator] = []
         self.history: list[tuple[int, float]] = []  # (N delivered, epsilon) of copy 0, for render
@@ -140,10 +150,10 @@ class EpisodeCore:
     def _draw_noise(self) -> np.ndarray:
         if self._noise_pos >= _CHUNK:
             for i, rng in enumerate(self._rngs):
-                self._noise[i] = rng.standard_normal((_CHUNK, self.n))
-            self._noise *= self._sw
+                rng.standard_normal(out=self._noise_draws[i])
+            kern.interleave_noise(self._noise_draws, self._sw, self._noise)
             self._noise_pos = 0
-        w = self._noise[:, self._noise_pos]
+        w = self._noise[self._noise_pos]
         self._noise_pos += 1
         return w
 
@@ -164,7 +174,7 @@ class EpisodeCore:
         self._noise_pos = _CHUNK
         self.loop.start_episode()
         for _ in range(self.p.warmup_steps):  # normal operation under the encrypted controller (eq:ec)
-            kern.plant_step(self.x, self.loop.control(self.x), self._draw_noise(), self._A, self._B)
+            kern.plant_step(self._dims, self.x, self.loop.control(self.x), self._draw_noise(), self._A, self._B)
         self.X[:] = 0.0
         self.U[:] = 0.0
         self.G[:] = 0.0
@@ -193,7 +203,7 @@ class EpisodeCore:
     def _sync_gram(self, upto: int) -> None:
         """Bring G and C up to the columns j < ``upto`` (the fused step leaves them behind)."""
         if upto > self._gram_upto:
-            kern.add_gram(self.X, self.U, self._gram_upto, upto, self.G, self.C)
+            kern.add_gram(self._dims, self.X, self.U, self._gram_upto, upto, self.G, self.C, self.ready)
             self._gram_upto = upto
 
     def _overflow(self) -> None:
@@ -221,16 +231,16 @@ class EpisodeCore:
             and self._since_refresh + target - first < _REFRESH
         ):  # steady state: columns, recursive least squares and error in one compiled call
             self._sync_gram(first)
-            kern.add_columns(self.X, self.U, first, target, self.G, self.C, self.Q, self.ready)
+            kern.add_columns(self._dims, self.X, self.U, first, target, self.G, self.C, self.Q, self.ready)
             self._gram_upto = target
-            kern.estimation_error(self.Q, self._theta_true_T, self._cf, self.ready, self.eps)
+            kern.estimation_error(self._dims, self.Q, self._theta_true_T, self._cf, self.ready, self.eps)
             self._since_refresh += target - first
             self.delivered = target
             self.history.append((target, float(self.eps[0])))
             return True
         self._sync_gram(first)
         if target > first:
-            kern.add_columns(self.X, self.U, first, target, self.G, self.C, self.Q, self.ready)
+            kern.add_columns(self._dims, self.X, self.U, first, target, self.G, self.C, self.Q, self.ready)
             self._gram_upto = target
         self.delivered = target
         if self.p.reward == "logdet":
@@ -246,7 +256,7 @@ class EpisodeCore:
                 rows = np.nonzero(stale)[0]
                 theta_hat_T = self._refresh(rows)
                 self.eps[rows] = ((theta_hat_T - self._theta_true_T) ** 2).sum(axis=(1, 2)) / self._c
-            kern.estimation_error(self.Q, self._theta_true_T, self._cf, self.ready & ~stale, self.eps)
+            kern.estimation_error(self._dims, self.Q, self._theta_true_T, self._cf, self.ready & ~stale, self.eps)
             self._all_ready = bool(self.ready.all())
         self.history.append((self.delivered, float(self.eps[0])))
         return True
@@ -254,11 +264,14 @@ class EpisodeCore:
     def _refresh(self, rows: np.ndarray) -> np.ndarray:
         """Exact least squares (eq:estimate) for the copies ``rows`` from the running Gram matrices.
 
-        Solves ``G [P | Theta_hat^T] = [I | C]`` with Jacobi scaling. A copy whose scaled Gram
-        matrix is well conditioned (re)starts its recursion from the solution; an exactly
-        singular one gets the pseudo-inverse solution of eq:estimate. Called for copies that
-        are not yet recursive, and for every copy each ``_REFRESH`` columns to bound rounding
-        drift. Returns Theta_hat^T of those copies, shape (len(rows), n + m, n).
+        Solves ``G [P | Theta_hat^T] = [I | C]`` with Jacobi scaling. A copy whose recursion
+        has not started starts it from the solution once its scaled Gram matrix is well
+        conditioned (condition number below ``_COND_LIMIT``); an exactly singular one gets the
+        pseudo-inverse solution of eq:estimate. A started recursion is re-anchored to the
+        solution without a new check: G only grows, by positive semidefinite terms, so its
+        smallest eigenvalue never falls. Called for copies that are not yet recursive, and for
+        every copy each ``_REFRESH`` columns to bound rounding drift. Returns Theta_hat^T of
+        those copies, shape (len(rows), n + m, n).
         """
         d = self.d
         G, C = self.G[rows], self.C[rows]
@@ -266,17 +279,19 @@ class EpisodeCore:
         Gs = G * s[:, :, None] * s[:, None, :]
         rhs = np.concatenate((np.broadcast_to(np.eye(d), G.shape) * s[:, :, None], C * s[:, :, None]), axis=2)
         out = np.empty((len(rows), d, self.n))
+        ok = self.ready[rows]  # a copy: the ones already recursive stay so
         try:
             sol = np.linalg.solve(Gs, rhs) * s[:, :, None]
-            ok = np.linalg.cond(Gs) < _COND_LIMIT
+            if not ok.all():
+                ok[~ok] = _condition(Gs[~ok]) < _COND_LIMIT
         except np.linalg.LinAlgError:  # some copy exactly singular: one by one
             sol = np.zeros_like(rhs)
-            ok = np.zeros(len(rows), dtype=bool)
             for i in range(len(rows)):
                 try:
                     sol[i] = np.linalg.solve(Gs[i], rhs[i]) * s[i, :, None]
-                    ok[i] = np.linalg.cond(Gs[i]) < _COND_LIMIT
+                    ok[i] = ok[i] or _condition(Gs[i]) < _COND_LIMIT
                 except np.linalg.LinAlgError:
+                    ok[i] = False
                     sol[i, :, d:] = np.linalg.lstsq(G[i], C[i], rcond=None)[0]  # pseudo-inverse
         out[:] = sol[:, :, d:]
         self.Q[rows[ok]] = sol[ok]
@@ -310,12 +325,12 @@ class EpisodeCore:
             if self._since_refresh + target - first < _REFRESH:
                 new = target > self.delivered
                 status = self._step_fused(
-                    act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
+                    self._dims, act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
                     self.X, self.U, self.collected - 1, self.collected, self.hist,
                     self._a, self._qa, self._qx,
-                    first, target, self.G, self.C, self.Q, self._theta_true_T, self._cf, self.eps,
+                    first, target, self.G, self.C, self.Q, self.ready, self._theta_true_T, self._cf, self.eps,
                     self._reward, self._obs, (target if new else self.delivered) - 1, float(new),
-                    float(self._time_frac[self.collected + 1]), *self._scratch,
+                    float(self._time_frac[self.collected + 1]),
                 )
                 if status == kern.STATE_OVERFLOW:
                     self._overflow()
@@ -330,7 +345,7 @@ class EpisodeCore:
         self._obs_valid = False
         if self._fused is not None:  # ideal backend: one compiled call
             status = kern.step_ideal(
-                act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
+                self._dims, act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
                 self.X, self.U, self.collected - 1, -1 if ended else self.collected, self.hist,
                 self._a, self._qa, self._qx,
             )
@@ -339,12 +354,12 @@ class EpisodeCore:
             if not ended:
                 self.collected += 1
         else:
-            kern.energy_budget(act, self._u_max, self.energy, self._budget, self._a)
+            kern.energy_budget(self._dims, act, self._u_max, self.energy, self._budget, self._a)
             u = self.loop.inject(self._a)
             self.U[self.collected - 1] = u
-            kern.plant_step(self.x, u, w, self._A, self._B)
+            kern.plant_step(self._dims, self.x, u, w, self._A, self._B)
             if p.input_history:
-                kern.shift_history(self.hist, act)
+                kern.shift_history(self._dims, self.hist, act)
             self.loop.tick()
             if not ended:
                 self._collect()
@@ -366,7 +381,7 @@ class EpisodeCore:
         if self._obs_valid:  # written by the fused step
             return self._obs.copy()
         kern.fill_observation(
-            self._obs, self.X, self.U, self.delivered - 1, float(self.new), self.hist,
+            self._dims, self._obs, self.X, self.U, self.delivered - 1, float(self.new), self.hist,
             float(self._time_frac[self.collected]), self.energy, self._budget,
         )
         return self._obs.copy()
