@@ -209,6 +209,34 @@ def test_final_epsilon_equals_batch_least_squares():
     assert info["epsilon"] == pytest.approx(estimation_error(env.params.A, env.params.B, A_hat, B_hat), rel=1e-8)
 
 
+def test_a_constant_input_gets_the_minimum_norm_estimate_every_step():
+    """A constant input makes the input columns collinear: the Gram matrix stays singular, no
+    copy starts its recursion, and epsilon after every step is that of the minimum-norm least
+    squares on the delivered data (numpy lstsq with the matching cut-off), in the vector
+    environment and the single one alike."""
+    K, act = 3, np.array([0.2, -0.1], dtype=np.float32)  # within the energy budget throughout
+    venv = EncryptedLTIAttackVectorEnv(num_envs=K, config=SMALL)
+    single = EncryptedLTIAttackEnv(config=SMALL)
+    venv.reset(seed=7)
+    single.reset(seed=7)
+    p, core = venv.params, venv._core
+    d = p.n + p.m
+    theta = np.hstack([p.A, p.B])
+    for _ in range(p.horizon):
+        obs_v, r_v, _, _, info_v = venv.step(np.tile(act, (K, 1)))
+        obs, r, te, tr, info = single.step(act)
+        assert np.array_equal(obs_v[0], obs) and r_v[0] == r and info_v["epsilon"][0] == info["epsilon"]
+        N = info["samples_delivered"]
+        if N - 1 >= d:
+            Z = np.hstack([core.X[: N - 1, 0], core.U[: N - 1, 0]])
+            th = np.linalg.lstsq(Z, core.X[1:N, 0], rcond=np.sqrt(d * np.finfo(float).eps))[0].T
+            assert info["epsilon"] == pytest.approx(np.sum((th - theta) ** 2) / theta.size, rel=1e-6)
+        if te or tr:
+            break
+    assert not core.ready.any()
+    assert np.isfinite(info["epsilon"]) and info["epsilon"] > 0
+
+
 # ------------------------------------------------------------------ backends and vector env
 def test_vector_env_matches_single_envs_bit_for_bit():
     K = 5

@@ -50,6 +50,16 @@ def _condition(Gs: np.ndarray) -> np.ndarray:
         return np.where(lo > 0.0, hi / np.where(lo > 0.0, lo, 1.0), np.inf)
 
 
+def _pinv_psd(G: np.ndarray) -> np.ndarray:
+    """Moore-Penrose pseudo-inverses of symmetric positive semidefinite matrices (..., d, d),
+    from their eigendecompositions; eigenvalues below ``d * eps * max`` count as zero (NumPy's
+    default cut-off for ``pinv``)."""
+    lam, V = np.linalg.eigh(G)
+    keep = lam > G.shape[-1] * np.finfo(float).eps * lam[..., -1:]
+    inv = np.where(keep, 1.0 / np.where(keep, lam, 1.0), 0.0)
+    return (V * inv[..., None, :]) @ np.swapaxes(V, -1, -2)
+
+
 def attack_design_for(p: AttackParams) -> Any:
     """The optimal attack design behind ``info["gamma_opt"]`` (security.attack_design): closed
     loop when states are delivered in time (``decipher_delay = 0``), open loop otherwise."""
@@ -264,39 +274,38 @@ class EpisodeCore:
     def _refresh(self, rows: np.ndarray) -> np.ndarray:
         """Exact least squares (eq:estimate) for the copies ``rows`` from the running Gram matrices.
 
-        Solves ``G [P | Theta_hat^T] = [I | C]`` with Jacobi scaling. A copy whose recursion
-        has not started starts it from the solution once its scaled Gram matrix is well
-        conditioned (condition number below ``_COND_LIMIT``); an exactly singular one gets the
-        pseudo-inverse solution of eq:estimate. A started recursion is re-anchored to the
-        solution without a new check: G only grows, by positive semidefinite terms, so its
-        smallest eigenvalue never falls. Called for copies that are not yet recursive, and for
-        every copy each ``_REFRESH`` columns to bound rounding drift. Returns Theta_hat^T of
-        those copies, shape (len(rows), n + m, n).
+        A copy whose Jacobi-scaled Gram matrix is well conditioned (condition number below
+        ``_COND_LIMIT``) solves ``G [P | Theta_hat^T] = [I | C]`` and (re)starts its recursion
+        from the solution; any other copy gets the minimum-norm least-squares solution
+        ``pinv(G) C`` of eq:estimate and stays non-recursive. A started recursion is re-anchored
+        without a new check: G only grows, by positive semidefinite terms, so its smallest
+        eigenvalue never falls. Called for copies that are not yet recursive, and for every copy
+        each ``_REFRESH`` columns to bound rounding drift. Returns Theta_hat^T of those copies,
+        shape (len(rows), n + m, n).
         """
         d = self.d
         G, C = self.G[rows], self.C[rows]
-        s = 1.0 / np.sqrt(np.maximum(np.einsum("kii->ki", G), 1e-300))
-        Gs = G * s[:, :, None] * s[:, None, :]
-        rhs = np.concatenate((np.broadcast_to(np.eye(d), G.shape) * s[:, :, None], C * s[:, :, None]), axis=2)
-        out = np.empty((len(rows), d, self.n))
         ok = self.ready[rows]  # a copy: the ones already recursive stay so
-        try:
-            sol = np.linalg.solve(Gs, rhs) * s[:, :, None]
-            if not ok.all():
-                ok[~ok] = _condition(Gs[~ok]) < _COND_LIMIT
-        except np.linalg.LinAlgError:  # some copy exactly singular: one by one
-            sol = np.zeros_like(rhs)
-            for i in range(len(rows)):
-                try:
-                    sol[i] = np.linalg.solve(Gs[i], rhs[i]) * s[i, :, None]
-                    ok[i] = ok[i] or _condition(Gs[i]) < _COND_LIMIT
-                except np.linalg.LinAlgError:
-                    ok[i] = False
-                    sol[i, :, d:] = np.linalg.lstsq(G[i], C[i], rcond=None)[0]  # pseudo-inverse
-        out[:] = sol[:, :, d:]
+        if not ok.all():
+            fresh = ~ok
+            g = G[fresh]
+            s = 1.0 / np.sqrt(np.maximum(np.einsum("kii->ki", g), 1e-300))
+            ok[fresh] = _condition(g * s[:, :, None] * s[:, None, :]) < _COND_LIMIT
+        sol = np.zeros((len(rows), d, d + self.n))
+        if ok.any():
+            g, c = G[ok], C[ok]
+            s = 1.0 / np.sqrt(np.einsum("kii->ki", g))  # Jacobi scaling
+            rhs = np.concatenate((np.broadcast_to(np.eye(d), g.shape) * s[:, :, None], c * s[:, :, None]), axis=2)
+            try:
+                sol[ok] = np.linalg.solve(g * s[:, :, None] * s[:, None, :], rhs) * s[:, :, None]
+            except np.linalg.LinAlgError:  # cannot happen to a well-conditioned matrix; never crash on it
+                ok[:] = False
+        if not ok.all():
+            bad = ~ok
+            sol[bad, :, d:] = _pinv_psd(G[bad]) @ C[bad]
         self.Q[rows[ok]] = sol[ok]
         self.ready[rows] = ok
-        return out
+        return sol[:, :, d:]
 
     def check_actions(self, action: Any) -> np.ndarray:
         """Validate actions: shape (K, m) (or (m,) for K = 1), finite, inside [-1, 1]."""
