@@ -38,6 +38,12 @@ _BLOCK = 16
 
 # ----------------------------------------------------------------------------- stages
 @njit(inline="always")
+def _scratch(n, m):
+    """Scratch vectors of the stages, allocated once per kernel call: (n,), (n + m,), (2n + m,), (n + m,)."""
+    return np.empty(n), np.empty(n + m), np.empty(2 * n + m), np.empty(n + m)
+
+
+@njit(inline="always")
 def _energy(k0, k1, m, act, u_max, energy, budget, a_out):
     """a = action * u_max, scaled down to exhaust the remaining energy when it would overdraw it
     (``act`` is scaled too: the agent's own input history records what was applied)."""
@@ -60,9 +66,8 @@ def _energy(k0, k1, m, act, u_max, energy, budget, a_out):
 
 
 @njit(inline="always")
-def _plant(k0, k1, n, m, x, u, w, A, B):
-    """x_k <- A x_k + B u_k + w_k (eq:system)."""
-    tmp = np.empty(n)
+def _plant(k0, k1, n, m, x, u, w, A, B, tmp):
+    """x_k <- A x_k + B u_k + w_k (eq:system); ``tmp`` (n,) is scratch."""
     for k in range(k0, k1):
         for i in range(n):
             s = 0.0
@@ -119,7 +124,7 @@ def _collect(k0, k1, n, x, X, collect_at, x_bound, delta, offset, limit, qx_buf)
 
 
 @njit(inline="always")
-def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready):
+def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready, z, r, g):
     """Regression columns ``([x_{j-1}; u_{j-1}], x_j)``, ``first <= j < target`` (eq:data).
 
     If ``gram``: the Gram matrix (its upper triangle, then mirrored) and the cross term. If
@@ -127,13 +132,10 @@ def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready)
     ``Q = [P | Theta_hat^T]``, ``r = z^T Q``, ``r[d:] -= y``, ``g = r[:d] / (1 + r[:d] . z)``,
     ``Q -= g r`` (Sherman-Morrison on P and the RLS update of Theta_hat together). P is
     symmetric; only its upper triangle is read and updated. Each copy takes its columns in
-    order of ``j``.
+    order of ``j``. ``z``, ``g`` (n + m,) and ``r`` (2n + m,) are scratch (see :func:`_scratch`).
     """
     d = n + m
     w = d + n
-    z = np.empty(d)
-    r = np.empty(w)
-    g = np.empty(d)
     # blocks of copies, period-major inside a block: a block's G, C, Q stay in cache while the
     # data of one period, contiguous across copies, stream through
     for kb in range(k0, k1, _BLOCK):
@@ -209,14 +211,14 @@ def _observation(k0, k1, n, m, H, obs, X, U, j, new, hist, time_frac, energy, bu
 @njit(inline="always")
 def _period(
     k0, k1, n, m, H, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
+    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, tmp,
 ):
     """One ideal-backend period of the copies ``k0 <= k < k1``, stage by stage: energy budget,
     forged input, plant update, own-input history and, if ``collect_at >= 0``, the collected
     state. Returns a status code."""
     _energy(k0, k1, m, act, u_max, energy, budget, a_buf)
     _forge(k0, k1, m, a_buf, q_buf, U, u_at, delta, offset, limit, one, zero2, n_cols)
-    _plant(k0, k1, n, m, x, a_buf, w, A, B)
+    _plant(k0, k1, n, m, x, a_buf, w, A, B, tmp)
     if H > 0:
         _history(k0, k1, m, H, hist, act)
     if collect_at >= 0:
@@ -225,14 +227,14 @@ def _period(
 
 
 @njit(inline="always")
-def _deliver(k0, k1, n, m, X, U, first, target, G, C, Q, ready, theta_true_T, c, eps, reward):
+def _deliver(k0, k1, n, m, X, U, first, target, G, C, Q, ready, theta_true_T, c, eps, reward, z, r, g):
     """Steady-state delivery of the copies ``k0 <= k < k1`` (all recursive): the columns
     ``first <= j < target`` by recursive least squares (the Gram matrices are left behind),
     the error and the reward ``log(eps_before / eps_after)``."""
     if target > first:
         for k in range(k0, k1):
             reward[k] = eps[k]
-        _columns(k0, k1, n, m, X, U, first, target, G, C, Q, False, True, ready)
+        _columns(k0, k1, n, m, X, U, first, target, G, C, Q, False, True, ready, z, r, g)
         _error(k0, k1, n, m, Q, theta_true_T, c, ready, eps)
         for k in range(k0, k1):
             reward[k] = np.log(reward[k] / eps[k])
@@ -259,7 +261,8 @@ def energy_budget(dims, act, u_max, energy, budget, a_out):
 
 @njit(cache=True)
 def plant_step(dims, x, u, w, A, B):
-    _plant(0, x.shape[0], len(dims[0]), len(dims[1]), x, u, w, A, B)
+    n = len(dims[0])
+    _plant(0, x.shape[0], n, len(dims[1]), x, u, w, A, B, np.empty(n))
 
 
 @njit(cache=True)
@@ -269,13 +272,17 @@ def shift_history(dims, hist, act):
 
 @njit(cache=True)
 def add_columns(dims, X, U, first, target, G, C, Q, ready):
-    _columns(0, G.shape[0], len(dims[0]), len(dims[1]), X, U, first, target, G, C, Q, True, True, ready)
+    n, m = len(dims[0]), len(dims[1])
+    _, z, r, g = _scratch(n, m)
+    _columns(0, G.shape[0], n, m, X, U, first, target, G, C, Q, True, True, ready, z, r, g)
 
 
 @njit(cache=True)
 def add_gram(dims, X, U, first, target, G, C, ready):
     """Only the Gram matrix and cross term of columns ``first <= j < target`` (catch-up)."""
-    _columns(0, G.shape[0], len(dims[0]), len(dims[1]), X, U, first, target, G, C, G, True, False, ready)
+    n, m = len(dims[0]), len(dims[1])
+    _, z, r, g = _scratch(n, m)
+    _columns(0, G.shape[0], n, m, X, U, first, target, G, C, G, True, False, ready, z, r, g)
 
 
 @njit(cache=True)
@@ -338,7 +345,7 @@ def step_ideal(
     n, m, H = len(dims[0]), len(dims[1]), len(dims[2])
     return _period(
         0, act.shape[0], n, m, H, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-        x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
+        x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, np.empty(n),
     )
 
 
@@ -355,13 +362,14 @@ def step_fused(
     """
     K = act.shape[0]
     n, m, H = len(dims[0]), len(dims[1]), len(dims[2])
+    tmp, z, r, g = _scratch(n, m)
     status = _period(
         0, K, n, m, H, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-        x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
+        x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, tmp,
     )
     if status != OK:
         return status
-    _deliver(0, K, n, m, X, U, first, target, G, C, Q, ready, theta_true_T, c, eps, reward)
+    _deliver(0, K, n, m, X, U, first, target, G, C, Q, ready, theta_true_T, c, eps, reward, z, r, g)
     _observation(0, K, n, m, H, obs, X, U, j_obs, new, hist, time_frac, energy, budget)
     return OK
 
@@ -381,13 +389,14 @@ def step_fused_parallel(
     for t in prange(n_chunks):
         k0 = t * _CHUNK
         k1 = min(k0 + _CHUNK, K)
+        tmp, z, r, g = _scratch(n, m)  # per task: the tasks run concurrently
         s = _period(
             k0, k1, n, m, H, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-            x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
+            x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, tmp,
         )
         if s != OK:
             status[t] = s
         else:
-            _deliver(k0, k1, n, m, X, U, first, target, G, C, Q, ready, theta_true_T, c, eps, reward)
+            _deliver(k0, k1, n, m, X, U, first, target, G, C, Q, ready, theta_true_T, c, eps, reward, z, r, g)
             _observation(k0, k1, n, m, H, obs, X, U, j_obs, new, hist, time_frac, energy, budget)
     return status.max()

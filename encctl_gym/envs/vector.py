@@ -93,11 +93,7 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
             return obs, np.zeros(self.num_envs), zeros, zeros.copy(), info
         reward, terminated, truncated = self._core.step(actions)
         self._needs_reset = terminated or truncated
-        K = self.num_envs
-        return (
-            self._core.observation(),
-            reward,
-            np.full(K, terminated),
-            np.full(K, truncated),
-            self._core.info_arrays(),
-        )
+        flags = np.zeros((2, self.num_envs), dtype=bool)  # the copies end together
+        flags[0] = terminated
+        flags[1] = truncated
+        return self._core.observation(), reward, flags[0], flags[1], self._core.info_arrays()
