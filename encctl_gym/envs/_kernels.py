@@ -124,7 +124,7 @@ def _collect(k0, k1, n, x, X, collect_at, x_bound, delta, offset, limit, qx_buf)
 
 
 @njit(inline="always")
-def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready, z, r, g):
+def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready, z, r, g, error, theta_true_T, c, eps):
     """Regression columns ``([x_{j-1}; u_{j-1}], x_j)``, ``first <= j < target`` (eq:data).
 
     If ``gram``: the Gram matrix (its upper triangle, then mirrored) and the cross term. If
@@ -133,6 +133,8 @@ def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready,
     ``Q -= g r`` (Sherman-Morrison on P and the RLS update of Theta_hat together). P is
     symmetric; only its upper triangle is read and updated. Each copy takes its columns in
     order of ``j``. ``z``, ``g`` (n + m,) and ``r`` (2n + m,) are scratch (see :func:`_scratch`).
+    If ``error``, the recursive copies' ``eps`` is set to the error of their final estimate
+    while it is written (summed as :func:`_error` sums it, so the numbers are the same).
     """
     d = n + m
     w = d + n
@@ -166,10 +168,22 @@ def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready,
                     inv = 1.0 / den
                     for a in range(d):
                         g[a] = r[a] * inv
+                    last = error and j == target - 1  # the error of the final estimate, as _error sums it
+                    s = 0.0
                     for a in range(d):
                         ga = g[a]
-                        for b in range(a, w):
+                        for b in range(a, d):
                             Q[k, a, b] -= ga * r[b]
+                        t = 0.0
+                        for b in range(d, w):
+                            q = Q[k, a, b] - ga * r[b]
+                            Q[k, a, b] = q
+                            if last:
+                                e = q - theta_true_T[a, b - d]
+                                t += e * e
+                        s += t
+                    if last:
+                        eps[k] = s / c
     if gram and target > first:
         for k in range(k0, k1):
             for a in range(1, d):
@@ -234,8 +248,7 @@ def _deliver(k0, k1, n, m, X, U, first, target, G, C, Q, ready, theta_true_T, c,
     if target > first:
         for k in range(k0, k1):
             reward[k] = eps[k]
-        _columns(k0, k1, n, m, X, U, first, target, G, C, Q, False, True, ready, z, r, g)
-        _error(k0, k1, n, m, Q, theta_true_T, c, ready, eps)
+        _columns(k0, k1, n, m, X, U, first, target, G, C, Q, False, True, ready, z, r, g, True, theta_true_T, c, eps)
         for k in range(k0, k1):
             reward[k] = np.log(reward[k] / eps[k])
     else:
@@ -274,7 +287,7 @@ def shift_history(dims, hist, act):
 def add_columns(dims, X, U, first, target, G, C, Q, ready):
     n, m = len(dims[0]), len(dims[1])
     _, z, r, g = _scratch(n, m)
-    _columns(0, G.shape[0], n, m, X, U, first, target, G, C, Q, True, True, ready, z, r, g)
+    _columns(0, G.shape[0], n, m, X, U, first, target, G, C, Q, True, True, ready, z, r, g, False, Q[0], 1.0, z)
 
 
 @njit(cache=True)
@@ -282,7 +295,7 @@ def add_gram(dims, X, U, first, target, G, C, ready):
     """Only the Gram matrix and cross term of columns ``first <= j < target`` (catch-up)."""
     n, m = len(dims[0]), len(dims[1])
     _, z, r, g = _scratch(n, m)
-    _columns(0, G.shape[0], n, m, X, U, first, target, G, C, G, True, False, ready, z, r, g)
+    _columns(0, G.shape[0], n, m, X, U, first, target, G, C, G, True, False, ready, z, r, g, False, G[0], 1.0, z)
 
 
 @njit(cache=True)
