@@ -4,9 +4,9 @@ One implementation serves both :class:`~encctl_gym.envs.EncryptedLTIAttackEnv` (
 native vector environment (K copies stepped at once), so the two have the same semantics by
 construction. All copies share the horizon and the delivery schedule, so they run in lockstep:
 time indices are plain integers, only the data differ. The per-step arithmetic is in the
-compiled kernels of :mod:`encctl_gym.envs._kernels`, written per copy, so copy ``i`` of a
-batch computes bit for bit what a single environment seeded the same way computes; the rare
-exact re-solves (batched LAPACK) are per matrix too.
+compiled kernels of :mod:`encctl_gym.envs._kernels`, whose arithmetic for each copy runs in a
+fixed order, so copy ``i`` of a batch computes bit for bit what a single environment seeded the
+same way computes; the rare exact re-solves (batched LAPACK) are per matrix too.
 
 Per sampling period ``k`` of the attack (Definition def:adversary):
 

@@ -37,9 +37,11 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
     config, **kwargs
         As for the single environment; only ``crypto="ideal"`` is batched.
     parallel : bool, default False
-        Spread the copies over the cores (numba ``prange``). The numbers are identical; it pays
-        on an otherwise idle machine (about 2x on 2 cores) and costs when another process holds
-        a core, hence off by default.
+        Spread the copies of the steady-state step over the cores (numba ``prange``). The
+        numbers are identical. Only the compiled step is spread (the noise draws, the Gram
+        catch-up and the Python around the step are not), so whether it pays depends on the
+        machine: on the 2-core development machine it was slower than one core in three
+        benchmark runs of four (``benchmarks/bench_env.py``), hence off by default.
 
     ``info`` holds one array of shape ``(num_envs,)`` per key of the single environment's info.
     """
