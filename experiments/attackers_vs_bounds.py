@@ -604,9 +604,10 @@ def summary_markdown(result: Result, *, command: str, plots: Sequence[Path]) -> 
     if result.elgamal:
         same = sum(abs(r["error_elgamal"] - r["error_ideal_same_seed"]) <= 1e-9 * r["error_ideal_same_seed"] for r in result.elgamal)
         lines.append("")
+        attackers = len({(r["system"], r["delay"], r["attacker"]) for r in result.elgamal})
         lines.append(f"Through real ElGamal ciphertexts ({result.elgamal[0]['key_length']}-bit key, N = {result.elgamal[0]['N']}): "
-                     f"{len(result.elgamal)} episodes of every attacker; {same} of them give the same final error as the ideal "
-                     "backend on the same seeds (elgamal.csv).")
+                     f"{len(result.elgamal)} episodes over {attackers} attacker settings; {same} of them give the same final "
+                     "error as the ideal backend on the same seeds (elgamal.csv).")
     return "\n".join(lines) + "\n"
 
 
