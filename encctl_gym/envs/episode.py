@@ -120,7 +120,7 @@ class EpisodeCore:
         self.U = np.zeros((N, K, m))  # applied inputs u_0 .. u_{N-1}
         self.G = np.zeros((K, self.d, self.d))  # regressor Gram matrix of the delivered data
         self.C = np.zeros((K, self.d, n))  # cross term sum z x_next^T
-        self.Q = np.zeros((K, self.d, self.d + n))  # recursive least squares: [P | Theta_hat^T]
+        self.Q = np.zeros((K, self.d, self.d + n))  # recursive least squares: [P | Theta_hat^T], P by its upper triangle
         self.ready = np.zeros(K, dtype=bool)  # recursion started (well-conditioned Gram matrix)
         self._gram_upto = 1  # G and C hold the columns j < _gram_upto (the fused step lets them lag)
         self._since_refresh = 0
