@@ -383,3 +383,69 @@ def test_parallel_vector_env_gives_the_same_numbers():
         a = serial.step(acts)
         b = parallel.step(acts)
         assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1]) and np.array_equal(a[2], b[2])
+
+
+def test_helper_thread_gives_the_same_numbers_through_refreshes_and_early_resets(monkeypatch):
+    """The helper thread (noise drawn ahead, Gram catch-up) changes where work runs, not the
+    numbers: a vector env with it matches single envs without it, step for step, through noise
+    chunks, Gram hand-overs, exact refreshes, the episode end and resets in mid-episode."""
+    from encctl_gym.envs import episode
+
+    monkeypatch.setattr(episode, "_CHUNK", 16)  # many chunk, hand-over and refresh boundaries
+    monkeypatch.setattr(episode, "_GRAM_BATCH", 4)
+    monkeypatch.setattr(episode, "_REFRESH", 40)
+    K, cfg = 4, {**SMALL, "scheme": "static", "max_samples": 150}
+    venv = EncryptedLTIAttackVectorEnv(num_envs=K, config=cfg, helper_thread=True)
+    singles = [EncryptedLTIAttackEnv(config=cfg) for _ in range(K)]
+    assert venv._core._use_helper and not singles[0]._core._use_helper
+    obs_v, _ = venv.reset(seed=7)
+    obs_s = [e.reset(seed=7 + i)[0] for i, e in enumerate(singles)]
+    rng = np.random.default_rng(1)
+    for step in range(400):
+        if step in (180, 233):  # mid-episode resets without a seed: the generators go on
+            obs_v, info_v = venv.reset()
+            obs_s = [e.reset()[0] for e in singles]
+            assert np.array_equal(obs_v, np.stack(obs_s))
+            continue
+        acts = random_actions(rng, K, venv.params.m)
+        obs_v, r_v, te_v, _, info_v = venv.step(acts)
+        for i, e in enumerate(singles):
+            if e._core.done:
+                obs, _ = e.reset()
+                r, eps = 0.0, e._core.eps[0]
+            else:
+                obs, r, _, _, info = e.step(acts[i])
+                eps = info["epsilon"]
+            assert np.array_equal(obs_v[i], obs) and r_v[i] == r and info_v["epsilon"][i] == eps, f"step {step}"
+    venv.close()
+
+
+def test_helper_thread_works_in_a_forked_child():
+    """A child forked after the parent used the helper thread starts its own."""
+    import multiprocessing as mp
+
+    from encctl_gym.envs import episode
+
+    venv = EncryptedLTIAttackVectorEnv(num_envs=2, config=LONG, helper_thread=True)
+    venv.reset(seed=0)
+    for _ in range(300):  # past a noise chunk: the parent's helper thread has run
+        venv.step(np.zeros((2, venv.params.m), np.float32))
+    assert episode._helper_pool is not None and venv.params.horizon == 600
+    child = mp.get_context("fork").Process(target=_step_past_a_chunk)
+    child.start()
+    child.join(120)
+    alive = child.is_alive()
+    if alive:
+        child.kill()
+    assert not alive and child.exitcode == 0
+
+
+LONG = {**SMALL, "scheme": "static", "max_samples": 600}
+
+
+def _step_past_a_chunk() -> None:
+    venv = EncryptedLTIAttackVectorEnv(num_envs=2, config=LONG, helper_thread=True)
+    venv.reset(seed=1)
+    for _ in range(300):
+        venv.step(np.zeros((2, venv.params.m), np.float32))
+    venv.close()

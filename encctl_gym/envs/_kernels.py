@@ -14,11 +14,15 @@ The small batched kernels (energy budget, plant update, regression columns, erro
 observation) are used one by one by the ElGamal backend, between calls into the crypto layer;
 :func:`step_fused` does a whole ideal-backend period (energy budget, forged input quantised
 through the residue table of :mod:`encctl_gym.crypto.residue_table`, plant, delivery,
-recursive least squares, error, reward, observation) in one call.
+recursive least squares, error, reward, observation) in one call. The batched kernels release
+the GIL, so the episode's helper thread (noise draws, Gram catch-up) runs while they do.
 
 Data layout: ``X`` (N, K, n) and ``U`` (N, K, m) are time-major, so the copies' data of one
-period are contiguous; ``G`` (K, d, d), ``C`` (K, d, n) and ``Q = [P | Theta_hat^T]``
-(K, d, d + n) hold each copy's running least squares, ``d = n + m``.
+period are contiguous; ``G`` (K, d, d) and ``C`` (K, d, n) hold each copy's Gram matrix and
+cross term, ``d = n + m``. The recursive least squares ``Q = [P | Theta_hat^T]`` is kept with
+the copies innermost, shape (d (d + n), K): entry (a, b) of every copy is the row
+``a (d + n) + b``. The steady-state update (:func:`_rls`) then runs each of its operations as
+one loop over the copies, which the compiler vectorises; no copy's numbers depend on that.
 """
 
 from __future__ import annotations
@@ -134,7 +138,9 @@ def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready,
     symmetric; only its upper triangle is read and updated. Each copy takes its columns in
     order of ``j``. ``z``, ``g`` (n + m,) and ``r`` (2n + m,) are scratch (see :func:`_scratch`).
     If ``error``, the recursive copies' ``eps`` is set to the error of their final estimate
-    while it is written (summed as :func:`_error` sums it, so the numbers are the same).
+    while it is written (summed as :func:`_error` sums it, so the numbers are the same). This
+    is the general path (any mix of copies, with or without the Gram matrix); the steady state
+    of the ideal backend uses :func:`_rls`, which computes the same numbers faster.
     """
     d = n + m
     w = d + n
@@ -158,7 +164,7 @@ def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready,
                     for b in range(w):  # r = z^T Q, summed over a in order, in a register
                         acc = 0.0
                         for a in range(d):
-                            acc += z[a] * (Q[k, a, b] if a <= b or b >= d else Q[k, b, a])
+                            acc += z[a] * (Q[a * w + b, k] if a <= b or b >= d else Q[b * w + a, k])
                         r[b] = acc
                     for b in range(n):
                         r[d + b] -= X[j, k, b]
@@ -173,11 +179,11 @@ def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready,
                     for a in range(d):
                         ga = g[a]
                         for b in range(a, d):
-                            Q[k, a, b] -= ga * r[b]
+                            Q[a * w + b, k] -= ga * r[b]
                         t = 0.0
                         for b in range(d, w):
-                            q = Q[k, a, b] - ga * r[b]
-                            Q[k, a, b] = q
+                            q = Q[a * w + b, k] - ga * r[b]
+                            Q[a * w + b, k] = q
                             if last:
                                 e = q - theta_true_T[a, b - d]
                                 t += e * e
@@ -195,13 +201,14 @@ def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready,
 def _error(k0, k1, n, m, Q, theta_true_T, c, ready, eps):
     """epsilon = ||Theta_hat - Theta||_F^2 / c (Definition def:error), copies flagged in ``ready``."""
     d = n + m
+    w = d + n
     for k in range(k0, k1):
         if ready[k]:
             s = 0.0
             for a in range(d):  # row sums first: short dependency chains
                 t = 0.0
                 for b in range(n):
-                    e = Q[k, a, d + b] - theta_true_T[a, b]
+                    e = Q[a * w + d + b, k] - theta_true_T[a, b]
                     t += e * e
                 s += t
             eps[k] = s / c
@@ -241,14 +248,76 @@ def _period(
 
 
 @njit(inline="always")
-def _deliver(k0, k1, n, m, X, U, first, target, G, C, Q, ready, theta_true_T, c, eps, reward, z, r, g):
+def _rls(k0, k1, n, m, X, U, first, target, Q, sc, theta_true_T, c, eps):
+    """Recursive least squares of :func:`_columns` for copies that are all recursive, with the
+    error of the final estimate: the same operations in the same order for every copy, but
+    each one a loop over the copies ``k0 <= k < k1`` (innermost, so it vectorises) instead of
+    a loop over a copy's entries. ``sc`` (2d + n + 2, K) is scratch: rows ``z`` (d), ``r``
+    (d + n), ``1 / den`` and a row for the error sums; ``z`` is overwritten by ``g``.
+    """
+    d = n + m
+    w = d + n
+    iv = d + w  # row of 1 / den
+    es = iv + 1  # row of the error sums
+    for j in range(first, target):
+        for i in range(n):
+            for k in range(k0, k1):
+                sc[i, k] = X[j - 1, k, i]
+        for i in range(m):
+            for k in range(k0, k1):
+                sc[n + i, k] = U[j - 1, k, i]
+        for b in range(w):  # r = z^T Q, summed over a in order
+            for k in range(k0, k1):
+                sc[d + b, k] = 0.0
+            for a in range(d):
+                row = a * w + b if a <= b or b >= d else b * w + a  # P by its upper triangle
+                for k in range(k0, k1):
+                    sc[d + b, k] += sc[a, k] * Q[row, k]
+        for b in range(n):
+            for k in range(k0, k1):
+                sc[2 * d + b, k] -= X[j, k, b]
+        for k in range(k0, k1):
+            sc[iv, k] = 1.0
+        for a in range(d):
+            for k in range(k0, k1):
+                sc[iv, k] += sc[d + a, k] * sc[a, k]
+        for k in range(k0, k1):
+            sc[iv, k] = 1.0 / sc[iv, k]
+        for a in range(d):  # g = r[:d] / den, over z
+            for k in range(k0, k1):
+                sc[a, k] = sc[d + a, k] * sc[iv, k]
+        for a in range(d):  # Q -= g r (upper triangle of P, all of Theta_hat^T)
+            for b in range(a, w):
+                row = a * w + b
+                for k in range(k0, k1):
+                    Q[row, k] -= sc[a, k] * sc[d + b, k]
+    if target > first:  # the error of the final estimate, summed as _error sums it
+        for k in range(k0, k1):
+            sc[es, k] = 0.0
+        for a in range(d):
+            for k in range(k0, k1):
+                sc[iv, k] = 0.0
+            for b in range(n):
+                tb = theta_true_T[a, b]
+                row = a * w + d + b
+                for k in range(k0, k1):
+                    e = Q[row, k] - tb
+                    sc[iv, k] += e * e
+            for k in range(k0, k1):
+                sc[es, k] += sc[iv, k]
+        for k in range(k0, k1):
+            eps[k] = sc[es, k] / c
+
+
+@njit(inline="always")
+def _deliver(k0, k1, n, m, X, U, first, target, Q, sc, theta_true_T, c, eps, reward):
     """Steady-state delivery of the copies ``k0 <= k < k1`` (all recursive): the columns
     ``first <= j < target`` by recursive least squares (the Gram matrices are left behind),
     the error and the reward ``log(eps_before / eps_after)``."""
     if target > first:
         for k in range(k0, k1):
             reward[k] = eps[k]
-        _columns(k0, k1, n, m, X, U, first, target, G, C, Q, False, True, ready, z, r, g, True, theta_true_T, c, eps)
+        _rls(k0, k1, n, m, X, U, first, target, Q, sc, theta_true_T, c, eps)
         for k in range(k0, k1):
             reward[k] = np.log(reward[k] / eps[k])
     else:
@@ -267,30 +336,30 @@ def dims(n: int, m: int, history: int) -> tuple[tuple[int, ...], tuple[int, ...]
     return ((0,) * n, (0,) * m, (0,) * history)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def energy_budget(dims, act, u_max, energy, budget, a_out):
     _energy(0, act.shape[0], len(dims[1]), act, u_max, energy, budget, a_out)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def plant_step(dims, x, u, w, A, B):
     n = len(dims[0])
     _plant(0, x.shape[0], n, len(dims[1]), x, u, w, A, B, np.empty(n))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def shift_history(dims, hist, act):
     _history(0, hist.shape[0], len(dims[1]), len(dims[2]), hist, act)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def add_columns(dims, X, U, first, target, G, C, Q, ready):
     n, m = len(dims[0]), len(dims[1])
     _, z, r, g = _scratch(n, m)
     _columns(0, G.shape[0], n, m, X, U, first, target, G, C, Q, True, True, ready, z, r, g, False, Q[0], 1.0, z)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def add_gram(dims, X, U, first, target, G, C, ready):
     """Only the Gram matrix and cross term of columns ``first <= j < target`` (catch-up)."""
     n, m = len(dims[0]), len(dims[1])
@@ -298,19 +367,19 @@ def add_gram(dims, X, U, first, target, G, C, ready):
     _columns(0, G.shape[0], n, m, X, U, first, target, G, C, G, True, False, ready, z, r, g, False, G[0], 1.0, z)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def estimation_error(dims, Q, theta_true_T, c, ready, eps):
     """Definition def:error for the copies flagged in ``ready``."""
-    _error(0, Q.shape[0], len(dims[0]), len(dims[1]), Q, theta_true_T, c, ready, eps)
+    _error(0, eps.shape[0], len(dims[0]), len(dims[1]), Q, theta_true_T, c, ready, eps)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def fill_observation(dims, obs, X, U, j, new, hist, time_frac, energy, budget):
     n, m, H = len(dims[0]), len(dims[1]), len(dims[2])
     _observation(0, obs.shape[0], n, m, H, obs, X, U, j, new, hist, time_frac, energy, budget)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def interleave_noise(src, scale, dst):
     """``dst[c, k] = scale * src[k, c]``: the copies' noise chunks, drawn one copy at a time
     (K, C, n), into the period-major layout (C, K, n) that the step kernels read."""
@@ -322,7 +391,7 @@ def interleave_noise(src, scale, dst):
                     dst[c, k, i] = src[k, c, i] * scale
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def check_actions(a):
     """Clip float32 rounding at the box edges; 0 ok, 1 non-finite, 2 outside [-1, 1]."""
     K, m = a.shape
@@ -342,14 +411,14 @@ def check_actions(a):
     return 0
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def log_ratio(before, after, out):
     """out = log(before / after): the reward, with the same log as the fused kernels."""
     for k in range(out.shape[0]):
         out[k] = np.log(before[k] / after[k])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def step_ideal(
     dims, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
     x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
@@ -362,11 +431,11 @@ def step_ideal(
     )
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def step_fused(
     dims, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
     x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
-    first, target, G, C, Q, ready, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
+    first, target, Q, sc, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
 ):
     """A whole steady-state ideal-backend period for every copy in one call: the period, the
     delivery by recursive least squares, the error, the reward and the observation (the Gram
@@ -375,23 +444,23 @@ def step_fused(
     """
     K = act.shape[0]
     n, m, H = len(dims[0]), len(dims[1]), len(dims[2])
-    tmp, z, r, g = _scratch(n, m)
+    tmp = np.empty(n)
     status = _period(
         0, K, n, m, H, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
         x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, tmp,
     )
     if status != OK:
         return status
-    _deliver(0, K, n, m, X, U, first, target, G, C, Q, ready, theta_true_T, c, eps, reward, z, r, g)
+    _deliver(0, K, n, m, X, U, first, target, Q, sc, theta_true_T, c, eps, reward)
     _observation(0, K, n, m, H, obs, X, U, j_obs, new, hist, time_frac, energy, budget)
     return OK
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def step_fused_parallel(
     dims, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
     x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
-    first, target, G, C, Q, ready, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
+    first, target, Q, sc, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
 ):
     """:func:`step_fused` with its chunks spread over the cores (``prange``): the same stages
     on the same chunks, which do not interact, so the numbers are identical."""
@@ -402,7 +471,7 @@ def step_fused_parallel(
     for t in prange(n_chunks):
         k0 = t * _CHUNK
         k1 = min(k0 + _CHUNK, K)
-        tmp, z, r, g = _scratch(n, m)  # per task: the tasks run concurrently
+        tmp = np.empty(n)  # per task: the tasks run concurrently (sc: each its own columns)
         s = _period(
             k0, k1, n, m, H, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
             x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, tmp,
@@ -410,6 +479,6 @@ def step_fused_parallel(
         if s != OK:
             status[t] = s
         else:
-            _deliver(k0, k1, n, m, X, U, first, target, G, C, Q, ready, theta_true_T, c, eps, reward, z, r, g)
+            _deliver(k0, k1, n, m, X, U, first, target, Q, sc, theta_true_T, c, eps, reward)
             _observation(k0, k1, n, m, H, obs, X, U, j_obs, new, hist, time_frac, energy, budget)
     return status.max()

@@ -23,7 +23,9 @@ Per sampling period ``k`` of the attack (Definition def:adversary):
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+import os
+from concurrent.futures import Future, ThreadPoolExecutor
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -39,6 +41,27 @@ _CHUNK = 256
 _REFRESH = 1024
 #: a copy starts its recursion once the condition number of its scaled Gram matrix is below this
 _COND_LIMIT = 1e8
+#: with a helper thread, the Gram catch-up is handed over once it lags this many columns
+_GRAM_BATCH = 64
+
+_helper_pool: ThreadPoolExecutor | None = None
+
+
+def _helper() -> ThreadPoolExecutor:
+    """The process's helper thread: one worker, shared by every episode, started on first use."""
+    global _helper_pool
+    if _helper_pool is None:
+        _helper_pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="encctl-gym-helper")
+    return _helper_pool
+
+
+def _forget_helper() -> None:
+    """After a fork the child holds the pool but not its thread: start a new one on next use."""
+    global _helper_pool
+    _helper_pool = None
+
+
+os.register_at_fork(after_in_child=_forget_helper)
 
 
 def _condition(Gs: np.ndarray) -> np.ndarray:
@@ -84,10 +107,23 @@ class EpisodeCore:
         K.
     parallel : bool
         Spread the copies of a steady-state step over the cores (same numbers).
+    helper_thread : bool
+        Draw the next chunk of noise and catch up the Gram matrices on a helper thread while
+        the copies are stepped (same numbers: the same work in the same order, only elsewhere).
+
+    Randomness: the noise of chunk ``c + 1`` (``_CHUNK`` periods) is drawn from every copy's
+    generator as soon as chunk ``c`` is taken into use, if the episode reaches it, with or
+    without the helper thread; so the draws, and hence the numbers, are the same either way.
     """
 
     def __init__(
-        self, params: AttackParams, loop: Any, design: Any = None, num_envs: int = 1, parallel: bool = False
+        self,
+        params: AttackParams,
+        loop: Any,
+        design: Any = None,
+        num_envs: int = 1,
+        parallel: bool = False,
+        helper_thread: bool = False,
     ) -> None:
         p = self.p = params
         self.loop = loop
@@ -120,7 +156,10 @@ class EpisodeCore:
         self.U = np.zeros((N, K, m))  # applied inputs u_0 .. u_{N-1}
         self.G = np.zeros((K, self.d, self.d))  # regressor Gram matrix of the delivered data
         self.C = np.zeros((K, self.d, n))  # cross term sum z x_next^T
-        self.Q = np.zeros((K, self.d, self.d + n))  # recursive least squares: [P | Theta_hat^T], P by its upper triangle
+        # recursive least squares [P | Theta_hat^T], P by its upper triangle; copies innermost:
+        # entry (a, b) of every copy is row a (d + n) + b (see _kernels)
+        self.Q = np.zeros((self.d * (self.d + n), K))
+        self._rls_scratch = np.zeros((2 * self.d + n + 2, K))
         self.ready = np.zeros(K, dtype=bool)  # recursion started (well-conditioned Gram matrix)
         self._gram_upto = 1  # G and C hold the columns j < _gram_upto (the fused step lets them lag)
         self._since_refresh = 0
@@ -152,17 +191,64 @@ class EpisodeCore:
         self._fused = getattr(loop, "fused_parameters", None)
         self._noise_draws = np.zeros((K, _CHUNK, n))  # each copy's chunk, as its generator draws it
         self._noise = np.zeros((_CHUNK, K, n))  # period-major, like X: one period's noise is contiguous
+        self._noise_next = np.zeros((_CHUNK, K, n))  # the chunk drawn ahead
         self._noise_pos = _CHUNK
+        self._noise_ahead = False  # _noise_next holds (or is being filled with) the next chunk
+        self._chunks = 0  # chunks taken into use this episode
+        self._periods = p.warmup_steps + p.horizon  # noise samples an episode uses
+        self._use_helper = bool(helper_thread)
+        self._noise_future: Future | None = None
+        self._gram_future: Future | None = None
         self._rngs: list[np.random.Generator] = []
         self.history: list[tuple[int, float]] = []  # (N delivered, epsilon) of copy 0, for render
 
+    # ----------------------------------------------------------------- helper thread
+    def _run(self, fn: Callable[..., Any], *args: Any) -> Future | None:
+        """``fn(*args)`` on the helper thread (returns its future) or, without one, now."""
+        if self._use_helper:
+            return _helper().submit(fn, *args)
+        fn(*args)
+        return None
+
+    def _wait_noise(self) -> None:
+        if self._noise_future is not None:
+            future, self._noise_future = self._noise_future, None
+            future.result()  # re-raises what the helper raised
+
+    def _wait_gram(self) -> None:
+        if self._gram_future is not None:
+            future, self._gram_future = self._gram_future, None
+            future.result()
+
+    def wait(self) -> None:
+        """Wait for the helper thread's work on this episode (noise drawn ahead, Gram catch-up)."""
+        self._wait_noise()
+        self._wait_gram()
+
     # ----------------------------------------------------------------- randomness
+    def _fill_noise(self, dst: np.ndarray) -> None:
+        """Draw the next ``_CHUNK`` periods of noise of every copy, into ``dst`` (C, K, n)."""
+        for i, rng in enumerate(self._rngs):
+            rng.standard_normal(out=self._noise_draws[i])
+        kern.interleave_noise(self._noise_draws, self._sw, dst)
+
+    def _take_chunk(self) -> None:
+        """Take the next noise chunk into use (the one drawn ahead, else draw it now), then draw
+        the one after it ahead if the episode will reach it."""
+        if self._noise_ahead:
+            self._wait_noise()
+            self._noise, self._noise_next = self._noise_next, self._noise
+        else:
+            self._fill_noise(self._noise)
+        self._chunks += 1
+        self._noise_pos = 0
+        self._noise_ahead = self._chunks * _CHUNK < self._periods
+        if self._noise_ahead:
+            self._noise_future = self._run(self._fill_noise, self._noise_next)
+
     def _draw_noise(self) -> np.ndarray:
         if self._noise_pos >= _CHUNK:
-            for i, rng in enumerate(self._rngs):
-                rng.standard_normal(out=self._noise_draws[i])
-            kern.interleave_noise(self._noise_draws, self._sw, self._noise)
-            self._noise_pos = 0
+            self._take_chunk()
         w = self._noise[self._noise_pos]
         self._noise_pos += 1
         return w
@@ -177,11 +263,14 @@ class EpisodeCore:
         rngs = [rng] if isinstance(rng, np.random.Generator) else list(rng)
         if len(rngs) != self.K:
             raise ParameterError(f"expected {self.K} random generators, got {len(rngs)}")
+        self.wait()  # the helper may still be drawing from the old generators or adding to G
         self._rngs = rngs
         self._obs_valid = False
         for i, g in enumerate(rngs):
             self.x[i] = g.standard_normal(self.n) * self._sx
         self._noise_pos = _CHUNK
+        self._noise_ahead = False
+        self._chunks = 0
         self.loop.start_episode()
         for _ in range(self.p.warmup_steps):  # normal operation under the encrypted controller (eq:ec)
             kern.plant_step(self._dims, self.x, self.loop.control(self.x), self._draw_noise(), self._A, self._B)
@@ -212,9 +301,23 @@ class EpisodeCore:
 
     def _sync_gram(self, upto: int) -> None:
         """Bring G and C up to the columns j < ``upto`` (the fused step leaves them behind)."""
+        self._wait_gram()
         if upto > self._gram_upto:
             kern.add_gram(self._dims, self.X, self.U, self._gram_upto, upto, self.G, self.C, self.ready)
             self._gram_upto = upto
+
+    def _gram_behind(self, upto: int) -> None:
+        """Hand the Gram catch-up of the columns j < ``upto`` to the helper thread, unless it
+        is still busy with the previous one. The columns are final: rows of X and U only ever
+        get written once, ahead of the columns that read them."""
+        if self._gram_future is not None:
+            if not self._gram_future.done():
+                return
+            self._wait_gram()
+        first, self._gram_upto = self._gram_upto, upto
+        self._gram_future = _helper().submit(
+            kern.add_gram, self._dims, self.X, self.U, first, upto, self.G, self.C, self.ready
+        )
 
     def _overflow(self) -> None:
         raise EncodingOverflowError(
@@ -303,7 +406,7 @@ class EpisodeCore:
         if not ok.all():
             bad = ~ok
             sol[bad, :, d:] = _pinv_psd(G[bad]) @ C[bad]
-        self.Q[rows[ok]] = sol[ok]
+        self.Q[:, rows[ok]] = sol[ok].reshape(-1, d * (d + self.n)).T
         self.ready[rows] = ok
         return sol[:, :, d:]
 
@@ -337,7 +440,7 @@ class EpisodeCore:
                     self._dims, act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
                     self.X, self.U, self.collected - 1, self.collected, self.hist,
                     self._a, self._qa, self._qx,
-                    first, target, self.G, self.C, self.Q, self.ready, self._theta_true_T, self._cf, self.eps,
+                    first, target, self.Q, self._rls_scratch, self._theta_true_T, self._cf, self.eps,
                     self._reward, self._obs, (target if new else self.delivered) - 1, float(new),
                     float(self._time_frac[self.collected + 1]),
                 )
@@ -349,6 +452,8 @@ class EpisodeCore:
                     self._since_refresh += target - first
                     self.delivered = target
                     self.history.append((target, float(self.eps[0])))
+                    if self._use_helper and target - self._gram_upto >= _GRAM_BATCH:
+                        self._gram_behind(target)
                 self._obs_valid = True
                 return self._reward.copy(), False, False
         self._obs_valid = False

@@ -42,6 +42,10 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         catch-up and the Python around the step are not), so whether it pays depends on the
         machine: on the 2-core development machine it was slower than one core in three
         benchmark runs of four (``benchmarks/bench_env.py``), hence off by default.
+    helper_thread : bool, default True
+        Draw the next 256 periods of noise and catch up the Gram matrices of the exact refresh
+        on a helper thread while the copies are stepped (the compiled kernels release the GIL).
+        The numbers are identical; ``False`` keeps all the work on the calling thread.
 
     ``info`` holds one array of shape ``(num_envs,)`` per key of the single environment's info.
     """
@@ -54,6 +58,7 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         config: dict[str, Any] | None = None,
         max_episode_steps: int | None = None,
         parallel: bool = False,
+        helper_thread: bool = True,
         **kwargs: Any,
     ) -> None:
         self.num_envs = check_int("num_envs", num_envs, minimum=1)
@@ -68,7 +73,9 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.design = attack_design_for(p) if p.gamma_opt else None
-        self._core = EpisodeCore(p, make_loop(p), self.design, num_envs=self.num_envs, parallel=bool(parallel))
+        self._core = EpisodeCore(
+            p, make_loop(p), self.design, num_envs=self.num_envs, parallel=bool(parallel), helper_thread=bool(helper_thread)
+        )
         self._rngs: list[np.random.Generator] | None = None
         self._needs_reset = False
 
@@ -99,3 +106,6 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         flags[0] = terminated
         flags[1] = truncated
         return self._core.observation(), reward, flags[0], flags[1], self._core.info_arrays()
+
+    def close_extras(self, **kwargs: Any) -> None:
+        self._core.wait()
