@@ -330,12 +330,32 @@ def test_bad_configuration_raises_named_error(overrides, error, text):
         EncryptedLTIAttackEnv(config={**SMALL, **overrides})
 
 
-@pytest.mark.parametrize("action", [[2.0, 0.0], [float("nan"), 0.0], [0.0, 0.0, 0.0]])
+@pytest.mark.parametrize("action", [[2.0, 0.0], [float("nan"), 0.0], [float("-inf"), 0.0], [0.0, 0.0, 0.0]])
 def test_bad_action_raises(action):
     env = EncryptedLTIAttackEnv(config=SMALL)
     env.reset(seed=0)
-    with pytest.raises(ParameterError):
+    with pytest.raises(ParameterError, match="action"):
         env.step(np.array(action, dtype=np.float32))
+
+
+def test_actions_are_read_not_changed_and_every_form_gives_the_same_step():
+    """The energy budget scales the applied input down, never the caller's array; float32,
+    float64, a list and an edge value off by float32 rounding all give the same step."""
+    K = 3
+    venv = EncryptedLTIAttackVectorEnv(num_envs=K, config=SMALL)
+    p = venv.params
+    edge = np.nextafter(np.float32(1.0), np.float32(2.0))  # 1 + 1.2e-7: clipped to 1
+    acts = np.full((K, p.m), edge, dtype=np.float32)
+    forms = [acts, acts.astype(np.float64), acts.tolist(), np.ones((K, p.m))]
+    results = []
+    for a in forms:
+        venv.reset(seed=4)
+        keep = np.array(a, copy=True)
+        for _ in range(p.horizon - 1):  # 16 times the allowed power: the budget runs out
+            obs, r, *_ = venv.step(a)
+        assert np.array_equal(np.asarray(a), keep)
+        results.append((obs, r))
+    assert all(np.array_equal(o, results[0][0]) and np.array_equal(r, results[0][1]) for o, r in results)
 
 
 def test_state_outside_declared_range_raises_overflow():
@@ -372,7 +392,9 @@ def test_both_backends_refuse_a_state_outside_x_bound_at_the_same_step():
 
 
 def test_parallel_vector_env_gives_the_same_numbers():
-    K = 16
+    from encctl_gym.envs import _kernels
+
+    K = 2 * _kernels._CHUNK + 3  # three tasks, one of them short
     serial = EncryptedLTIAttackVectorEnv(num_envs=K, config=SMALL)
     parallel = EncryptedLTIAttackVectorEnv(num_envs=K, config=SMALL, parallel=True)
     o1, _ = serial.reset(seed=5)

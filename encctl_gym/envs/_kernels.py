@@ -35,7 +35,7 @@ OK = 0
 STATE_OVERFLOW = 1
 
 #: copies per task of the parallel kernel
-_CHUNK = 32
+_CHUNK = 256
 #: copies whose running least squares are updated together over a run of periods
 _BLOCK = 16
 
@@ -392,23 +392,45 @@ def interleave_noise(src, scale, dst):
 
 
 @njit(cache=True, nogil=True)
-def check_actions(a):
-    """Clip float32 rounding at the box edges; 0 ok, 1 non-finite, 2 outside [-1, 1]."""
-    K, m = a.shape
+def load_actions(src, dst):
+    """``dst = src`` in float64, float32 rounding at the box edges clipped; returns 0 if all
+    are valid, 1 at a non-finite entry, 2 at one outside [-1, 1] (``dst`` is then partial)."""
+    K, m = src.shape
+    outside = 0
+    for k in range(K):  # the common case, branch-free: copy and count entries outside the box
+        for j in range(m):
+            v = np.float64(src[k, j])
+            outside += (v < -1.0) | (v > 1.0) | (v != v)
+            dst[k, j] = v
+    if outside == 0:
+        return 0
     for k in range(K):
         for j in range(m):
-            v = a[k, j]
-            if not np.isfinite(v):
-                return 1
-            if v > 1.0:
-                if v > 1.0 + 1e-6:
+            v = dst[k, j]
+            if not (-1.0 <= v <= 1.0):  # NaN too
+                if not np.isfinite(v):
+                    return 1
+                if abs(v) > 1.0 + 1e-6:
                     return 2
-                a[k, j] = 1.0
-            elif v < -1.0:
-                if v < -1.0 - 1e-6:
-                    return 2
-                a[k, j] = -1.0
+                dst[k, j] = 1.0 if v > 0.0 else -1.0
     return 0
+
+
+@njit(cache=True, nogil=True)
+def fill_info(f, counts, eps, energy, gamma, time, power_den, gamma_opt, collected, delivered):
+    """The info rows of every copy: epsilon, gamma, deciphering time, input energy, average
+    power (energy / power_den) and, if ``f`` has a sixth row, gamma_opt; the sample counts."""
+    for k in range(f.shape[1]):
+        f[0, k] = eps[k]
+        f[1, k] = gamma
+        f[2, k] = time
+        f[3, k] = energy[k]
+        f[4, k] = energy[k] / power_den
+        counts[0, k] = collected
+        counts[1, k] = delivered
+    if f.shape[0] > 5:
+        for k in range(f.shape[1]):
+            f[5, k] = gamma_opt
 
 
 @njit(cache=True, nogil=True)

@@ -173,7 +173,8 @@ class EpisodeCore:
         self.delivered = 0  # samples delivered to the agent
         self.new = False
         self.done = False
-        self._obs = np.zeros((K, p.obs_dim), dtype=np.float32)
+        self._obs_out: np.ndarray | None = None  # observation written by the fused step, not yet handed out
+        self._act = np.zeros((K, m))  # the actions of the current step, float64
         self._a = np.zeros((K, m))
         self._qa = np.zeros((K, m), dtype=np.int64)
         self._qx = np.zeros((K, n), dtype=np.int64)
@@ -182,7 +183,6 @@ class EpisodeCore:
         self._horizon = p.horizon
         self._reward = np.zeros(K)
         self._step_fused = kern.step_fused_parallel if parallel else kern.step_fused
-        self._obs_valid = False
         self._u_max = p.u_max
         self._budget = p.energy_budget
         self._logdet = p.reward == "logdet"
@@ -265,7 +265,7 @@ class EpisodeCore:
             raise ParameterError(f"expected {self.K} random generators, got {len(rngs)}")
         self.wait()  # the helper may still be drawing from the old generators or adding to G
         self._rngs = rngs
-        self._obs_valid = False
+        self._obs_out = None
         for i, g in enumerate(rngs):
             self.x[i] = g.standard_normal(self.n) * self._sx
         self._noise_pos = _CHUNK
@@ -411,16 +411,21 @@ class EpisodeCore:
         return sol[:, :, d:]
 
     def check_actions(self, action: Any) -> np.ndarray:
-        """Validate actions: shape (K, m) (or (m,) for K = 1), finite, inside [-1, 1]."""
-        a = np.array(action, dtype=np.float64, ndmin=2)
+        """Validate actions: shape (K, m) (or (m,) for K = 1), finite, inside [-1, 1]. Returns
+        them in float64, in a buffer of the episode's own (the caller's array is never changed)."""
+        a = action
+        if not (isinstance(a, np.ndarray) and a.dtype in (np.float32, np.float64)):
+            a = np.asarray(a, dtype=np.float64)
+        if a.ndim < 2:
+            a = a.reshape(1, -1)
         if a.shape != (self.K, self.m):
             want = (self.m,) if self.K == 1 else (self.K, self.m)
             raise ParameterError(f"action must have shape {want}, got {np.shape(action)}")
-        code = kern.check_actions(a)
+        code = kern.load_actions(a, self._act)
         if code:
             what = "finite" if code == 1 else "inside the action space [-1, 1]"
             raise ParameterError(f"action must be {what}, got {np.asarray(action).tolist()}")
-        return a
+        return self._act
 
     def step(self, action: Any) -> tuple[np.ndarray, bool, bool]:
         """Apply the actions of all copies. Returns (rewards (K,), terminated, truncated)."""
@@ -436,12 +441,13 @@ class EpisodeCore:
             target = self._target(self.collected + 1)
             if self._since_refresh + target - first < _REFRESH:
                 new = target > self.delivered
+                obs = np.empty((self.K, p.obs_dim), dtype=np.float32)
                 status = self._step_fused(
                     self._dims, act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
                     self.X, self.U, self.collected - 1, self.collected, self.hist,
                     self._a, self._qa, self._qx,
                     first, target, self.Q, self._rls_scratch, self._theta_true_T, self._cf, self.eps,
-                    self._reward, self._obs, (target if new else self.delivered) - 1, float(new),
+                    self._reward, obs, (target if new else self.delivered) - 1, float(new),
                     float(self._time_frac[self.collected + 1]),
                 )
                 if status == kern.STATE_OVERFLOW:
@@ -454,9 +460,9 @@ class EpisodeCore:
                     self.history.append((target, float(self.eps[0])))
                     if self._use_helper and target - self._gram_upto >= _GRAM_BATCH:
                         self._gram_behind(target)
-                self._obs_valid = True
+                self._obs_out = obs
                 return self._reward.copy(), False, False
-        self._obs_valid = False
+        self._obs_out = None
         if self._fused is not None:  # ideal backend: one compiled call
             status = kern.step_ideal(
                 self._dims, act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
@@ -491,28 +497,27 @@ class EpisodeCore:
 
     # ----------------------------------------------------------------- observation and info
     def observation(self) -> np.ndarray:
-        """Observations of all copies, shape (K, obs_dim), float32 (see the class docstring)."""
-        if self._obs_valid:  # written by the fused step
-            return self._obs.copy()
-        kern.fill_observation(
-            self._dims, self._obs, self.X, self.U, self.delivered - 1, float(self.new), self.hist,
-            float(self._time_frac[self.collected]), self.energy, self._budget,
-        )
-        return self._obs.copy()
+        """Observations of all copies, shape (K, obs_dim), float32 (see the class docstring), in
+        a new array: the one the fused step wrote, if not yet handed out, else filled now."""
+        obs, self._obs_out = self._obs_out, None
+        if obs is None:
+            obs = np.empty((self.K, self.p.obs_dim), dtype=np.float32)
+            kern.fill_observation(
+                self._dims, obs, self.X, self.U, self.delivered - 1, float(self.new), self.hist,
+                float(self._time_frac[self.collected]), self.energy, self._budget,
+            )
+        return obs
 
     def info_arrays(self) -> dict[str, np.ndarray]:
         """Info of every copy as arrays of shape (K,) (keys as in :meth:`info`); rows of two
-        fresh buffers, one float and one integer, so a step costs two allocations."""
+        fresh buffers, one float and one integer, filled in one compiled call."""
         N = self.delivered
         f = np.empty((6 if self.has_gamma_opt else 5, self.K))
-        f[0] = self.eps
-        f[1] = self.gamma_table[N]
-        f[2] = self.time_table[self.collected]
-        f[3] = self.energy
-        np.divide(self.energy, max(self.collected, 1) * self.m, out=f[4])
         counts = np.empty((2, self.K), dtype=np.int64)
-        counts[0] = self.collected
-        counts[1] = N
+        kern.fill_info(
+            f, counts, self.eps, self.energy, float(self.gamma_table[N]), float(self.time_table[self.collected]),
+            float(max(self.collected, 1) * self.m), float(self.gamma_opt_table[N]), self.collected, N,
+        )
         info = {
             "epsilon": f[0],
             "gamma": f[1],
@@ -523,7 +528,6 @@ class EpisodeCore:
             "average_power": f[4],
         }
         if self.has_gamma_opt:
-            f[5] = self.gamma_opt_table[N]
             info["gamma_opt"] = f[5]
         return info
 
