@@ -442,6 +442,23 @@ def test_helper_thread_gives_the_same_numbers_through_refreshes_and_early_resets
     venv.close()
 
 
+def test_a_vector_env_with_the_helper_busy_can_be_pickled_and_copied():
+    import copy
+    import pickle
+
+    venv = EncryptedLTIAttackVectorEnv(num_envs=2, config=LONG, helper_thread=True)
+    venv.reset(seed=0)
+    acts = random_actions(np.random.default_rng(0), 300, venv.params.m)
+    for a in acts[:270]:  # past a noise chunk and Gram hand-overs: work is on the helper
+        venv.step(np.stack([a, a]))
+    clones = [pickle.loads(pickle.dumps(venv)), copy.deepcopy(venv)]
+    for a in acts[270:]:
+        want = venv.step(np.stack([a, a]))
+        for c in clones:
+            got = c.step(np.stack([a, a]))
+            assert np.array_equal(got[0], want[0]) and np.array_equal(got[1], want[1])
+
+
 def test_helper_thread_works_in_a_forked_child():
     """A child forked after the parent used the helper thread starts its own."""
     import multiprocessing as mp

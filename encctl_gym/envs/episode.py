@@ -175,6 +175,7 @@ class EpisodeCore:
         self.done = False
         self._obs_out: np.ndarray | None = None  # observation written by the fused step, not yet handed out
         self._act = np.zeros((K, m))  # the actions of the current step, float64
+        self._obs_shape = (K, p.obs_dim)
         self._a = np.zeros((K, m))
         self._qa = np.zeros((K, m), dtype=np.int64)
         self._qx = np.zeros((K, n), dtype=np.int64)
@@ -224,6 +225,11 @@ class EpisodeCore:
         """Wait for the helper thread's work on this episode (noise drawn ahead, Gram catch-up)."""
         self._wait_noise()
         self._wait_gram()
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickling and deep copies see the helper's work finished (a future cannot be copied)."""
+        self.wait()
+        return self.__dict__.copy()
 
     # ----------------------------------------------------------------- randomness
     def _fill_noise(self, dst: np.ndarray) -> None:
@@ -414,7 +420,7 @@ class EpisodeCore:
         """Validate actions: shape (K, m) (or (m,) for K = 1), finite, inside [-1, 1]. Returns
         them in float64, in a buffer of the episode's own (the caller's array is never changed)."""
         a = action
-        if not (isinstance(a, np.ndarray) and a.dtype in (np.float32, np.float64)):
+        if not (isinstance(a, np.ndarray) and a.dtype.char in "fd"):  # float32 and float64 are read as they are
             a = np.asarray(a, dtype=np.float64)
         if a.ndim < 2:
             a = a.reshape(1, -1)
@@ -441,7 +447,7 @@ class EpisodeCore:
             target = self._target(self.collected + 1)
             if self._since_refresh + target - first < _REFRESH:
                 new = target > self.delivered
-                obs = np.empty((self.K, p.obs_dim), dtype=np.float32)
+                obs = np.empty(self._obs_shape, dtype=np.float32)
                 status = self._step_fused(
                     self._dims, act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
                     self.X, self.U, self.collected - 1, self.collected, self.hist,
@@ -501,7 +507,7 @@ class EpisodeCore:
         a new array: the one the fused step wrote, if not yet handed out, else filled now."""
         obs, self._obs_out = self._obs_out, None
         if obs is None:
-            obs = np.empty((self.K, self.p.obs_dim), dtype=np.float32)
+            obs = np.empty(self._obs_shape, dtype=np.float32)
             kern.fill_observation(
                 self._dims, obs, self.X, self.U, self.delivered - 1, float(self.new), self.hist,
                 float(self._time_frac[self.collected]), self.energy, self._budget,
