@@ -18,11 +18,12 @@ recursive least squares, error, reward, observation) in one call. The batched ke
 the GIL, so the episode's helper thread (noise draws, Gram catch-up) runs while they do.
 
 Data layout: ``X`` (N, K, n) and ``U`` (N, K, m) are time-major, so the copies' data of one
-period are contiguous; ``G`` (K, d, d) and ``C`` (K, d, n) hold each copy's Gram matrix and
-cross term, ``d = n + m``. The recursive least squares ``Q = [P | Theta_hat^T]`` is kept with
-the copies innermost, shape (d (d + n), K): entry (a, b) of every copy is the row
-``a (d + n) + b``. The steady-state update (:func:`_rls`) then runs each of its operations as
-one loop over the copies, which the compiler vectorises; no copy's numbers depend on that.
+period are contiguous. The running least squares are kept with the copies innermost: the
+recursive ``Q = [P | Theta_hat^T]`` and the Gram matrix with the cross term ``GC = [G | C]``
+(``d = n + m``), each of shape (d (d + n), K), where entry (a, b) of every copy is the row
+``a (d + n) + b``. The steady-state kernels (:func:`_rls`, :func:`_gram`) then run each of
+their operations as one loop over the copies, which the compiler vectorises; no copy's
+numbers depend on that.
 """
 
 from __future__ import annotations
@@ -128,23 +129,22 @@ def _collect(k0, k1, n, x, X, collect_at, x_bound, delta, offset, limit, qx_buf)
 
 
 @njit(inline="always")
-def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready, z, r, g, error, theta_true_T, c, eps):
-    """Regression columns ``([x_{j-1}; u_{j-1}], x_j)``, ``first <= j < target`` (eq:data).
+def _columns(k0, k1, n, m, X, U, first, target, GC, Q, ready, z, r, g):
+    """Regression columns ``([x_{j-1}; u_{j-1}], x_j)``, ``first <= j < target`` (eq:data), for
+    any mix of copies (the general path: the start of an episode, the ElGamal backend).
 
-    If ``gram``: the Gram matrix (its upper triangle, then mirrored) and the cross term. If
-    ``recursive``, for the copies flagged in ``ready``: recursive least squares on
-    ``Q = [P | Theta_hat^T]``, ``r = z^T Q``, ``r[d:] -= y``, ``g = r[:d] / (1 + r[:d] . z)``,
-    ``Q -= g r`` (Sherman-Morrison on P and the RLS update of Theta_hat together). P is
-    symmetric; only its upper triangle is read and updated. Each copy takes its columns in
-    order of ``j``. ``z``, ``g`` (n + m,) and ``r`` (2n + m,) are scratch (see :func:`_scratch`).
-    If ``error``, the recursive copies' ``eps`` is set to the error of their final estimate
-    while it is written (summed as :func:`_error` sums it, so the numbers are the same). This
-    is the general path (any mix of copies, with or without the Gram matrix); the steady state
-    of the ideal backend uses :func:`_rls`, which computes the same numbers faster.
+    Every copy adds the columns to its Gram matrix and cross term ``GC = [G | C]`` (the upper
+    triangle of G, mirrored at the end: G is exactly symmetric). The copies flagged in
+    ``ready`` also run recursive least squares on ``Q = [P | Theta_hat^T]``: ``r = z^T Q``,
+    ``r[d:] -= y``, ``g = r[:d] / (1 + r[:d] . z)``, ``Q -= g r`` (Sherman-Morrison on P and
+    the RLS update of Theta_hat together); P is symmetric, only its upper triangle is read and
+    updated. Each copy takes its columns in order of ``j``. ``z``, ``g`` (n + m,) and ``r``
+    (2n + m,) are scratch (see :func:`_scratch`). The steady state uses :func:`_rls` and
+    :func:`_gram` instead, which compute the same numbers as this faster.
     """
     d = n + m
     w = d + n
-    # blocks of copies, period-major inside a block: a block's G, C, Q stay in cache while the
+    # blocks of copies, period-major inside a block: a block's GC, Q stay in cache while the
     # data of one period, contiguous across copies, stream through
     for kb in range(k0, k1, _BLOCK):
         for j in range(first, target):
@@ -153,14 +153,13 @@ def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready,
                     z[i] = X[j - 1, k, i]
                 for i in range(m):
                     z[n + i] = U[j - 1, k, i]
-                if gram:  # upper triangle of G only (mirrored below): G is exactly symmetric
-                    for a in range(d):
-                        za = z[a]
-                        for b in range(a, d):
-                            G[k, a, b] += za * z[b]
-                        for b in range(n):
-                            C[k, a, b] += za * X[j, k, b]
-                if recursive and ready[k]:
+                for a in range(d):  # upper triangle of G, and C
+                    za = z[a]
+                    for b in range(a, d):
+                        GC[a * w + b, k] += za * z[b]
+                    for b in range(n):
+                        GC[a * w + d + b, k] += za * X[j, k, b]
+                if ready[k]:
                     for b in range(w):  # r = z^T Q, summed over a in order, in a register
                         acc = 0.0
                         for a in range(d):
@@ -174,27 +173,47 @@ def _columns(k0, k1, n, m, X, U, first, target, G, C, Q, gram, recursive, ready,
                     inv = 1.0 / den
                     for a in range(d):
                         g[a] = r[a] * inv
-                    last = error and j == target - 1  # the error of the final estimate, as _error sums it
-                    s = 0.0
                     for a in range(d):
                         ga = g[a]
-                        for b in range(a, d):
+                        for b in range(a, w):
                             Q[a * w + b, k] -= ga * r[b]
-                        t = 0.0
-                        for b in range(d, w):
-                            q = Q[a * w + b, k] - ga * r[b]
-                            Q[a * w + b, k] = q
-                            if last:
-                                e = q - theta_true_T[a, b - d]
-                                t += e * e
-                        s += t
-                    if last:
-                        eps[k] = s / c
-    if gram and target > first:
-        for k in range(k0, k1):
-            for a in range(1, d):
-                for b in range(a):
-                    G[k, a, b] = G[k, b, a]
+    if target > first:
+        _mirror(k0, k1, d, w, GC)
+
+
+@njit(inline="always")
+def _mirror(k0, k1, d, w, GC):
+    """Lower triangle of G from its upper triangle."""
+    for a in range(1, d):
+        for b in range(a):
+            for k in range(k0, k1):
+                GC[a * w + b, k] = GC[b * w + a, k]
+
+
+@njit(inline="always")
+def _gram(k0, k1, n, m, X, U, first, target, GC, sc):
+    """The Gram matrix and cross term of :func:`_columns` alone (the catch-up behind the
+    steady state), each operation one loop over the copies, as in :func:`_rls`: the same
+    numbers. ``sc`` (2n + m, K) is scratch: rows ``[z | y]``."""
+    d = n + m
+    w = d + n
+    for j in range(first, target):
+        for i in range(n):
+            for k in range(k0, k1):
+                sc[i, k] = X[j - 1, k, i]
+        for i in range(m):
+            for k in range(k0, k1):
+                sc[n + i, k] = U[j - 1, k, i]
+        for i in range(n):
+            for k in range(k0, k1):
+                sc[d + i, k] = X[j, k, i]
+        for a in range(d):  # G_ab += z_a z_b (b >= a), C_ab += z_a y_b
+            for b in range(a, w):
+                row = a * w + b
+                for k in range(k0, k1):
+                    GC[row, k] += sc[a, k] * sc[b, k]
+    if target > first:
+        _mirror(k0, k1, d, w, GC)
 
 
 @njit(inline="always")
@@ -353,18 +372,16 @@ def shift_history(dims, hist, act):
 
 
 @njit(cache=True, nogil=True)
-def add_columns(dims, X, U, first, target, G, C, Q, ready):
+def add_columns(dims, X, U, first, target, GC, Q, ready):
     n, m = len(dims[0]), len(dims[1])
     _, z, r, g = _scratch(n, m)
-    _columns(0, G.shape[0], n, m, X, U, first, target, G, C, Q, True, True, ready, z, r, g, False, Q[0], 1.0, z)
+    _columns(0, ready.shape[0], n, m, X, U, first, target, GC, Q, ready, z, r, g)
 
 
 @njit(cache=True, nogil=True)
-def add_gram(dims, X, U, first, target, G, C, ready):
+def add_gram(dims, X, U, first, target, GC, sc):
     """Only the Gram matrix and cross term of columns ``first <= j < target`` (catch-up)."""
-    n, m = len(dims[0]), len(dims[1])
-    _, z, r, g = _scratch(n, m)
-    _columns(0, G.shape[0], n, m, X, U, first, target, G, C, G, True, False, ready, z, r, g, False, G[0], 1.0, z)
+    _gram(0, GC.shape[1], len(dims[0]), len(dims[1]), X, U, first, target, GC, sc)
 
 
 @njit(cache=True, nogil=True)

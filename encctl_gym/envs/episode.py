@@ -154,8 +154,12 @@ class EpisodeCore:
         # time-major: the data of all copies for one period are contiguous
         self.X = np.zeros((N, K, n))  # collected (deciphered) states x_0 .. x_{N-1}
         self.U = np.zeros((N, K, m))  # applied inputs u_0 .. u_{N-1}
-        self.G = np.zeros((K, self.d, self.d))  # regressor Gram matrix of the delivered data
-        self.C = np.zeros((K, self.d, n))  # cross term sum z x_next^T
+        # regressor Gram matrix G of the delivered data and cross term C = sum z x_next^T, kept
+        # as [G | C] with the copies innermost (see _kernels); G and C are views of it, (K, d, .)
+        self._GC = np.zeros((self.d * (self.d + n), K))
+        gc = self._GC.reshape(self.d, self.d + n, K).transpose(2, 0, 1)
+        self.G, self.C = gc[:, :, : self.d], gc[:, :, self.d :]
+        self._gram_scratch = np.zeros((self.d + n, K))  # add_gram's, apart from the step's (the helper runs it)
         # recursive least squares [P | Theta_hat^T], P by its upper triangle; copies innermost:
         # entry (a, b) of every copy is row a (d + n) + b (see _kernels)
         self.Q = np.zeros((self.d * (self.d + n), K))
@@ -282,8 +286,7 @@ class EpisodeCore:
             kern.plant_step(self._dims, self.x, self.loop.control(self.x), self._draw_noise(), self._A, self._B)
         self.X[:] = 0.0
         self.U[:] = 0.0
-        self.G[:] = 0.0
-        self.C[:] = 0.0
+        self._GC[:] = 0.0
         self.ready[:] = False
         self._gram_upto = 1
         self._all_ready = False
@@ -309,7 +312,7 @@ class EpisodeCore:
         """Bring G and C up to the columns j < ``upto`` (the fused step leaves them behind)."""
         self._wait_gram()
         if upto > self._gram_upto:
-            kern.add_gram(self._dims, self.X, self.U, self._gram_upto, upto, self.G, self.C, self.ready)
+            kern.add_gram(self._dims, self.X, self.U, self._gram_upto, upto, self._GC, self._gram_scratch)
             self._gram_upto = upto
 
     def _gram_behind(self, upto: int) -> None:
@@ -322,7 +325,7 @@ class EpisodeCore:
             self._wait_gram()
         first, self._gram_upto = self._gram_upto, upto
         self._gram_future = _helper().submit(
-            kern.add_gram, self._dims, self.X, self.U, first, upto, self.G, self.C, self.ready
+            kern.add_gram, self._dims, self.X, self.U, first, upto, self._GC, self._gram_scratch
         )
 
     def _overflow(self) -> None:
@@ -350,7 +353,7 @@ class EpisodeCore:
             and self._since_refresh + target - first < _REFRESH
         ):  # steady state: columns, recursive least squares and error in one compiled call
             self._sync_gram(first)
-            kern.add_columns(self._dims, self.X, self.U, first, target, self.G, self.C, self.Q, self.ready)
+            kern.add_columns(self._dims, self.X, self.U, first, target, self._GC, self.Q, self.ready)
             self._gram_upto = target
             kern.estimation_error(self._dims, self.Q, self._theta_true_T, self._cf, self.ready, self.eps)
             self._since_refresh += target - first
@@ -359,7 +362,7 @@ class EpisodeCore:
             return True
         self._sync_gram(first)
         if target > first:
-            kern.add_columns(self._dims, self.X, self.U, first, target, self.G, self.C, self.Q, self.ready)
+            kern.add_columns(self._dims, self.X, self.U, first, target, self._GC, self.Q, self.ready)
             self._gram_upto = target
         self.delivered = target
         if self.p.reward == "logdet":
