@@ -40,8 +40,9 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         Spread the copies of the steady-state step over the cores (numba ``prange``). The
         numbers are identical. Only the compiled step is spread (the noise draws, the Gram
         catch-up and the Python around the step are not), so whether it pays depends on the
-        machine: on the 2-core development machine it was slower than one core in three
-        benchmark runs of four (``benchmarks/bench_env.py``), hence off by default.
+        machine: on the 2-core development machine it was slower than the default (which
+        leaves the second core to the helper thread) in every run of
+        ``benchmarks/bench_env.py``, hence off by default.
     helper_thread : bool, default True
         Draw the next 256 periods of noise and catch up the Gram matrices of the exact refresh
         on a helper thread while the copies are stepped (the compiled kernels release the GIL).
