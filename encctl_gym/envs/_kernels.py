@@ -191,6 +191,18 @@ def _mirror(k0, k1, d, w, GC):
 
 
 @njit(inline="always")
+def _regressors(k0, k1, n, m, X, U, j, sc):
+    """The regressor ``z = [x_{j-1}; u_{j-1}]`` of every copy into rows ``0 .. n + m - 1`` of
+    ``sc`` (copies innermost)."""
+    for i in range(n):
+        for k in range(k0, k1):
+            sc[i, k] = X[j - 1, k, i]
+    for i in range(m):
+        for k in range(k0, k1):
+            sc[n + i, k] = U[j - 1, k, i]
+
+
+@njit(inline="always")
 def _gram(k0, k1, n, m, X, U, first, target, GC, sc):
     """The Gram matrix and cross term of :func:`_columns` alone (the catch-up behind the
     steady state), each operation one loop over the copies, as in :func:`_rls`: the same
@@ -198,12 +210,7 @@ def _gram(k0, k1, n, m, X, U, first, target, GC, sc):
     d = n + m
     w = d + n
     for j in range(first, target):
-        for i in range(n):
-            for k in range(k0, k1):
-                sc[i, k] = X[j - 1, k, i]
-        for i in range(m):
-            for k in range(k0, k1):
-                sc[n + i, k] = U[j - 1, k, i]
+        _regressors(k0, k1, n, m, X, U, j, sc)
         for i in range(n):
             for k in range(k0, k1):
                 sc[d + i, k] = X[j, k, i]
@@ -279,12 +286,7 @@ def _rls(k0, k1, n, m, X, U, first, target, Q, sc, theta_true_T, c, eps):
     iv = d + w  # row of 1 / den
     es = iv + 1  # row of the error sums
     for j in range(first, target):
-        for i in range(n):
-            for k in range(k0, k1):
-                sc[i, k] = X[j - 1, k, i]
-        for i in range(m):
-            for k in range(k0, k1):
-                sc[n + i, k] = U[j - 1, k, i]
+        _regressors(k0, k1, n, m, X, U, j, sc)
         for b in range(w):  # r = z^T Q, summed over a in order
             for k in range(k0, k1):
                 sc[d + b, k] = 0.0
