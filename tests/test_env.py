@@ -238,24 +238,26 @@ def test_a_constant_input_gets_the_minimum_norm_estimate_every_step():
 
 
 # ------------------------------------------------------------------ backends and vector env
-def test_vector_env_matches_single_envs_bit_for_bit():
-    K = 5
-    venv = EncryptedLTIAttackVectorEnv(num_envs=K, config=SMALL)
-    singles = [EncryptedLTIAttackEnv(config=SMALL) for _ in range(K)]
+@pytest.mark.parametrize("gamma_opt", [False, True])
+def test_vector_env_matches_single_envs_bit_for_bit(gamma_opt):
+    K, cfg = 5, {**SMALL, "gamma_opt": gamma_opt}
+    venv = EncryptedLTIAttackVectorEnv(num_envs=K, config=cfg)
+    singles = [EncryptedLTIAttackEnv(config=cfg) for _ in range(K)]
     obs_v, _ = venv.reset(seed=100)
     obs_s = [e.reset(seed=100 + i)[0] for i, e in enumerate(singles)]
     assert np.array_equal(obs_v, np.stack(obs_s))
     rng = np.random.default_rng(0)
     for _ in range(venv.params.horizon + 2):  # through the end and the autoreset
         acts = random_actions(rng, K, venv.params.m)
-        obs_v, r_v, te_v, tr_v, _ = venv.step(acts)
+        obs_v, r_v, te_v, tr_v, info_v = venv.step(acts)
         for i, e in enumerate(singles):
             if e._core.done:
-                obs, _ = e.reset()
+                obs, info = e.reset()
                 r, te = 0.0, False
             else:
-                obs, r, te, _, _ = e.step(acts[i])
+                obs, r, te, _, info = e.step(acts[i])
             assert np.array_equal(obs_v[i], obs) and r_v[i] == r and te_v[i] == te
+            assert info_v.keys() == info.keys() and all(info_v[key][i] == info[key] for key in info)
 
 
 @pytest.mark.parametrize("scheme", ["modified", "token", "static"])

@@ -256,6 +256,23 @@ def _observation(k0, k1, n, m, H, obs, X, U, j, new, hist, time_frac, energy, bu
 
 
 @njit(inline="always")
+def _info(k0, k1, f, counts, eps, energy, gamma, time, power_den, gamma_opt, collected, delivered):
+    """The info rows: epsilon, gamma, deciphering time, input energy, average power
+    (energy / power_den) and, if ``f`` has a sixth row, gamma_opt; the sample counts."""
+    for k in range(k0, k1):
+        f[0, k] = eps[k]
+        f[1, k] = gamma
+        f[2, k] = time
+        f[3, k] = energy[k]
+        f[4, k] = energy[k] / power_den
+        counts[0, k] = collected
+        counts[1, k] = delivered
+    if f.shape[0] > 5:
+        for k in range(k0, k1):
+            f[5, k] = gamma_opt
+
+
+@njit(inline="always")
 def _period(
     k0, k1, n, m, H, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
     x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, tmp,
@@ -437,19 +454,8 @@ def load_actions(src, dst):
 
 @njit(cache=True, nogil=True)
 def fill_info(f, counts, eps, energy, gamma, time, power_den, gamma_opt, collected, delivered):
-    """The info rows of every copy: epsilon, gamma, deciphering time, input energy, average
-    power (energy / power_den) and, if ``f`` has a sixth row, gamma_opt; the sample counts."""
-    for k in range(f.shape[1]):
-        f[0, k] = eps[k]
-        f[1, k] = gamma
-        f[2, k] = time
-        f[3, k] = energy[k]
-        f[4, k] = energy[k] / power_den
-        counts[0, k] = collected
-        counts[1, k] = delivered
-    if f.shape[0] > 5:
-        for k in range(f.shape[1]):
-            f[5, k] = gamma_opt
+    """The info of every copy (see :func:`_info`)."""
+    _info(0, f.shape[1], f, counts, eps, energy, gamma, time, power_den, gamma_opt, collected, delivered)
 
 
 @njit(cache=True, nogil=True)
@@ -477,11 +483,13 @@ def step_fused(
     dims, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
     x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
     first, target, Q, sc, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
+    info, counts, gamma, time, power_den, gamma_opt, collected, delivered,
 ):
     """A whole steady-state ideal-backend period for every copy in one call: the period, the
     delivery by recursive least squares, the error, the reward and the observation (the Gram
     matrices are left behind; :func:`add_gram` catches them up when they are needed). Stage
-    by stage over the whole batch: measured faster here than chunk by chunk.
+    by stage over the whole batch: measured faster here than chunk by chunk. Also writes the
+    info rows (see :func:`_info`) for the period's new sample counts.
     """
     K = act.shape[0]
     n, m, H = len(dims[0]), len(dims[1]), len(dims[2])
@@ -494,6 +502,7 @@ def step_fused(
         return status
     _deliver(0, K, n, m, X, U, first, target, Q, sc, theta_true_T, c, eps, reward)
     _observation(0, K, n, m, H, obs, X, U, j_obs, new, hist, time_frac, energy, budget)
+    _info(0, K, info, counts, eps, energy, gamma, time, power_den, gamma_opt, collected, delivered)
     return OK
 
 
@@ -502,6 +511,7 @@ def step_fused_parallel(
     dims, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
     x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
     first, target, Q, sc, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
+    info, counts, gamma, time, power_den, gamma_opt, collected, delivered,
 ):
     """:func:`step_fused` with its chunks spread over the cores (``prange``): the same stages
     on the same chunks, which do not interact, so the numbers are identical."""
@@ -522,4 +532,5 @@ def step_fused_parallel(
         else:
             _deliver(k0, k1, n, m, X, U, first, target, Q, sc, theta_true_T, c, eps, reward)
             _observation(k0, k1, n, m, H, obs, X, U, j_obs, new, hist, time_frac, energy, budget)
+            _info(k0, k1, info, counts, eps, energy, gamma, time, power_den, gamma_opt, collected, delivered)
     return status.max()

@@ -184,6 +184,9 @@ class EpisodeCore:
         self.new = False
         self.done = False
         self._obs_out: np.ndarray | None = None  # observation written by the fused step, not yet handed out
+        self._info_out: tuple[np.ndarray, np.ndarray] | None = None  # so the info (its two buffers)
+        self._info_in_step = K > 1
+        self._info_unread = (*self._info_buffers(), 0.0, 0.0, 1.0, 0.0, 0, 0)
         self._act = np.zeros((K, m))  # the actions of the current step, float64
         self._obs_shape = (K, p.obs_dim)
         self._a = np.zeros((K, m))
@@ -281,7 +284,7 @@ class EpisodeCore:
             raise ParameterError(f"expected {self.K} random generators, got {len(rngs)}")
         self.wait()  # the helper may still be drawing from the old generators or adding to G
         self._rngs = rngs
-        self._obs_out = None
+        self._obs_out = self._info_out = None
         for i, g in enumerate(rngs):
             self.x[i] = g.standard_normal(self.n) * self._sx
         self._noise_pos = _CHUNK
@@ -457,13 +460,19 @@ class EpisodeCore:
             if self._since_refresh + target - first < _REFRESH:
                 new = target > self.delivered
                 obs = np.empty(self._obs_shape, dtype=np.float32)
+                N, collected = (target if new else self.delivered), self.collected + 1
+                # the vector env's info arrays are written by the same call; a single env, whose
+                # info is Python scalars, gives it buffers it does not read
+                info_args = self._info_unread
+                if self._info_in_step:
+                    info_args = (*self._info_buffers(), *self._info_scalars(collected, N))
                 status = self._step_fused(
                     self._dims, act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
                     self.X, self.U, self.collected - 1, self.collected, self.hist,
                     self._a, self._qa, self._qx,
                     first, target, self.Q, self._rls_scratch, self._theta_true_T, self._cf, self.eps,
-                    self._reward, obs, (target if new else self.delivered) - 1, float(new),
-                    float(self._time_frac[self.collected + 1]),
+                    self._reward, obs, N - 1, float(new), float(self._time_frac[collected]),
+                    *info_args,
                 )
                 if status == kern.STATE_OVERFLOW:
                     self._overflow()
@@ -476,8 +485,10 @@ class EpisodeCore:
                     if self._use_helper and target - self._gram_upto >= _GRAM_BATCH:
                         self._gram_behind(target)
                 self._obs_out = obs
+                if self._info_in_step:
+                    self._info_out = (info_args[0], info_args[1])
                 return self._reward.copy(), False, False
-        self._obs_out = None
+        self._obs_out = self._info_out = None
         if self._fused is not None:  # ideal backend: one compiled call
             status = kern.step_ideal(
                 self._dims, act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
@@ -523,16 +534,24 @@ class EpisodeCore:
             )
         return obs
 
-    def info_arrays(self) -> dict[str, np.ndarray]:
-        """Info of every copy as arrays of shape (K,) (keys as in :meth:`info`); rows of two
-        fresh buffers, one float and one integer, filled in one compiled call."""
-        N = self.delivered
-        f = np.empty((6 if self.has_gamma_opt else 5, self.K))
-        counts = np.empty((2, self.K), dtype=np.int64)
-        kern.fill_info(
-            f, counts, self.eps, self.energy, float(self.gamma_table[N]), float(self.time_table[self.collected]),
-            float(max(self.collected, 1) * self.m), float(self.gamma_opt_table[N]), self.collected, N,
+    def _info_buffers(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.empty((6 if self.has_gamma_opt else 5, self.K)), np.empty((2, self.K), dtype=np.int64)
+
+    def _info_scalars(self, collected: int, N: int) -> tuple[float, float, float, float, int, int]:
+        """The info entries shared by all copies, as :func:`kern.fill_info` takes them."""
+        return (
+            float(self.gamma_table[N]), float(self.time_table[collected]), float(max(collected, 1) * self.m),
+            float(self.gamma_opt_table[N]), collected, N,
         )
+
+    def info_arrays(self) -> dict[str, np.ndarray]:
+        """Info of every copy as arrays of shape (K,) (keys as in :meth:`info`): rows of two new
+        buffers, one float and one integer, filled by the fused step or, if it did not run, now."""
+        bufs, self._info_out = self._info_out, None
+        if bufs is None:
+            bufs = self._info_buffers()
+            kern.fill_info(*bufs, self.eps, self.energy, *self._info_scalars(self.collected, self.delivered))
+        f, counts = bufs
         info = {
             "epsilon": f[0],
             "gamma": f[1],
