@@ -184,7 +184,7 @@ class EpisodeCore:
         self.new = False
         self.done = False
         self._obs_out: np.ndarray | None = None  # observation written by the fused step, not yet handed out
-        self._info_out: tuple[np.ndarray, np.ndarray] | None = None  # so the info (its two buffers)
+        self._info_out: tuple[np.ndarray, np.ndarray] | None = None  # and the info arrays (two buffers), likewise
         self._info_in_step = K > 1
         self._info_unread = (*self._info_buffers(), 0.0, 0.0, 1.0, 0.0, 0, 0)
         self._act = np.zeros((K, m))  # the actions of the current step, float64
