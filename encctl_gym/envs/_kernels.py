@@ -44,8 +44,9 @@ _BLOCK = 16
 # ----------------------------------------------------------------------------- stages
 @njit(inline="always")
 def _scratch(n, m):
-    """Scratch vectors of the stages, allocated once per kernel call: (n,), (n + m,), (2n + m,), (n + m,)."""
-    return np.empty(n), np.empty(n + m), np.empty(2 * n + m), np.empty(n + m)
+    """Scratch vectors ``z``, ``r``, ``g`` of :func:`_columns`, allocated once per kernel call:
+    (n + m,), (2n + m,), (n + m,)."""
+    return np.empty(n + m), np.empty(2 * n + m), np.empty(n + m)
 
 
 @njit(inline="always")
@@ -393,7 +394,7 @@ def shift_history(dims, hist, act):
 @njit(cache=True, nogil=True)
 def add_columns(dims, X, U, first, target, GC, Q, ready):
     n, m = len(dims[0]), len(dims[1])
-    _, z, r, g = _scratch(n, m)
+    z, r, g = _scratch(n, m)
     _columns(0, ready.shape[0], n, m, X, U, first, target, GC, Q, ready, z, r, g)
 
 
