@@ -29,7 +29,8 @@ if __package__ in (None, ""):
 import numpy as np
 
 from encctl_gym.sim.montecarlo import gaussian_attack_errors, log_grid
-from encctl_gym.sim.plant import LinearPlant, as_seed_sequence
+from encctl_gym.parallel import as_seed_sequence
+from encctl_gym.sim.plant import LinearPlant
 
 
 def loop_errors(plant: LinearPlant, grid: np.ndarray, runs: int, sigma_u2: float, seed: int) -> np.ndarray:

@@ -82,7 +82,7 @@ def compute(
         Master seed; the figure uses child 1 of ``SeedSequence(seed)`` and panel ``k`` its child
         ``k``, so a panel does not depend on the others or on the workers.
     n_jobs, scheduler, progress
-        Parallel execution (see :func:`encctl_gym.sim.parallel.run_tasks`).
+        Parallel execution (see :func:`encctl_gym.parallel.run_tasks`).
     Returns
     -------
     Table

@@ -83,7 +83,7 @@ def compute(
     seed
         Master seed; the figure uses child 2 of ``SeedSequence(seed)``, panel ``k`` its child ``k``.
     n_jobs, scheduler, progress
-        Parallel execution (see :func:`encctl_gym.sim.parallel.run_tasks`).
+        Parallel execution (see :func:`encctl_gym.parallel.run_tasks`).
 
     Returns
     -------

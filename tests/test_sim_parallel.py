@@ -9,7 +9,7 @@ import pytest
 
 from encctl_gym.errors import ConfigError, EncctlError, ParameterError, ShapeError
 from encctl_gym.sim.montecarlo import AttackSpec, gaussian_attack_errors, log_grid, sweep_gaussian_attack
-from encctl_gym.sim.parallel import child_seeds, run_tasks
+from encctl_gym.parallel import child_seeds, run_tasks
 from encctl_gym.sim.plant import LinearPlant
 
 

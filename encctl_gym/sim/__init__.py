@@ -1,7 +1,8 @@
 """Numerical engine: the plant of eq:system, least-squares identification (eq:estimate) and
 its error (Definition def:error) on grids of sample sizes, and seeded parallel sweeps.
 
-Modules import downward only: ``plant -> identification -> parallel -> montecarlo``.
+Modules import downward only: ``plant -> identification -> montecarlo``; sweeps run on
+:func:`encctl_gym.parallel.run_tasks`.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from .identification import (
     prefix_estimates,
 )
 from .montecarlo import AttackSpec, gaussian_attack_errors, log_grid, sweep_gaussian_attack
-from .parallel import child_seeds, run_tasks
+from ..parallel import child_seeds, run_tasks
 from .plant import LinearPlant, SimulationResult, simulate, simulate_gaussian_attack
 
 __all__ = [

@@ -3,7 +3,7 @@
 One task = one system: ``runs`` trajectories of length ``N_max`` under i.i.d. Gaussian attack
 inputs (Theorem thm:sic), and the error ``epsilon(N)`` of Definition def:error on a whole grid
 of sample sizes from each trajectory (:func:`~encctl_gym.sim.identification.identification_errors`).
-A sweep spreads systems over workers with :func:`~encctl_gym.sim.parallel.run_tasks`, one
+A sweep spreads systems over workers with :func:`~encctl_gym.parallel.run_tasks`, one
 child seed per system.
 """
 
@@ -16,9 +16,9 @@ import numpy as np
 
 from .._validation import check_int, check_nonnegative
 from ..errors import ParameterError
+from ..parallel import SeedLike, run_tasks
 from .identification import check_sample_sizes, identification_errors
-from .parallel import run_tasks
-from .plant import LinearPlant, SeedLike, simulate_gaussian_attack
+from .plant import LinearPlant, simulate_gaussian_attack
 
 __all__ = ["AttackSpec", "gaussian_attack_errors", "sweep_gaussian_attack", "log_grid"]
 
@@ -137,7 +137,7 @@ def sweep_gaussian_attack(
         System ``i`` uses child ``i`` of ``SeedSequence(seed)``; the result does not depend on
         ``n_jobs`` or ``scheduler``.
     n_jobs, scheduler, cluster_kwargs, progress, desc
-        See :func:`~encctl_gym.sim.parallel.run_tasks`.
+        See :func:`~encctl_gym.parallel.run_tasks`.
 
     Returns
     -------

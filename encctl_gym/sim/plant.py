@@ -27,6 +27,7 @@ import numpy as np
 
 from .._validation import as_finite_array, check_int, check_nonnegative, check_positive, check_system
 from ..errors import ParameterError, ShapeError
+from ..parallel import SeedLike, as_seed_sequence
 
 __all__ = [
     "LinearPlant",
@@ -36,29 +37,6 @@ __all__ = [
     "simulate",
     "simulate_gaussian_attack",
 ]
-
-SeedLike = Union[int, np.integer, np.random.SeedSequence]
-"""An integer seed or a :class:`numpy.random.SeedSequence`."""
-
-Size = Union[int, tuple[int, ...], None]
-
-
-def as_seed_sequence(seed: SeedLike) -> np.random.SeedSequence:
-    """Return ``seed`` as a :class:`numpy.random.SeedSequence`.
-
-    Parameters
-    ----------
-    seed
-        A non-negative integer or a ``SeedSequence`` (returned unchanged).
-
-    Returns
-    -------
-    numpy.random.SeedSequence
-    """
-    if isinstance(seed, np.random.SeedSequence):
-        return seed
-    return np.random.SeedSequence(check_int("seed", seed, minimum=0))
-
 
 def _size_tuple(size: Size) -> tuple[int, ...]:
     if size is None:
