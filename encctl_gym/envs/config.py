@@ -20,11 +20,15 @@ from ..security.complexity import sic_from_traces
 from ..security.deciphering import ADVERSARIES, SCHEMES, keys_to_break, max_affordable_samples, per_sample_cost
 from ..security.design import bit_security_of_key_length, design_from_traces, minimum_key_length
 from ..security.gramians import controllability_gramian, noise_gramian
+from ..loop import BACKENDS as _LOOP_BACKENDS
+from .layout import ObservationLayout
+from .rewards import REWARDS as _REWARD_CLASSES
 
 __all__ = ["default_config", "AttackParams", "resolve_params", "REWARDS", "BACKENDS"]
 
-REWARDS = ("log_error", "logdet")
-BACKENDS = ("ideal", "elgamal")
+#: Names of the rewards (:data:`encctl_gym.envs.rewards.REWARDS`) and backends (:data:`encctl_gym.loop.BACKENDS`).
+REWARDS: tuple[str, ...] = tuple(_REWARD_CLASSES)
+BACKENDS: tuple[str, ...] = tuple(_LOOP_BACKENDS)
 
 
 def default_config() -> dict[str, Any]:
@@ -138,20 +142,17 @@ class AttackParams:
         return self.m * self.sigma_u2 * self.horizon
 
     @property
+    def layout(self) -> ObservationLayout:
+        """The observation layout of this environment."""
+        return ObservationLayout.of(self)
+
+    @property
     def obs_dim(self) -> int:
-        return self.n + self.m + 1 + self.input_history * self.m + 2
+        return self.layout.dim
 
     def observation_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Finite bounds of the observation: states within the encoder's declared range
-        ``x_bound`` (encoding beyond it raises) plus the encoder's largest shift to the group
-        (64/Delta), inputs within the actuator bound plus the forged input's quantisation,
-        flag and fractions within [0, 1]."""
-        n, m, H = self.n, self.m, self.input_history
-        x_hi = self.x_bound + 65.0 / self.delta
-        u_hi = (self.u_max + 65.0 / self.delta) * (1.0 + 65.0 / self.delta) + n / self.delta**2
-        high = np.concatenate([np.full(n, x_hi), np.full(m, u_hi), [1.0], np.ones(H * m), [1.0, 1.0]])
-        low = np.concatenate([-high[: n + m], [0.0], -np.ones(H * m), [0.0, 0.0]])
-        return low.astype(np.float32), high.astype(np.float32)
+        """Finite bounds of the observation (:meth:`ObservationLayout.bounds`)."""
+        return self.layout.bounds(x_bound=self.x_bound, u_max=self.u_max, delta=self.delta)
 
     def gamma(self, N: Any) -> Any:
         """gamma(N) of eq:sic (Theorem thm:sic) for this plant and the attacker's input power."""
