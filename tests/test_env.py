@@ -513,3 +513,82 @@ def _step_past_a_chunk() -> None:
     for _ in range(300):
         venv.step(np.zeros((2, venv.params.m), np.float32))
     venv.close()
+
+
+# ------------------------------------------------------------------ hardening (issue 16 classes)
+@pytest.mark.parametrize(
+    "overrides,error,text",
+    [
+        ({"gamma_opt": "no"}, ParameterError, "gamma_opt"),
+        ({"gamma_opt": 1}, ParameterError, "gamma_opt"),
+        ({"preset": ["small"]}, ParameterError, "preset"),
+        ({"decipher_delay": np.array([1, 2])}, ParameterError, "decipher_delay"),
+        ({"scheme": ["modified"]}, ParameterError, "scheme"),
+        ({"warmup_steps": 10**9}, ParameterError, "warmup_steps"),
+        ({"input_history": 10**9}, ParameterError, "GiB"),
+        ({"scheme": "static", "max_samples": 10**12}, ParameterError, "GiB"),
+    ],
+)
+def test_bad_values_are_refused_before_any_work(overrides, error, text):
+    with pytest.raises(error, match=text):
+        EncryptedLTIAttackEnv(config={**SMALL, **overrides})
+
+
+def test_a_config_that_is_not_a_mapping_is_a_config_error():
+    from encctl_gym.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="abc"):
+        EncryptedLTIAttackEnv(config="abc")
+
+
+def test_a_huge_batch_is_refused_with_its_memory_estimate():
+    with pytest.raises(ParameterError, match=r"num_envs = 1000000 .* GiB"):
+        EncryptedLTIAttackVectorEnv(num_envs=10**6, config=SMALL)
+
+
+def test_step_before_reset_and_bool_seeds_are_refused():
+    env = EncryptedLTIAttackEnv(config=SMALL)
+    with pytest.raises(ParameterError, match="before reset"):
+        env.step(np.zeros(2, np.float32))
+    with pytest.raises(ParameterError, match="seed"):
+        env.reset(seed=True)
+    venv = EncryptedLTIAttackVectorEnv(num_envs=2, config=SMALL)
+    with pytest.raises(ParameterError, match="seed"):
+        venv.reset(seed=[0, True])
+    with pytest.raises(ParameterError, match="seed"):
+        venv.reset(seed=-1)
+
+
+@pytest.mark.parametrize("action", [["a", "b"], [1 + 2j, 0.0], np.array([0.5 + 0.1j, 0.0]), None])
+def test_non_numeric_and_complex_actions_are_refused(action):
+    env = EncryptedLTIAttackEnv(config=SMALL)
+    env.reset(seed=0)
+    with pytest.raises(ParameterError, match="action"):
+        env.step(action)
+
+
+def test_a_tiny_logdet_regularization_still_gives_finite_rewards():
+    env = EncryptedLTIAttackEnv(config={**SMALL, "reward": "logdet", "logdet_regularization": 1e-300})
+    env.reset(seed=0)
+    rewards = [env.step(env.action_space.sample())[1] for _ in range(20)]
+    assert all(math.isfinite(r) for r in rewards)
+
+
+def test_a_users_plant_is_not_completed_from_the_default_preset():
+    A, B = [[0.5, 0.0], [0.1, 0.4]], [[1.0], [0.5]]
+    with pytest.raises(ParameterError) as err:
+        resolve_params({"A": A, "B": B})
+    for key in ("sigma_w2", "sigma_u2", "upsilon", "tau_c", "gamma_c"):
+        assert key in str(err.value)  # every missing value named at once
+    full = {"A": A, "B": B, "sigma_w2": 0.1, "sigma_u2": 1.0, "upsilon": 1e9, "tau_c": 1e3, "gamma_c": 1e-3, "key_length": 64}
+    p = resolve_params(full)
+    assert p.sources["sigma_x2"] == "default" and p.sources["A"] == "config" and p.sources["tau_c"] == "config"
+    with pytest.warns(UserWarning, match="preset 'small'.*sigma_w2"):
+        q = resolve_params({"preset": "small", "A": A, "B": B, "gamma_opt": False})
+    assert q.sources["sigma_w2"] == "preset small" and q.sources["A"] == "config"
+
+
+@pytest.mark.parametrize("x_bound", [2e4, 1e6])
+def test_a_quantisation_table_too_large_is_refused_with_its_size(x_bound):
+    with pytest.raises(ParameterError, match="x_bound.*GiB"):
+        EncryptedLTIAttackEnv(config={**SMALL, "x_bound": x_bound})

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import EncodingOverflowError, GroupError, ParameterError
 
-__all__ = ["ResidueTable", "residue_table"]
+__all__ = ["ResidueTable", "residue_table", "table_bytes", "PEAK_BYTES_PER_ENTRY"]
 
 
 def _legendre_table(p: int, limit: int) -> np.ndarray:
@@ -122,3 +122,13 @@ class ResidueTable:
 def residue_table(p: int, limit: int) -> ResidueTable:
     """A cached :class:`ResidueTable` (built once per process for each ``(p, limit)``)."""
     return ResidueTable(p, limit)
+
+
+#: Peak bytes the construction of a :class:`ResidueTable` allocates per unit of ``limit`` (the
+#: sieve and the search arrays; measured with tracemalloc: 121 at limits 1e5 to 4e6).
+PEAK_BYTES_PER_ENTRY = 128
+
+
+def table_bytes(limit: int) -> int:
+    """Estimated peak bytes of building the residue table of ``limit`` (:data:`PEAK_BYTES_PER_ENTRY`)."""
+    return PEAK_BYTES_PER_ENTRY * (int(limit) + 64)

@@ -8,13 +8,14 @@ the user's ``config`` and keyword arguments and resolved once into an immutable
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+import warnings
+from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 import numpy as np
 
 from .._validation import check_int, check_nonnegative, check_positive, check_schur_stable, check_system
-from ..errors import BudgetError, ParameterError
+from ..errors import BudgetError, ConfigError, ParameterError
 from ..presets import get_preset
 from ..security.complexity import sic_from_traces
 from ..security.deciphering import ADVERSARIES, SCHEMES, keys_to_break, max_affordable_samples, per_sample_cost
@@ -127,6 +128,7 @@ class AttackParams:
     crypto_seed: int | None
     tr_psi_u: float
     tr_psi_w: float
+    sources: dict[str, str] = field(default_factory=dict)  # where A, B, the variances and design values came from
 
     @property
     def n(self) -> int:
@@ -159,52 +161,99 @@ class AttackParams:
         return sic_from_traces(N, self.tr_psi_u, self.tr_psi_w, self.m, self.n, self.sigma_u2, self.sigma_w2, self.sigma_x2)
 
 
+#: Longest warm-up accepted: the warm-up runs the encrypted controller period by period, and the
+#: plant forgets x_0 geometrically fast under it, so more is never needed.
+MAX_WARMUP_STEPS = 100_000
+
+#: Values taken from the preset, the package's defaults or the configuration, by key
+#: (:attr:`AttackParams.sources`).
+SOURCE_KEYS = ("A", "B", "sigma_w2", "sigma_x2", "sigma_u2", "upsilon", "tau_c", "gamma_c")
+
+
 def _choice(name: str, value: Any, options: tuple[str, ...]) -> str:
-    if value not in options:
+    if not isinstance(value, str) or value not in options:
         raise ParameterError(f"unknown {name} {value!r}; choose one of {', '.join(options)}")
     return value
+
+
+def _flag(name: str, value: Any) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise ParameterError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
 
 
 def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> AttackParams:
     """Merge ``config`` and ``kwargs`` over :func:`default_config` and validate everything.
 
+    A plant given by ``A`` and ``B`` without a ``preset`` key is not completed from the default
+    preset: then every variance and design value must be given (all missing ones are named at
+    once). With an explicit preset and ``A``/``B``, the other values come from the preset and a
+    warning says which. :attr:`AttackParams.sources` records where each value came from.
+
     Raises
     ------
     ParameterError
         Unknown keys, schemes, backends, rewards or presets; non-positive Upsilon, tau_c or
-        variances; an unstable A (UnstableSystemError); mismatched shapes (ShapeError).
+        variances; an unstable A (UnstableSystemError); mismatched shapes (ShapeError); a flag
+        that is not a bool; missing values without a preset.
+    ConfigError
+        A configuration that is not a mapping.
     BudgetError
         A budget too small to identify anything (fewer than n + m + 1 samples).
     """
+    if config is not None and not isinstance(config, Mapping):
+        raise ConfigError(f"config must be a mapping of configuration keys to values, got {config!r}")
     cfg = default_config()
     merged = dict(config or {})
     merged.update(kwargs)
-    unknown = sorted(set(merged) - set(cfg))
+    unknown = sorted(set(merged) - set(cfg), key=str)
     if unknown:
         raise ParameterError(f"unknown configuration key(s) {unknown}; known keys: {sorted(cfg)}")
     cfg.update(merged)
-
-    preset = get_preset(cfg["preset"]) if cfg["preset"] is not None else None
+    if ("A" in merged or "B" in merged) and "preset" not in merged:
+        cfg["preset"] = None  # a plant of the user's is not silently completed from the default preset
+    name = cfg["preset"]
+    if name is not None and not isinstance(name, str):
+        raise ParameterError(f"preset must be a preset name or None, got {name!r}")
+    preset = get_preset(name) if name is not None else None
     if preset is None and (cfg["A"] is None or cfg["B"] is None):
         raise ParameterError("without a preset, both A and B must be given")
-    A, B = check_system(
-        cfg["A"] if cfg["A"] is not None else preset.A,
-        cfg["B"] if cfg["B"] is not None else preset.B,
-    )
+    sources: dict[str, str] = {}
+    missing: list[str] = []
+
+    def pick(key: str, default: Any = None) -> Any:
+        if cfg[key] is not None:
+            sources[key] = "config"
+            return cfg[key]
+        if preset is not None:
+            sources[key] = f"preset {preset.name}"
+            return getattr(preset, key)
+        if default is not None:
+            sources[key] = "default"
+            return default
+        missing.append(key)
+        return None
+
+    A, B = check_system(pick("A"), pick("B"))
     check_schur_stable(A)
+    raw = {key: pick(key, 1.0 if key == "sigma_x2" else None) for key in SOURCE_KEYS[2:]}
+    if missing:
+        raise ParameterError(f"without a preset these values must be given too: {', '.join(missing)}")
+    if preset is not None and {"A", "B"} & set(merged):
+        inherited = [k for k in SOURCE_KEYS if sources[k].startswith("preset")]
+        warnings.warn(
+            f"A/B are given and the other values come from preset {preset.name!r}: {', '.join(inherited)}; "
+            "pass preset=None to give them all yourself",
+            UserWarning,
+            stacklevel=3,
+        )
 
-    def pick(key: str, default: float | None) -> Any:
-        value = cfg[key] if cfg[key] is not None else (getattr(preset, key) if preset is not None else default)
-        if value is None:
-            raise ParameterError(f"{key} must be given when no preset is used")
-        return value
-
-    sigma_w2 = check_positive("sigma_w2", pick("sigma_w2", None))
-    sigma_x2 = check_nonnegative("sigma_x2", pick("sigma_x2", 1.0))
-    sigma_u2 = check_positive("sigma_u2", pick("sigma_u2", None))
-    upsilon = check_positive("upsilon", pick("upsilon", None))
-    tau_c = check_positive("tau_c", pick("tau_c", None))
-    gamma_c = check_positive("gamma_c", pick("gamma_c", None))
+    sigma_w2 = check_positive("sigma_w2", raw["sigma_w2"])
+    sigma_x2 = check_nonnegative("sigma_x2", raw["sigma_x2"])
+    sigma_u2 = check_positive("sigma_u2", raw["sigma_u2"])
+    upsilon = check_positive("upsilon", raw["upsilon"])
+    tau_c = check_positive("tau_c", raw["tau_c"])
+    gamma_c = check_positive("gamma_c", raw["gamma_c"])
     scheme = _choice("scheme", cfg["scheme"], SCHEMES)
     adversary = _choice("adversary", cfg["adversary"], ADVERSARIES)
     reward = _choice("reward", cfg["reward"], REWARDS)
@@ -255,12 +304,15 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         )
 
     delay = cfg["decipher_delay"]
-    if delay == "end":
+    if isinstance(delay, str):
+        if delay != "end":
+            raise ParameterError(f"decipher_delay must be a non-negative integer or 'end', got {delay!r}")
         delay_v: int | None = None
-    elif isinstance(delay, str):
-        raise ParameterError(f"decipher_delay must be a non-negative integer or 'end', got {delay!r}")
     else:
         delay_v = check_int("decipher_delay", delay, minimum=0)
+    warmup = check_int("warmup_steps", cfg["warmup_steps"], minimum=0)
+    if warmup > MAX_WARMUP_STEPS:
+        raise ParameterError(f"warmup_steps must be <= {MAX_WARMUP_STEPS} (MAX_WARMUP_STEPS), got {warmup}")
 
     delta = check_int("delta", cfg["delta"], minimum=2)
     action_scale = check_positive("action_scale", cfg["action_scale"])
@@ -273,12 +325,12 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         upsilon=upsilon, tau_c=tau_c, gamma_c=gamma_c,
         sample_cost=per_sample_cost(lam, upsilon), budget_samples=budget,
         horizon=horizon, independent_keys=keys_to_break(2, scheme, adversary) == 2, budget_limited=budget_limited, decipher_delay=delay_v,
-        warmup_steps=check_int("warmup_steps", cfg["warmup_steps"], minimum=0),
+        warmup_steps=warmup,
         reward=reward,
         logdet_regularization=check_positive("logdet_regularization", cfg["logdet_regularization"]),
         crypto=crypto, delta=delta, x_bound=check_positive("x_bound", cfg["x_bound"]),
         u_max=action_scale * math.sqrt(sigma_u2),
         input_history=check_int("input_history", cfg["input_history"], minimum=0),
-        gamma_opt=bool(cfg["gamma_opt"]), crypto_seed=crypto_seed,
-        tr_psi_u=tr_psi_u, tr_psi_w=tr_psi_w,
+        gamma_opt=_flag("gamma_opt", cfg["gamma_opt"]), crypto_seed=crypto_seed,
+        tr_psi_u=tr_psi_u, tr_psi_w=tr_psi_w, sources=sources,
     )

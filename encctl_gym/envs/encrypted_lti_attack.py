@@ -11,12 +11,21 @@ from gymnasium import spaces
 from ..errors import ParameterError
 from ..loop import LoopBackend, make_loop
 from .config import AttackParams, default_config, resolve_params
-from .episode import EpisodeCore, EpisodeSchedule, attack_design_for
+from .episode import EpisodeCore, EpisodeSchedule, attack_design_for, check_episode_memory
 
-__all__ = ["EncryptedLTIAttackEnv", "reset_options"]
+__all__ = ["EncryptedLTIAttackEnv", "reset_options", "check_seed"]
 
 #: The keys ``reset(options=...)`` accepts (see :meth:`EpisodeCore.reset`).
 RESET_OPTIONS = ("x0", "noise")
+
+
+def check_seed(seed: Any) -> int | None:
+    """A reset seed: ``None`` or a non-negative integer (not a bool)."""
+    if seed is None:
+        return None
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ParameterError(f"seed must be None or a non-negative integer, got {seed!r}")
+    return int(seed)
 
 
 def reset_options(options: dict[str, Any] | None) -> dict[str, Any]:
@@ -172,6 +181,7 @@ class EncryptedLTIAttackEnv(gym.Env):
             raise ParameterError(f"unknown render_mode {render_mode!r}; choose one of {self.metadata['render_modes']}")
         self.render_mode = render_mode
         p = self.params
+        check_episode_memory(p, 1, schedule)  # before anything is sized by the parameters
         self.action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
         self.observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
         self.design = attack_design_for(p) if p.gamma_opt else None
@@ -195,7 +205,7 @@ class EncryptedLTIAttackEnv(gym.Env):
         return self._core
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
-        super().reset(seed=seed)
+        super().reset(seed=check_seed(seed))
         obs = self._core.reset(self.np_random, **reset_options(options))
         return obs[0], self._core.info()
 

@@ -42,13 +42,14 @@ import numpy as np
 from .._validation import as_finite_array, check_int, check_positive
 from ..errors import EncodingOverflowError, ParameterError, ShapeError
 from ..loop import LoopBackend
+from ..resources import check_memory
 from . import _kernels as kern
 from .config import AttackParams
 from .helper import HelperThread
 from .layout import ObservationLayout, info_buffers, info_from_buffers
 from .rewards import REWARDS
 
-__all__ = ["EpisodeCore", "EpisodeSchedule", "attack_design_for"]
+__all__ = ["EpisodeCore", "EpisodeSchedule", "attack_design_for", "episode_bytes", "check_episode_memory"]
 
 
 @dataclass(frozen=True)
@@ -78,6 +79,44 @@ class EpisodeSchedule:
         check_int("refresh", self.refresh, minimum=1)
         check_positive("cond_limit", self.cond_limit)
         check_int("gram_batch", self.gram_batch, minimum=1)
+
+
+def episode_bytes(params: AttackParams, num_envs: int, schedule: EpisodeSchedule | None = None) -> int:
+    """Bytes an episode of ``num_envs`` copies allocates (an estimate, within a few percent).
+
+    The data of the attack (states and inputs of the horizon), the running least squares, the
+    noise chunks, the per-copy generators and the tables over the sample size, with a margin of
+    a half for the transient arrays of the exact refresh and the buffers handed out per step.
+    """
+    sch = schedule if schedule is not None else EpisodeSchedule()
+    n, m, N, K = params.n, params.m, params.horizon, int(num_envs)
+    d, H = n + m, params.input_history
+    per_copy = (
+        N * d  # X, U
+        + 2 * d * (d + n)  # GC, Q
+        + 3 * d + 2 * n + 2  # scratch
+        + 3 * sch.chunk * n  # noise: drawn, in use, ahead
+        + H * m + 4 * m + 2 * n + 8  # history, actions and buffers, energy, eps, reward
+        + (ObservationLayout.of(params).dim + 8 * 2) // 2  # observation (float32) and info per step
+    )
+    generators = 2048  # a numpy Generator with its bit generator, per copy
+    tables = 4 * (N + 1)
+    return int(1.5 * (8 * (K * per_copy + tables) + K * generators))
+
+
+def check_episode_memory(
+    params: AttackParams, num_envs: int, schedule: EpisodeSchedule | None = None, memory_limit: int | None = None
+) -> None:
+    """Refuse an episode whose :func:`episode_bytes` exceed ``memory_limit`` (default
+    :data:`encctl_gym.resources.MEMORY_LIMIT`), before anything is allocated."""
+    p = params
+    check_memory(
+        f"an episode of num_envs = {num_envs} copies, horizon N = {p.horizon}, n = {p.n}, m = {p.m}, "
+        f"input_history = {p.input_history}",
+        episode_bytes(p, num_envs, schedule),
+        memory_limit,
+        "use fewer copies, a shorter attack (max_samples) or a shorter input_history",
+    )
 
 
 def _condition(Gs: np.ndarray) -> np.ndarray:
@@ -127,6 +166,9 @@ class EpisodeCore:
         copies are stepped (same numbers: the same work in the same order, only elsewhere).
     schedule : EpisodeSchedule, optional
         Batching of the work (default :class:`EpisodeSchedule`).
+    memory_limit : int, optional
+        Refuse, before allocating anything, an episode whose :func:`episode_bytes` exceed this
+        many bytes (default :data:`encctl_gym.resources.MEMORY_LIMIT`).
 
     Public state (for training, evaluation and tests; privileged where it involves the true
     plant or undelivered data): :attr:`done`, :attr:`collected`, :attr:`delivered`,
@@ -148,13 +190,15 @@ class EpisodeCore:
         parallel: bool = False,
         helper: HelperThread | None = None,
         schedule: EpisodeSchedule | None = None,
+        memory_limit: int | None = None,
     ) -> None:
         p = self.p = params
         self.loop = loop
-        self.K = K = int(num_envs)
+        self.K = K = check_int("num_envs", num_envs, minimum=1)
         if K > 1 and not loop.batched:
             raise ParameterError(f"the {p.crypto} backend steps one copy, got num_envs = {K}")
         self.schedule = sch = schedule if schedule is not None else EpisodeSchedule()
+        check_episode_memory(p, K, sch, memory_limit)
         n, m, N = p.n, p.m, p.horizon
         self.n, self.m, self.d = n, m, n + m
         self.layout = ObservationLayout.of(p)
@@ -507,7 +551,13 @@ class EpisodeCore:
         them in float64, in a buffer of the episode's own (the caller's array is never changed)."""
         a = action
         if not (isinstance(a, np.ndarray) and a.dtype.char in "fd"):  # float32 and float64 are read as they are
-            a = np.asarray(a, dtype=np.float64)
+            try:
+                a = np.asarray(a)
+                if a.dtype.kind not in "biuf":
+                    raise TypeError(a.dtype)
+                a = a.astype(np.float64)
+            except (TypeError, ValueError):
+                raise ParameterError(f"action must be a real numeric array, got {action!r}") from None
         if a.ndim < 2:
             a = a.reshape(1, -1)
         if a.shape != (self.K, self.m):
@@ -521,6 +571,8 @@ class EpisodeCore:
 
     def step(self, action: Any) -> tuple[np.ndarray, bool, bool]:
         """Apply the actions of all copies. Returns (rewards (K,), terminated, truncated)."""
+        if not self._rngs:
+            raise ParameterError("step() called before reset(); call reset() first")
         if self.done:
             raise ParameterError("step() called after the episode ended; call reset() first")
         p = self.p

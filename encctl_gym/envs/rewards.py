@@ -87,7 +87,12 @@ class LogDetReward(Reward):
         self._before = self.value.copy()
 
     def on_delivery(self, core: Any) -> None:
-        self.value = np.linalg.slogdet(core.G + self._reg)[1]
+        sign, value = np.linalg.slogdet(core.G + self._reg)
+        bad = ~((sign > 0) & np.isfinite(value))
+        if bad.any():  # delta I lost to rounding next to a singular G: log det from the clipped eigenvalues
+            lam = np.clip(np.linalg.eigvalsh(core.G[bad]), 0.0, None)
+            value[bad] = np.log(lam + self._reg[0, 0]).sum(axis=-1)
+        self.value = value
 
     def end(self, core: Any) -> np.ndarray:
         return self.value - self._before

@@ -22,8 +22,8 @@ from .._validation import check_int
 from ..errors import ParameterError
 from ..loop import make_loop
 from .config import AttackParams, resolve_params
-from .encrypted_lti_attack import reset_options
-from .episode import EpisodeCore, EpisodeSchedule, attack_design_for
+from .encrypted_lti_attack import check_seed, reset_options
+from .episode import EpisodeCore, EpisodeSchedule, attack_design_for, check_episode_memory
 from .helper import HelperThread
 
 __all__ = ["EncryptedLTIAttackVectorEnv"]
@@ -53,6 +53,9 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         :meth:`close`); ``True`` makes one of the environment's own.
     schedule : EpisodeSchedule, optional
         How the work is batched (see the single environment).
+    memory_limit : int, optional
+        Bytes the copies may allocate (default :data:`encctl_gym.resources.MEMORY_LIMIT`,
+        8 GiB); a larger batch is refused before anything is allocated.
 
     ``info`` holds one array of shape ``(num_envs,)`` per key of the single environment's info
     (privileged keys as documented there). ``reset(options={"x0": (K, n), "noise": (K, T, n)})``
@@ -69,6 +72,7 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         parallel: bool = False,
         helper_thread: bool | HelperThread = True,
         schedule: EpisodeSchedule | None = None,
+        memory_limit: int | None = None,
         **kwargs: Any,
     ) -> None:
         self.num_envs = check_int("num_envs", num_envs, minimum=1)
@@ -78,6 +82,7 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         if max_episode_steps is not None:
             raise ParameterError("the attack length is set by tau_c or max_samples, not max_episode_steps")
         p = self.params
+        check_episode_memory(p, self.num_envs, schedule, memory_limit)  # before anything is sized by the parameters
         self.single_action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
         self.single_observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
@@ -92,7 +97,8 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         if not isinstance(parallel, bool):
             raise ParameterError(f"parallel must be a bool, got {parallel!r}")
         self._core = EpisodeCore(
-            p, make_loop(p), self.design, num_envs=self.num_envs, parallel=parallel, helper=self.helper, schedule=schedule
+            p, make_loop(p), self.design, num_envs=self.num_envs, parallel=parallel, helper=self.helper, schedule=schedule,
+            memory_limit=memory_limit,
         )
         self._rngs: list[np.random.Generator] | None = None
         self._needs_reset = False
@@ -102,9 +108,10 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
             if isinstance(seed, (list, tuple)):
                 if len(seed) != self.num_envs:
                     raise ParameterError(f"expected {self.num_envs} seeds, got {len(seed)}")
-                seeds = list(seed)
+                seeds = [check_seed(s) for s in seed]
             else:
-                seeds = [None if seed is None else seed + i for i in range(self.num_envs)]
+                first = check_seed(seed)
+                seeds = [None if first is None else first + i for i in range(self.num_envs)]
             self._rngs = [seeding.np_random(s)[0] for s in seeds]
             self._np_random, self._np_random_seed = seeding.np_random(seed if isinstance(seed, int) else None)
         obs = self._core.reset(self._rngs, **reset_options(options))

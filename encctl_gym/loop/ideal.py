@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import EncodingOverflowError
+from ..resources import check_memory
 from .backend import lqr_gain, table_limit
 from .quantize import OK, Quantization, collect_states, forge_inputs
 
@@ -36,13 +37,20 @@ class IdealLoop:
     batched = True
 
     def __init__(self, params: Any, group: Any) -> None:
-        from ..crypto.residue_table import residue_table
+        from ..crypto.residue_table import residue_table, table_bytes
 
         self.delta = float(params.delta)
         self.x_bound = float(params.x_bound)
         self.n, self.m = params.n, params.m
         self.Phi = -lqr_gain(params.A, params.B)
-        self.table = residue_table(int(group.p), table_limit(params, self.Phi))
+        limit = table_limit(params, self.Phi)
+        check_memory(
+            f"the quantisation table for |round(Delta v)| <= {limit} (Delta = {params.delta}, x_bound = {params.x_bound}, "
+            f"u_max = {params.u_max:.4g})",
+            table_bytes(limit),
+            advice="use a smaller x_bound or delta",
+        )
+        self.table = residue_table(int(group.p), limit)
         self.Phi_int = self.encode_int(self.Phi)
         self.quantization = Quantization(
             delta=self.delta,
