@@ -40,6 +40,7 @@ def random_actions(rng, n_steps, m, scale=0.3):
         {"decipher_delay": 3},
         {"decipher_delay": "end"},
         {"reward": "logdet"},
+        {"reward": "a_optimality", "decipher_delay": "end"},
         {"warmup_steps": 5},
         {"scheme": "token", "adversary": "server", "max_samples": 40},
         {"scheme": "static", "max_samples": 40},

@@ -72,6 +72,30 @@ def test_single_and_vector_info_have_the_layout_keys_and_agree():
 def test_reward_names_come_from_the_registry():
     assert REWARDS == tuple(REWARD_CLASSES) and all(REWARD_CLASSES[n].name == n for n in REWARDS)
     assert [n for n in REWARDS if REWARD_CLASSES[n].fused] == ["log_error"]
+    assert set(REWARDS) == {"log_error", "logdet", "a_optimality"}
+
+
+@pytest.mark.parametrize("delay", [0, "end"])
+def test_a_optimality_reward_telescopes_to_the_trace_of_the_inverse_gram_matrix(delay):
+    """The return is log(d / delta) - log tr((Z^T Z + delta I)^-1) of the delivered regressors
+    Z, computed here from delivered_data; with delay "end" it all arrives at the last step."""
+    cfg = {**SMALL, "reward": "a_optimality", "gamma_opt": False, "decipher_delay": delay, "logdet_regularization": 0.5}
+    env = EncryptedLTIAttackEnv(config=cfg)
+    p = env.params
+    env.reset(seed=3)
+    rewards = []
+    while True:
+        _, r, te, tr, _ = env.step(env.action_space.sample() * 0.5)
+        rewards.append(r)
+        if te or tr:
+            break
+    X, U = env.episode.delivered_data()
+    Z = np.hstack([X[0, :-1], U[0]])
+    d = p.n + p.m
+    want = np.log(d / 0.5) - np.log(np.trace(np.linalg.inv(Z.T @ Z + 0.5 * np.eye(d))))
+    assert sum(rewards) == pytest.approx(want, rel=1e-9)
+    if delay == "end":
+        assert all(r == 0.0 for r in rewards[:-1]) and rewards[-1] > 0
 
 
 def test_logdet_reward_telescopes_to_the_log_det_of_the_delivered_gram_matrix():

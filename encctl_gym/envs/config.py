@@ -54,8 +54,10 @@ def default_config() -> dict[str, Any]:
                                   break reveals every sample (static; token vs server)
     ``decipher_delay``            0 (adaptive), an integer number of steps, or ``"end"``
     ``warmup_steps``              steps of normal encrypted LQR control before the attack
-    ``reward``                    ``"log_error"`` or ``"logdet"``
-    ``logdet_regularization``     delta of ``log det(G + delta I)`` for ``reward="logdet"``
+    ``reward``                    ``"log_error"``, ``"logdet"`` or ``"a_optimality"``
+                                  (:mod:`encctl_gym.envs.rewards`)
+    ``logdet_regularization``     delta of ``G + delta I`` in the Gram-matrix rewards
+                                  (``logdet``, ``a_optimality``)
     ``crypto``                    ``"ideal"`` (exact arithmetic, no big integers) or ``"elgamal"``
     ``delta``                     encoder scaling factor Delta (Definition def:ec)
     ``x_bound``                   declared state range of the encoder (overflow raises)

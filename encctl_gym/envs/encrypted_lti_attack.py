@@ -115,7 +115,11 @@ class EncryptedLTIAttackEnv(gym.Env):
       ``n + m`` regression columns the estimate is ``[A B] = 0``. The return telescopes to
       ``log epsilon_0 - log epsilon_final``.
     * ``reward="logdet"``: the increase of ``log det(G + delta I)`` of the regressor Gram
-      matrix ``G`` of the delivered data, which an attacker can compute without ``(A, B)``.
+      matrix ``G`` of the delivered data, which an attacker can compute without ``(A, B)``
+      (D-optimality).
+    * ``reward="a_optimality"``: the decrease of ``log tr((G + delta I)^-1)`` (A-optimality):
+      the log of the expected error of the current least-squares estimate given the delivered
+      regressors, ``sigma_w2 tr(G^-1) / (n + m)``; low variance, computable without ``(A, B)``.
 
     ## Starting State
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from . import _kernels as kern
 
-__all__ = ["Reward", "LogErrorReward", "LogDetReward", "REWARDS"]
+__all__ = ["Reward", "LogErrorReward", "LogDetReward", "AOptimalityReward", "REWARDS"]
 
 
 class Reward:
@@ -98,5 +98,41 @@ class LogDetReward(Reward):
         return self.value - self._before
 
 
+class AOptimalityReward(Reward):
+    """The decrease of ``log tr((G + delta I)^-1)``: A-optimality of the delivered regressors.
+
+    For least squares with white noise, the error of Definition def:error given the regressors is
+    ``E[epsilon | D] = sigma_w2 tr(G^-1) / (n + m)`` (the first steps of the proof of Theorem
+    thm:sic, before its Jensen step), so this reward is the decrease of the log of the expected
+    error of the current estimate: it tracks the quantity an attacker wants to make small with
+    far less variance than the realised error (``log_error``), and an attacker can compute it
+    without knowing ``(A, B)``. ``delta = logdet_regularization`` keeps it finite before ``G`` is
+    invertible; the return telescopes to ``log(d / delta) - log tr((G_N + delta I)^-1)``.
+    """
+
+    name = "a_optimality"
+    needs_gram = True
+
+    def __init__(self, params: Any, num_envs: int) -> None:
+        super().__init__(params, num_envs)
+        self._d = params.n + params.m
+        self._delta = params.logdet_regularization
+        self._value0 = math.log(self._d / self._delta)
+        self.value = np.full(num_envs, self._value0)
+
+    def reset(self, core: Any) -> None:
+        self.value = np.full(self.K, self._value0)
+
+    def begin(self, core: Any) -> None:
+        self._before = self.value.copy()
+
+    def on_delivery(self, core: Any) -> None:
+        lam = np.clip(np.linalg.eigvalsh(core.G), 0.0, None)  # G is PSD; clip rounding below 0
+        self.value = np.log((1.0 / (lam + self._delta)).sum(axis=-1))
+
+    def end(self, core: Any) -> np.ndarray:
+        return self._before - self.value
+
+
 #: Rewards by the name the ``reward`` configuration key gives.
-REWARDS: dict[str, type[Reward]] = {cls.name: cls for cls in (LogErrorReward, LogDetReward)}
+REWARDS: dict[str, type[Reward]] = {cls.name: cls for cls in (LogErrorReward, LogDetReward, AOptimalityReward)}
