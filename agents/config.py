@@ -237,11 +237,15 @@ def load_config(
         cfg = _merge(cfg, raw)
         quick_layers.append(q)
         files.append(str(path))
+    if not isinstance(cfg.get("env"), dict):
+        raise ConfigError(f"env must be a mapping, got {cfg.get('env')!r}")
     if preset is not None:
         cfg["env"]["preset"] = preset
     if quick:
         for q in quick_layers:
             cfg = _merge(cfg, q)
+        if not isinstance(cfg.get("env"), dict):
+            raise ConfigError(f"env must be a mapping, got {cfg.get('env')!r}")
     if system is not None:
         cfg["env"].update(plant_config(system))
         cfg["system"] = Path(system).stem
