@@ -193,9 +193,9 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
     for system in dict.fromkeys((c.system, c.design_kind, c.N) for c in cs):
         ref = next(c for c in cs if (c.system, c.design_kind, c.N) == system)
         ax.axhline(ref.gamma / ref.gamma_opt, color="0.35", ls="--", lw=1.0,
-                   label=f"{ref.system}: paper's gamma(N) (eq:sic) / gamma_opt(N)")
+                   label=f"{ref.system}, {ref.design_kind}: paper's gamma(N) (eq:sic) / gamma_opt(N)")
         ax.axhline(ref.gamma_gauss / ref.gamma_opt, color="0.35", ls="-.", lw=1.0,
-                   label=f"{ref.system}: Gaussian attack, exact rate / gamma_opt(N)")
+                   label=f"{ref.system}, {ref.design_kind}: Gaussian attack, exact rate / gamma_opt(N)")
     ax.axhline(1.0, color="k", lw=1.0, label="1: the optimal design (gamma_opt, same power)")
     ax.set_xlabel("training steps")
     ax.set_ylabel("E[eps(N)] / gamma_opt(N)  (evaluation episodes)")
@@ -207,3 +207,26 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m agents.curves RUN_DIR ... --out FILE``: several runs' learning curves in one figure."""
+    import argparse
+    import sys
+
+    parser = argparse.ArgumentParser(prog="python -m agents.curves", description=main.__doc__)
+    parser.add_argument("runs", nargs="+", metavar="RUN_DIR", help="training run directories (or learning_curve.npz files)")
+    parser.add_argument("--out", required=True, help="output PNG")
+    parser.add_argument("--title", default=None, help="figure title")
+    args = parser.parse_args(argv)
+    try:
+        path = plot_learning_curves(args.runs, args.out, title=args.title)
+    except ConfigError as exc:
+        print(f"python -m agents.curves: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())
