@@ -54,7 +54,7 @@ def type_hints(fn: Any) -> tuple[list[str], dict[str, Any]]:
         from stable_baselines3.common.vec_env import VecEnv
 
         hints = typing.get_type_hints(fn, localns={"VecEnv": VecEnv})
-    except Exception:  # noqa: BLE001 - a forward reference we cannot resolve: names only
+    except (NameError, TypeError, AttributeError):  # a forward reference we cannot resolve: names only
         hints = {}
     return params, hints
 

@@ -17,8 +17,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 from agents import Attacker  # noqa: E402
 from agents.runs import find_runs as _find_run_infos  # noqa: E402
-from experiments.compare.attackers import learned_attackers, make_attackers  # noqa: E402
-from experiments.compare.attackers import ATTACKERS  # noqa: E402
+from experiments.compare.attackers import ATTACKERS, learned_attackers, make_attackers  # noqa: E402
 from experiments.compare.cli import QUICK_CAP, QUICK_EPISODES, QUICK_SYSTEMS, add_arguments, main, run  # noqa: E402
 from experiments.compare.plots import plot  # noqa: E402
 from experiments.compare.protocol import Curve, Result, compute, elgamal_check, evaluate, planned_steps  # noqa: E402
