@@ -17,7 +17,7 @@ import numpy as np
 
 from agents import Attacker, ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker, PRBSAttacker
 from agents.runs import RunInfo
-from encctl_gym.errors import ConfigError
+from encctl_gym.errors import ConfigError, EncctlError
 
 from .settings import Setting
 
@@ -61,9 +61,14 @@ def learned_attackers(setting: Setting, runs: Sequence[RunInfo], which: str = "b
     name, each is named by its run directory. ``which="best"`` falls back to the final model
     for a run without ``best_model.zip``.
     """
-    from agents.sb3 import load_attacker
-
     chosen = [r for r in runs if run_applies(r, setting)]
+    if not chosen:
+        return []
+    try:
+        from agents.sb3 import load_attacker
+    except ModuleNotFoundError as exc:
+        raise EncctlError(f"learned attackers need stable-baselines3 (module {exc.name!r} is missing); "
+                          "install the extra: pip install 'encctl-gym[rl]'") from exc
     names = [r.algo + ("-blind" if r.observation == "blind" else "") for r in chosen]
     count = Counter(names)
     out = []

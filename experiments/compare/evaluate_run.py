@@ -27,6 +27,7 @@ from typing import Any
 
 from agents import Attacker
 from agents.runs import RunInfo, read_run
+from agents.sb3 import load_attacker  # the [rl] extra: without it the CLI says which extra to install
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ConfigError
 
@@ -110,8 +111,6 @@ def run(args: argparse.Namespace) -> int:
     settings = run_settings(info, systems, delays, length)
 
     def learned(setting: Setting) -> list[Attacker]:
-        from agents.sb3 import load_attacker
-
         w = args.which if args.which == "final" or (info.path / "best_model.zip").exists() else "final"
         label = info.algo + ("-blind" if info.observation == "blind" else "")
         return [load_attacker(info.path, which=w, params=setting.params, name=label, deterministic=args.deterministic)]
