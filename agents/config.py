@@ -178,10 +178,13 @@ def plant_config(path: str | Path) -> dict[str, Any]:
     """The environment entries read from a plant file (``A``, ``B``; JSON, YAML or NPZ).
 
     The one place ``train --system FILE`` reads a plant; it uses the ``design`` command's
-    reader, so both accept the same files.
+    reader, so both accept the same files. A YAML plant file first passes :func:`read_yaml`'s
+    guards (size, no aliases), which that reader does not have.
     """
     from encctl_gym.security.design_cli import load_system
 
+    if Path(path).suffix.lower() in (".yaml", ".yml") and Path(path).is_file():
+        read_yaml(path)
     A, B = load_system(path)
     return {"A": A.tolist(), "B": B.tolist()}
 

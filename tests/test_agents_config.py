@@ -79,6 +79,10 @@ def test_system_file_replaces_a_and_b(tmp_path):
     base = get_preset("paper-example")  # the rest from the preset
     assert (p.sigma_w2, p.sigma_u2, p.sigma_x2, p.gamma_c, p.upsilon) == (base.sigma_w2, base.sigma_u2, base.sigma_x2, base.gamma_c, base.upsilon)
     assert p.horizon == cfg["horizon"] == 256
+    bomb = tmp_path / "bomb.yaml"
+    bomb.write_text("a: &a [1, 1, 1]\nb: &b [*a, *a, *a]\nA: [*b, *b]\nB: [[1]]\n")
+    with pytest.raises(ConfigError, match="alias"):
+        load_config("ppo", system=bomb)
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({"A": [[2.0]], "B": [[1.0]]}))
     with pytest.raises(ConfigError, match="env:.*"):
