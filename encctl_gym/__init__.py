@@ -21,8 +21,10 @@ from .errors import (
     EncodingOverflowError,
     GroupError,
     KeyMismatchError,
+    ModelRangeError,
     ParameterError,
     PlaintextError,
+    ResourceLimitError,
     ShapeError,
     SolverError,
     UnstableSystemError,
@@ -44,6 +46,8 @@ __all__ = [
     "SolverError",
     "BudgetError",
     "ConfigError",
+    "ModelRangeError",
+    "ResourceLimitError",
 ]
 
 
