@@ -211,8 +211,12 @@ def as_finite_array(name: str, value: Any, ndim: int | None = None) -> np.ndarra
         raise ParameterError(f"{name} must be numeric, got a boolean array {format_value(raw)}")
     if kind in "USV" or kind == "M" or kind == "m":
         raise ParameterError(f"{name} must be a numeric array, got {format_value(value)}")
-    if kind == "O" and any(isinstance(v, (complex, np.complexfloating)) for v in raw.ravel()[:100_000]):
-        raise ParameterError(f"{name} must be real, got complex entries in {format_value(value)}")
+    if kind == "O":
+        for v in raw.ravel():
+            if isinstance(v, (complex, np.complexfloating)):
+                raise ParameterError(f"{name} must be real, got complex entries in {format_value(value)}")
+            if v is None or isinstance(v, (bool, np.bool_, str, bytes)):
+                raise ParameterError(f"{name} must be a numeric array, got the entry {format_value(v)} in {format_value(value)}")
     try:
         arr = np.asarray(raw, dtype=np.float64)
     except OverflowError as exc:
