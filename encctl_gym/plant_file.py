@@ -326,7 +326,8 @@ def load_plant_file(path: str | Path, *, defaults: Mapping[str, Any] | SystemPre
     else:
         base = dict(defaults)
     values: dict[str, float] = {}
-    from_file, from_defaults = ["A", "B"], []
+    from_file: list[str] = ["A", "B"]
+    from_defaults: list[str] = []
     for key in DESIGN_FIELDS:
         if key in data:
             raw, from_file_ = _scalar(p, key, data[key]), True

@@ -10,13 +10,18 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from encctl_gym._validation import format_value
-from encctl_gym.errors import ParameterError, ResourceLimitError, SolverError, UnstableSystemError
+from encctl_gym.errors import (
+    ParameterError,
+    ResourceLimitError,
+    SolverError,
+    UnstableSystemError,
+)
 from encctl_gym.security.attack_design import (
     gamma_opt,
-    sdp_estimate,
     gaussian_attack_design,
     optimal_attack_design,
     robust_security_design,
+    sdp_estimate,
 )
 from encctl_gym.security.complexity import sic_asymptotic_from_traces
 from encctl_gym.security.design import paper_design_example, sample_size_for_rate

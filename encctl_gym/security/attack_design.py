@@ -481,8 +481,8 @@ def robust_security_design(
     SecurityDesign
         ``method`` equal to ``kind``.
     """
-    if kind not in KINDS:
-        raise ParameterError(f"unknown kind {kind!r}; expected one of {', '.join(KINDS)}")
+    if not isinstance(kind, str) or kind not in KINDS:
+        raise ParameterError(f"unknown kind {format_value(kind)}; expected one of {', '.join(KINDS)}")
     A, B, su, sw = _check_inputs(A, B, sigma_u2, sigma_w2)
     n, m = B.shape
     if design is None:

@@ -144,7 +144,10 @@ def check_gnfs_correction(correction: Any) -> float:
     """
     if isinstance(correction, bool) or not isinstance(correction, (numbers.Real, np.floating, np.integer)):
         raise ParameterError(f"gnfs_correction must be a number of bits, got {format_value(correction)}")
-    c = float(correction) if abs(correction) < 1e300 else math.inf
+    try:
+        c = float(correction)
+    except OverflowError:  # an integer beyond the float range
+        c = math.inf
     if not math.isfinite(c) or c < 0:
         raise ParameterError(f"gnfs_correction must be finite and >= 0 bits, got {format_value(correction)}")
     top = _gnfs_bits(float(GNFS_MIN_KEY_LENGTH))
@@ -242,10 +245,10 @@ def check_security_parameter(lam: Any) -> int | float:
         If ``lam`` exceeds :data:`LAMBDA_MAX` (``2^lam`` would be an unboundedly large integer).
     """
     if isinstance(lam, (numbers.Integral, np.integer)) and not isinstance(lam, bool):
-        v = check_int("lam", lam, 1)
-        if v > LAMBDA_MAX:
-            raise ModelRangeError(f"security parameter lam must be <= {LAMBDA_MAX} bits, got {format_value(v)}")
-        return v
+        k = check_int("lam", lam, 1)
+        if k > LAMBDA_MAX:
+            raise ModelRangeError(f"security parameter lam must be <= {LAMBDA_MAX} bits, got {format_value(k)}")
+        return k
     v = check_positive("lam", lam)
     if v > LAMBDA_MAX:
         raise ModelRangeError(f"security parameter lam must be <= {LAMBDA_MAX} bits, got {format_value(lam)}")

@@ -281,7 +281,7 @@ def per_sample_cost(lam: Any, upsilon: Any) -> float:
     float
         Seconds (``inf`` beyond the float range).
     """
-    return sample_deciphering_time(1, lam, upsilon)
+    return float(sample_deciphering_time(1, lam, upsilon))
 
 
 def max_affordable_samples(

@@ -279,8 +279,8 @@ def design_for_sample_size(
         If ``lam*`` lies outside the range of the GNFS formula (see
         :func:`~encctl_gym.security.cost_models.minimum_key_length`).
     """
-    if method not in METHODS:
-        raise ParameterError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
+    if not isinstance(method, str) or method not in METHODS:
+        raise ParameterError(f"unknown method {format_value(method)}; expected one of {', '.join(METHODS)}")
     N_star = check_int("N_star", N_star, 2)
     lam_star = optimal_security_parameter(N_star, tau_c=tau_c, upsilon=upsilon)
     try:
@@ -351,6 +351,8 @@ def design_from_traces(
     su = decimal_fraction("sigma_u2", sigma_u2)
     sw = decimal_fraction("sigma_w2", sigma_w2)
     check_nonnegative("sigma_x2", sigma_x2)
+    if not isinstance(method, str):
+        raise ParameterError(f"unknown method {format_value(method)}; expected 'asymptotic' or 'exact'")
     if method == "asymptotic":
         N_star = optimal_sample_size(tr_psi_u, tr_psi_w, m, n, r_sigma=su / sw, gamma_c=gamma_c)
         gamma = exact_sic_asymptotic_function(tr_psi_u, tr_psi_w, m, n, r_sigma=su / sw)
@@ -360,7 +362,7 @@ def design_from_traces(
         )
         gamma = exact_sic_function(tr_psi_u, tr_psi_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=sigma_x2)
     else:
-        raise ParameterError(f"unknown method {method!r}; expected 'asymptotic' or 'exact'")
+        raise ParameterError(f"unknown method {format_value(method)}; expected 'asymptotic' or 'exact'")
     return design_for_sample_size(
         method, N_star, gamma, m=m, n=n, sigma_u2=sigma_u2, sigma_w2=sigma_w2, sigma_x2=sigma_x2,
         tr_psi_u=tr_psi_u, tr_psi_w=tr_psi_w, gamma_c=gamma_c, tau_c=tau_c, upsilon=upsilon,
@@ -415,7 +417,7 @@ def paper_design_example(method: str = "asymptotic") -> SecurityDesign:
     -------
     SecurityDesign
     """
-    p = dict(PAPER_DESIGN_EXAMPLE)
+    p: dict[str, Any] = dict(PAPER_DESIGN_EXAMPLE)
     return design_from_traces(
-        p.pop("tr_psi_u"), p.pop("tr_psi_w"), p.pop("m"), p.pop("n"), method=method, **p
+        p.pop("tr_psi_u"), p.pop("tr_psi_w"), int(p.pop("m")), int(p.pop("n")), method=method, **p
     )

@@ -40,14 +40,37 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._validation import check_int, check_nonnegative, check_positive, check_schur_stable, check_system, format_value, parse_number
+from .._validation import (
+    check_int,
+    check_nonnegative,
+    check_positive,
+    check_schur_stable,
+    check_system,
+    format_value,
+    parse_number,
+)
 from ..errors import ConfigError, ParameterError, ResourceLimitError
 from ..plant_file import load_plant_file, load_system
 from ..presets import DESIGN_FIELDS, design_defaults, get_preset, preset_names
 from ..units import SECONDS_PER_UNIT, parse_duration
-from .attack_design import SDP_MAX_DIMENSION, gaussian_attack_design, optimal_attack_design, robust_security_design
-from .complexity import input_upper_bound, noise_upper_bound, sic_asymptotic_from_traces, sic_from_traces
-from .cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION, check_gnfs_correction, gnfs_log2_complexity
+from .attack_design import (
+    SDP_MAX_DIMENSION,
+    gaussian_attack_design,
+    optimal_attack_design,
+    robust_security_design,
+)
+from .complexity import (
+    input_upper_bound,
+    noise_upper_bound,
+    sic_asymptotic_from_traces,
+    sic_from_traces,
+)
+from .cost_models import (
+    DECIPHERING_MODELS,
+    GUILLEVIC_CORRECTION,
+    check_gnfs_correction,
+    gnfs_log2_complexity,
+)
 from .design import SecurityDesign, design_from_traces
 from .gramians import controllability_gramian, noise_gramian
 from .key_length import build_model, design_key_length, key_length_value
@@ -240,12 +263,12 @@ def compute(
     su = check_positive("sigma_u2", sigma_u2)
     sw = check_positive("sigma_w2", sigma_w2)
     sx = check_nonnegative("sigma_x2", sigma_x2)
-    if complexity not in COMPLEXITIES:
+    if not isinstance(complexity, str) or complexity not in COMPLEXITIES:
         raise ParameterError(f"unknown complexity {format_value(complexity)}; choose one of {', '.join(COMPLEXITIES)}")
     c = check_gnfs_correction(gnfs_correction)
     tr_u = float(np.trace(controllability_gramian(A, B)))
     tr_w = float(np.trace(noise_gramian(A)))
-    kw = dict(gamma_c=gamma_c, tau_c=tau_c, upsilon=upsilon)
+    kw: dict[str, Any] = dict(gamma_c=gamma_c, tau_c=tau_c, upsilon=upsilon)
     designs: dict[str, SecurityDesign] = {
         "paper_sic2": design_from_traces(tr_u, tr_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=sx, method="asymptotic", **kw),
         "exact_sic": design_from_traces(tr_u, tr_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=sx, method="exact", **kw),
@@ -364,8 +387,9 @@ def _format_cost_models(res: dict[str, Any]) -> list[str]:
                 f"{_bits(r['log2_ratio'], 7, 2)}{_bits(r['log2_operations'], 8, 2)}{_bits(r['formula_bits'], 9, 2)}"
                 f"{_bits(r['formula_minus_record_bits'], 7, 2)}  {'ratio' if r['use_for_ratio'] else '-'}"
             )
-        lines.append("  ratio: log2(total / per-key time); ops: log2 cycles of the total; formula: log2 Omega(k); diff: formula - ops.")
-        lines += ["", f"  NIST SP 800-57 comparable strengths against the GNFS formula (bits):",
+        lines.append("  ratio: log2(total / per-key time); ops: log2 cycles of the total; formula: log2 Omega(k); "
+                     "diff: formula - ops.")
+        lines += ["", "  NIST SP 800-57 comparable strengths against the GNFS formula (bits):",
                   f"  {'key length':>12}{'NIST':>8}{'formula':>10}{'formula - ' + format(GUILLEVIC_CORRECTION, 'g'):>18}"]
         for row in rec["nist_sp800_57"]["rows"]:
             lines.append(f"  {row['key_length']:>12d}{row['strength']:>8d}{row['formula_bits']:>10.2f}"

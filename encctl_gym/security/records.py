@@ -352,7 +352,8 @@ def _load(p: Path) -> RecordSet:
     try:
         data = json.loads(p.read_text(encoding="utf-8"))
     except (ValueError, UnicodeDecodeError, RecursionError) as exc:
-        raise ConfigError(f"cannot read records file {str(p)!r}: {format_value(str(exc).splitlines()[0] if str(exc) else exc)}") from None
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ConfigError(f"cannot read records file {str(p)!r}: {format_value(first)}") from None
     return parse_records(data, str(p))
 
 
