@@ -16,8 +16,10 @@ from .errors import (
     EncodingOverflowError,
     GroupError,
     KeyMismatchError,
+    ModelRangeError,
     ParameterError,
     PlaintextError,
+    ResourceLimitError,
     ShapeError,
     SolverError,
     UnstableSystemError,
@@ -39,6 +41,8 @@ __all__ = [
     "SolverError",
     "BudgetError",
     "ConfigError",
+    "ModelRangeError",
+    "ResourceLimitError",
 ]
 
 

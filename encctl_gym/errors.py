@@ -21,6 +21,8 @@ __all__ = [
     "SolverError",
     "BudgetError",
     "ConfigError",
+    "ModelRangeError",
+    "ResourceLimitError",
 ]
 
 
@@ -70,3 +72,15 @@ class BudgetError(ParameterError):
 
 class ConfigError(ParameterError):
     """A configuration or system file cannot be read or has invalid content."""
+
+
+class ModelRangeError(ParameterError):
+    """A value lies outside the range where a formula or cost model holds (a key length below
+    the GNFS crossover, a security parameter above the supported bound, ...); the message names
+    the value and the range."""
+
+
+class ResourceLimitError(ParameterError):
+    """An input would need more time or memory than the package allows (a file above the size
+    bound, YAML aliases expanding past the node bound, an SDP too large to solve); the message
+    names the estimate and the bound."""

@@ -34,6 +34,7 @@ from .._validation import (
     check_nonnegative,
     check_positive,
     check_system,
+    format_value,
 )
 from ..errors import ParameterError, ShapeError
 from .gramians import controllability_gramian, noise_gramian
@@ -76,7 +77,7 @@ def check_sample_size(N: Any, name: str = "N") -> tuple[np.ndarray, bool]:
         return np.asarray(float(check_int(name, N if not isinstance(N, np.ndarray) else N.item(), 2))), True
     arr = as_finite_array(name, N)
     if not np.all(arr == np.round(arr)):
-        raise ParameterError(f"{name} must contain integers, got {np.asarray(N)!r}")
+        raise ParameterError(f"{name} must contain integers, got {format_value(np.asarray(N))}")
     if np.any(arr < 2):
         raise ParameterError(f"{name} must be >= 2 (N - 1 regression columns), got min {arr.min():g}")
     return arr, False
