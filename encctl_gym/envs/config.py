@@ -14,13 +14,40 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .._validation import check_int, check_nonnegative, check_positive, check_schur_stable, check_system
+from .._validation import (
+    check_bool,
+    check_int,
+    check_nonnegative,
+    check_positive,
+    check_schur_stable,
+    check_system,
+    format_value,
+)
 from ..errors import BudgetError, ConfigError, ParameterError
 from ..presets import get_preset
 from ..security.complexity import sic_from_traces
-from ..security.deciphering import ADVERSARIES, SCHEMES, keys_to_break, max_affordable_samples, per_sample_cost
-from ..security.design import bit_security_of_key_length, design_from_traces, minimum_key_length
+from ..security.cost_models import (
+    DECIPHERING_MODELS,
+    GENERIC_MIN_KEY_LENGTH,
+    GUILLEVIC_CORRECTION,
+    KeyBreakCost,
+    PaperModel,
+    check_gnfs_correction,
+    check_security_parameter,
+    deciphering_model,
+)
+from ..security.deciphering import (
+    ADVERSARIES,
+    SCHEMES,
+    independent_keys,
+    max_affordable_samples,
+    per_sample_cost,
+    sample_deciphering_time,
+)
+from ..security.design import design_from_traces
+from ..security.exact import decimal_fraction
 from ..security.gramians import controllability_gramian, noise_gramian
+from ..units import parse_duration
 from ..loop import BACKENDS as _LOOP_BACKENDS
 from .layout import ObservationLayout
 from .rewards import REWARDS as _REWARD_CLASSES
@@ -48,7 +75,14 @@ def default_config() -> dict[str, Any]:
     ``security_parameter``        lambda in bits; ``None``: from ``key_length``, else lambda* of
                                   Theorem thm:opt_sec for the preset's design parameters
     ``key_length``                key length k in bits (lambda = log2 Omega(k), eq:opt_key)
-    ``upsilon``, ``tau_c``        attacker FLOPS and defense period in s (preset's if ``None``)
+    ``deciphering_model``         what breaking the keys costs (:mod:`encctl_gym.security.cost_models`):
+                                  ``"paper"`` (def:sdt: ``2^lambda`` per key), ``"precomputation"``
+                                  (one GNFS precomputation per group, then a cheap step per key),
+                                  ``"generic"`` (Pollard rho per key)
+    ``gnfs_correction``           o(1) correction of the GNFS cost in bits (0: the paper's; the
+                                  documented alternative ``"guillevic"``, 11.91)
+    ``upsilon``, ``tau_c``        attacker FLOPS and defense period in s or a duration such as
+                                  ``"10y"`` (preset's if ``None``)
     ``gamma_c``                   acceptable error, used for the default lambda*
     ``max_samples``               cap on the attack length N (truncation); required when one
                                   break reveals every sample (static; token vs server)
@@ -78,6 +112,8 @@ def default_config() -> dict[str, Any]:
         "adversary": "eavesdropper",
         "security_parameter": None,
         "key_length": None,
+        "deciphering_model": "paper",
+        "gnfs_correction": 0.0,
         "upsilon": None,
         "tau_c": None,
         "gamma_c": None,
@@ -107,12 +143,15 @@ class AttackParams:
     sigma_u2: float
     scheme: str
     adversary: str
-    security_parameter: float
+    security_parameter: float  # lambda of the paper's model for this key (def:bit_sec, eq:opt_key)
     key_length: int
     upsilon: float
     tau_c: float
     gamma_c: float
-    sample_cost: float  # 2^lambda / Upsilon, seconds per broken key
+    deciphering_model: str
+    cost: KeyBreakCost  # operations for the first key of the group and for each further key
+    sample_cost: float  # seconds to break the first key (2^lambda / Upsilon under the paper's model)
+    next_sample_cost: float  # seconds to break each further key of the same group
     budget_samples: float  # samples affordable within tau_c (inf if one break reveals all)
     horizon: int  # N: the attack length in samples
     independent_keys: bool  # every sample under its own key (def:sdt), else one break reveals all
@@ -139,6 +178,10 @@ class AttackParams:
     @property
     def m(self) -> int:
         return int(self.B.shape[1])
+
+    def deciphering_time(self, N: Any) -> Any:
+        """tau(N) of the configured model (Definition def:sdt, :func:`sample_deciphering_time`), seconds."""
+        return sample_deciphering_time(N, self.cost, self.upsilon, scheme=self.scheme, adversary=self.adversary)
 
     @property
     def energy_budget(self) -> float:
@@ -174,14 +217,8 @@ SOURCE_KEYS = ("A", "B", "sigma_w2", "sigma_x2", "sigma_u2", "upsilon", "tau_c",
 
 def _choice(name: str, value: Any, options: tuple[str, ...]) -> str:
     if not isinstance(value, str) or value not in options:
-        raise ParameterError(f"unknown {name} {value!r}; choose one of {', '.join(options)}")
+        raise ParameterError(f"unknown {name} {format_value(value)}; choose one of {', '.join(options)}")
     return value
-
-
-def _flag(name: str, value: Any) -> bool:
-    if not isinstance(value, (bool, np.bool_)):
-        raise ParameterError(f"{name} must be True or False, got {value!r}")
-    return bool(value)
 
 
 def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> AttackParams:
@@ -254,7 +291,7 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     sigma_x2 = check_nonnegative("sigma_x2", raw["sigma_x2"])
     sigma_u2 = check_positive("sigma_u2", raw["sigma_u2"])
     upsilon = check_positive("upsilon", raw["upsilon"])
-    tau_c = check_positive("tau_c", raw["tau_c"])
+    tau_c = parse_duration(raw["tau_c"], "tau_c")
     gamma_c = check_positive("gamma_c", raw["gamma_c"])
     scheme = _choice("scheme", cfg["scheme"], SCHEMES)
     adversary = _choice("adversary", cfg["adversary"], ADVERSARIES)
@@ -269,23 +306,30 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     lam_cfg, k_cfg = cfg["security_parameter"], cfg["key_length"]
     if lam_cfg is not None and k_cfg is not None:
         raise ParameterError("give either security_parameter or key_length, not both")
+    model_name = _choice("deciphering_model", cfg["deciphering_model"], tuple(DECIPHERING_MODELS))
+    correction = cfg["gnfs_correction"]
+    if correction == "guillevic":
+        correction = GUILLEVIC_CORRECTION
+    correction = check_gnfs_correction(correction)
+    model = deciphering_model(model_name, **({"gnfs_correction": correction} if model_name != "generic" else {}))
+    paper = PaperModel(correction)  # eq:opt_key: lambda <-> key length
     if k_cfg is not None:
-        key_length = check_int("key_length", k_cfg, minimum=16)
-        lam = bit_security_of_key_length(key_length)
+        key_length = check_int("key_length", k_cfg, minimum=GENERIC_MIN_KEY_LENGTH)
+        cost = model.break_cost(key_length)
+        lam = cost.security_parameter if model_name == "paper" else paper.security_parameter_of_key_length(key_length)
     else:
         if lam_cfg is not None:
-            lam = check_positive("security_parameter", lam_cfg)
-            if float(lam).is_integer():
-                lam = int(lam)
+            lam = check_security_parameter(lam_cfg)
         else:
             design = design_from_traces(
                 tr_psi_u, tr_psi_w, m, n, sigma_u2=sigma_u2, sigma_w2=sigma_w2, sigma_x2=sigma_x2,
                 gamma_c=gamma_c, tau_c=tau_c, upsilon=upsilon,
             )
             lam = design.lam_star  # Theorem thm:opt_sec
-        key_length = minimum_key_length(lam)
+        key_length = paper.key_length_for_security_parameter(lam)  # eq:opt_key
+        cost = paper.cost_of_security_parameter(lam) if model_name == "paper" else model.break_cost(key_length)
 
-    budget = max_affordable_samples(tau_c, lam, upsilon, scheme=scheme, adversary=adversary)
+    budget = max_affordable_samples(tau_c, cost, upsilon, scheme=scheme, adversary=adversary)
     max_samples = cfg["max_samples"]
     if max_samples is not None:
         max_samples = check_int("max_samples", max_samples, minimum=1)
@@ -301,8 +345,8 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     if horizon < n + m + 1:
         raise BudgetError(
             f"the attack can collect only N = {horizon} samples (budget {budget} within tau_c = {tau_c:g} s at "
-            f"lambda = {lam}, Upsilon = {upsilon:g}; max_samples = {max_samples}); identification needs "
-            f"N >= n + m + 1 = {n + m + 1}"
+            f"lambda = {format_value(lam)}, k = {key_length} bits, {model_name} model, Upsilon = {upsilon:g}; "
+            f"max_samples = {max_samples}); identification needs N >= n + m + 1 = {n + m + 1}"
         )
 
     delay = cfg["decipher_delay"]
@@ -324,15 +368,16 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     return AttackParams(
         A=A, B=B, sigma_w2=sigma_w2, sigma_x2=sigma_x2, sigma_u2=sigma_u2,
         scheme=scheme, adversary=adversary, security_parameter=lam, key_length=key_length,
-        upsilon=upsilon, tau_c=tau_c, gamma_c=gamma_c,
-        sample_cost=per_sample_cost(lam, upsilon), budget_samples=budget,
-        horizon=horizon, independent_keys=keys_to_break(2, scheme, adversary) == 2, budget_limited=budget_limited, decipher_delay=delay_v,
+        upsilon=upsilon, tau_c=tau_c, gamma_c=gamma_c, deciphering_model=model_name, cost=cost,
+        sample_cost=per_sample_cost(cost, upsilon), next_sample_cost=float(cost.next / decimal_fraction("upsilon", upsilon)),
+        budget_samples=budget, horizon=horizon, independent_keys=independent_keys(scheme, adversary),
+        budget_limited=budget_limited, decipher_delay=delay_v,
         warmup_steps=warmup,
         reward=reward,
         logdet_regularization=check_positive("logdet_regularization", cfg["logdet_regularization"]),
         crypto=crypto, delta=delta, x_bound=check_positive("x_bound", cfg["x_bound"]),
         u_max=action_scale * math.sqrt(sigma_u2),
         input_history=check_int("input_history", cfg["input_history"], minimum=0),
-        gamma_opt=_flag("gamma_opt", cfg["gamma_opt"]), crypto_seed=crypto_seed,
+        gamma_opt=check_bool("gamma_opt", cfg["gamma_opt"]), crypto_seed=crypto_seed,
         tr_psi_u=tr_psi_u, tr_psi_w=tr_psi_w, sources=sources,
     )

@@ -217,8 +217,7 @@ class EpisodeCore:
         self.gamma_opt_table = np.full(N + 1, np.inf)
         if design is not None:
             self.gamma_opt_table[2:] = design.gamma(Ns[2:])
-        keys = Ns if p.independent_keys else np.minimum(Ns, 1)
-        self.time_table = keys * p.sample_cost  # Definition def:sdt
+        self.time_table = np.asarray(p.deciphering_time(Ns), dtype=np.float64)  # Definition def:sdt, under the model
         self._time_frac = self.time_table / p.tau_c
         # per-copy data: collected (deciphered) states and applied inputs
         # time-major: the data of all copies for one period are contiguous

@@ -258,10 +258,12 @@ def sample_deciphering_time(
         raise ParameterError(f"N must contain integers >= 0, got {format_value(np.asarray(N))}")
     keys = arr if independent else np.minimum(arr, 1.0)
     t_first, t_next = _to_float(cost.first / ups), _to_float(cost.next / ups)
-    out = np.zeros_like(keys)
-    out[keys >= 1] = t_first
-    later = keys > 1
-    with np.errstate(over="ignore"):
+    with np.errstate(over="ignore", invalid="ignore"):
+        if cost.first == cost.next:  # every key alike (the paper's model): N 2^lam / Upsilon, one rounding
+            return np.where(keys > 0, keys * t_first, 0.0)
+        out = np.zeros_like(keys)
+        out[keys >= 1] = t_first
+        later = keys > 1
         out[later] = t_first + (keys[later] - 1.0) * t_next
     return out
 
