@@ -23,6 +23,7 @@ from .errors import (
     KeyMismatchError,
     ParameterError,
     PlaintextError,
+    ResourceLimitError,
     ShapeError,
     SolverError,
     UnstableSystemError,
@@ -44,6 +45,7 @@ __all__ = [
     "SolverError",
     "BudgetError",
     "ConfigError",
+    "ResourceLimitError",
 ]
 
 

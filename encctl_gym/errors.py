@@ -21,6 +21,7 @@ __all__ = [
     "SolverError",
     "BudgetError",
     "ConfigError",
+    "ResourceLimitError",
 ]
 
 
@@ -70,3 +71,7 @@ class BudgetError(ParameterError):
 
 class ConfigError(ParameterError):
     """A configuration or system file cannot be read or has invalid content."""
+
+
+class ResourceLimitError(ParameterError):
+    """The estimated time or memory of a request exceeds its limit (the message gives both)."""
