@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import json
 import math
-import time
 
 import gmpy2
 import numpy as np
 import pytest
 
-from encctl_gym.crypto import arith, group as group_mod
+from encctl_gym.crypto import arith
 from encctl_gym.crypto.arith import (
     PowmodCounter,
     RandomSource,
@@ -216,11 +215,9 @@ def test_generate_progress_goes_to_stderr(capsys):
 
 
 @pytest.mark.parametrize("bits", [712, pytest.param(1024, marks=pytest.mark.slow)])
-def test_generation_takes_seconds_not_minutes(bits):
-    t0 = time.perf_counter()
-    grp = generate_safe_prime_group(bits, rng=11)
-    _assert_safe_prime_group(grp, bits)
-    assert time.perf_counter() - t0 < 30.0
+def test_generation_at_key_sizes(bits):
+    # Its time against estimate_generation_seconds: benchmarks/bench_crypto.py.
+    _assert_safe_prime_group(generate_safe_prime_group(bits, rng=11), bits)
 
 
 @pytest.mark.slow
@@ -242,16 +239,16 @@ def test_shipped_groups_are_safe_prime_groups_and_verify_fast():
         grp = shipped_group(bits)
         _assert_safe_prime_group(grp, bits)
         assert get_group(bits) == grp
-    # Verification from scratch (cache cleared) of the largest group is well under 2 s,
-    # and the cached verification is instant.
+    # Verification from scratch exponentiates once (g^q; the primality tests are not counted),
+    # a cached verification not at all (its time: benchmarks/bench_crypto.py).
     big = shipped_group(2048)
-    group_mod._VERIFIED.discard((big.p, big.q, big.g))
-    t0 = time.perf_counter()
-    big.verify()
-    assert time.perf_counter() - t0 < 2.0
-    t0 = time.perf_counter()
-    shipped_group(2048)
-    assert time.perf_counter() - t0 < 0.05
+    with PowmodCounter() as c:
+        assert big.verify(recheck=True) is big
+    assert c.count == 1
+    with PowmodCounter() as c:
+        shipped_group(2048)
+        big.verify()
+    assert c.count == 0
     with pytest.raises(ParameterError, match="no shipped group of 100 bits"):
         shipped_group(100)
 
@@ -309,19 +306,19 @@ def test_generation_estimate_grows_with_bits_and_is_finite_for_any_size():
 
 
 def test_generation_is_refused_before_it_starts_when_the_estimate_exceeds_the_limit():
-    t0 = time.perf_counter()
-    with pytest.raises(ResourceLimitError, match=r"2560000-bit safe-prime group is estimated to take"):
-        generate_safe_prime_group(2_560_000)
-    with pytest.raises(ResourceLimitError, match="max_seconds = 60 s"):
-        get_group(2_560_000)
-    with pytest.raises(ResourceLimitError, match="max_seconds = 60 s"):
-        keygen(2_560_000, rng=1)
     big = estimate_generation_seconds(4096)
-    with pytest.raises(ResourceLimitError, match=f"{big:.3g} s"):
-        generate_safe_prime_group(4096)
-    with pytest.raises(ResourceLimitError, match="3000-bit"):
-        generate_safe_prime_group(3000, max_seconds=1.0)
-    assert time.perf_counter() - t0 < 5.0  # refused, not started (a 3000-bit search takes ~minute)
+    refusals = [
+        (lambda: generate_safe_prime_group(2_560_000), r"2560000-bit safe-prime group is estimated to take"),
+        (lambda: get_group(2_560_000), "max_seconds = 60 s"),
+        (lambda: keygen(2_560_000, rng=1), "max_seconds = 60 s"),
+        (lambda: generate_safe_prime_group(4096), f"{big:.3g} s"),
+        (lambda: generate_safe_prime_group(3000, max_seconds=1.0), "3000-bit"),
+    ]
+    with PowmodCounter() as counter:
+        for call, match in refusals:
+            with pytest.raises(ResourceLimitError, match=match):
+                call()
+    assert counter.count == 0  # refused before the search started (no Fermat test ran)
     assert DEFAULT_MAX_GENERATION_SECONDS == 60.0
     for bad in (0.0, -1.0, math.nan, math.inf, "60"):
         with pytest.raises(ParameterError, match="max_seconds"):
