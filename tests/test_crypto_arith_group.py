@@ -330,3 +330,22 @@ def test_generation_is_refused_before_it_starts_when_the_estimate_exceeds_the_li
 def test_int_seed_of_generation_is_keyed_by_the_purpose_group():
     assert generate_safe_prime_group(80, rng=9) == generate_safe_prime_group(80, rng=seeded_random(9, "group"))
     assert generate_safe_prime_group(80, rng=9) != generate_safe_prime_group(80, rng=seeded_random(9))
+
+
+def test_error_messages_survive_integers_beyond_the_int_to_str_limit():
+    big = 10**5000 + 1  # 5001 decimal digits; str(big) raises ValueError in Python >= 3.11
+    assert arith.format_int(23) == "23" and arith.format_int(-(2**255)) == str(-(2**255))
+    assert arith.format_int(big).endswith("(16610 bits)") and arith.format_int("x") == "'x'"
+    with pytest.raises(GroupError, match=r"p is not prime: p = 0x[0-9a-f]+\.\.\.[0-9a-f]+ \(16610 bits\)"):
+        GroupParams(big, 5, 4).verify()  # 5 divides 10^5000
+    with pytest.raises(GroupError, match="does not divide"):
+        GroupParams(big, 7, 4)
+    with pytest.raises(GroupError, match="declared bits"):
+        GroupParams.from_dict({"p": big, "q": 5, "g": 4, "bits": big})
+    with pytest.raises(GroupError, match="fields"):
+        GroupParams.from_dict([big])
+    with pytest.raises(ParameterError, match="no inverse"):
+        invert(big - 1, big - 1)
+    with pytest.raises(ParameterError, match=r"rng=0x.*\(16610 bits\)"):
+        arith.as_random_stream(big, "encrypt")
+    assert "16610 bits" in repr(seeded_random(big))

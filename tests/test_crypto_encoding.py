@@ -22,7 +22,7 @@ from encctl_gym.crypto.encoding import (
     nearest_member,
 )
 from encctl_gym.crypto.group import GroupParams, shipped_group
-from encctl_gym.errors import EncodingOverflowError, ParameterError, PlaintextError
+from encctl_gym.errors import EncodingOverflowError, GroupError, ParameterError, PlaintextError
 
 TOY = GroupParams(23, 11, 4)  # G = {1, 2, 3, 4, 6, 8, 9, 12, 13, 16, 18}
 G64, G128 = shipped_group(64), shipped_group(128)
@@ -271,3 +271,17 @@ def test_error_bound_known_values():
     enc = Encoder(G64, 4.0)
     assert enc.error_bound(0) == 0.125 and enc.error_bound(3) == 3.5 / 4
     assert enc.error_bound() == (0.5 + 64) / 4 and enc.error_bound(64) == enc.error_bound()
+
+
+def test_encoder_needs_a_verified_group_and_huge_values_give_one_line_errors():
+    with pytest.raises(GroupError, match="p is not prime"):
+        Encoder(GroupParams(27, 13, 4), 1.0)  # Jacobi symbols modulo a composite would lie
+    with pytest.raises(GroupError):
+        encode_int(GroupParams(27, 13, 4), 3)
+    enc = Encoder(G64, 2.0**10)
+    with pytest.raises(EncodingOverflowError, match=r"x = 0x[0-9a-f]+\.\.\.[0-9a-f]+ \(1329 bits\) is too large"):
+        enc.encode(10**400)
+    with pytest.raises(EncodingOverflowError, match="too large"):
+        Encoder(G64, 2.0**10, x_bound=10**400)
+    with pytest.raises(PlaintextError, match=r"\(66439 bits\)"):
+        decode_int(G64, 10**20000)  # more than Python's 4300-digit limit of int-to-str

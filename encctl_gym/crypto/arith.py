@@ -59,6 +59,7 @@ __all__ = [
     "is_prime",
     "jacobi",
     "legendre",
+    "format_int",
     "PowmodCounter",
     "powmod_count",
     "RandomSource",
@@ -98,7 +99,9 @@ def powmod(base: int, exp: int, mod: int) -> int:
     try:
         return gmpy2.powmod(base, exp, mod)
     except (ValueError, ZeroDivisionError) as exc:  # e.g. no inverse for a negative exponent
-        raise ParameterError(f"powmod({base!r}, {exp!r}, {mod!r}) is undefined: {exc}") from exc
+        raise ParameterError(
+            f"powmod({format_int(base)}, {format_int(exp)}, {format_int(mod)}) is undefined: {exc}"
+        ) from exc
 
 
 def powmod_count() -> int:
@@ -146,7 +149,7 @@ def invert(a: int, mod: int) -> int:
     try:
         return gmpy2.invert(a, mod)
     except ZeroDivisionError as exc:
-        raise ParameterError(f"{a} has no inverse modulo {mod}") from exc
+        raise ParameterError(f"{format_int(a)} has no inverse modulo {format_int(mod)}") from exc
 
 
 def is_prime(n: int, reps: int = 25) -> bool:
@@ -182,6 +185,23 @@ def legendre(a: int, p: int) -> int:
     return int(gmpy2.legendre(a, p))
 
 
+def format_int(n: Any) -> str:
+    """An integer for an error message or a repr: decimal up to 256 bits, else abbreviated hex.
+
+    Python refuses to convert integers of more than 4300 decimal digits to text, so a message
+    that printed such a number in decimal would itself raise; ``0x1234abcd...89ef (N bits)``
+    always works and still tells numbers apart.
+    """
+    try:
+        v = int(n)
+    except (TypeError, ValueError):
+        return repr(n)
+    if abs(v).bit_length() <= 256:
+        return str(v)
+    h = hex(v)
+    return f"{h[:14]}...{h[-8:]} ({abs(v).bit_length()} bits)"
+
+
 # --------------------------------------------------------------------------- randomness
 class RandomSource:
     """Source of uniform random integers for the cryptographic algorithms.
@@ -199,7 +219,7 @@ class RandomSource:
     def between(self, low: int, high: int) -> int:
         """Return an integer uniform in ``[low, high)``; requires ``low < high``."""
         if not high > low:
-            raise ParameterError(f"empty range [{low}, {high})")
+            raise ParameterError(f"empty range [{format_int(low)}, {format_int(high)})")
         return low + self.below(high - low)
 
     def spawn(self, purpose: str) -> "RandomSource":
@@ -218,7 +238,7 @@ class RandomSource:
         if isinstance(n, bool) or not isinstance(n, (numbers.Integral, type(mpz(0)))):
             raise ParameterError(f"the bound n must be an integer, got {n!r}")
         if n < 1:
-            raise ParameterError(f"the bound n must be >= 1, got {n}")
+            raise ParameterError(f"the bound n must be >= 1, got {format_int(n)}")
         return n
 
 
@@ -315,7 +335,7 @@ class SeededRandom(RandomSource):
         return child
 
     def __repr__(self) -> str:
-        return f"SeededRandom(seed={self.seed}, purpose={self.purpose!r})"
+        return f"SeededRandom(seed={format_int(self.seed)}, purpose={self.purpose!r})"
 
 
 def secure_random() -> SecureRandom:
@@ -394,7 +414,7 @@ def as_random_stream(rng: RngLike, caller: str) -> RandomSource:
         return rng
     if isinstance(rng, (numbers.Integral, np.integer)) and not isinstance(rng, bool):
         raise ParameterError(
-            f"{caller} draws fresh randomness at every call, so the int seed rng={int(rng)} would "
-            f"repeat it; pass one stream and reuse it, e.g. rng=seeded_random({int(rng)})"
+            f"{caller} draws fresh randomness at every call, so the int seed rng={format_int(rng)} "
+            f"would repeat it; pass one stream and reuse it, e.g. rng=seeded_random({format_int(rng)})"
         )
     return as_random_source(rng, caller)

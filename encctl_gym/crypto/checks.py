@@ -109,6 +109,6 @@ def check_component(group: GroupParams, c: int, name: str) -> None:
     One Jacobi symbol for safe-prime groups (see :meth:`GroupParams.contains`).
     """
     if not 0 < c < group.p:
-        raise CiphertextError(f"ciphertext component {name} = {c} is outside [1, p)")
+        raise CiphertextError(f"ciphertext component {name} = {arith.format_int(c)} is outside [1, p)")
     if not group.contains(c):
-        raise CiphertextError(f"ciphertext component {name} = {c} is not in the subgroup G")
+        raise CiphertextError(f"ciphertext component {name} = {arith.format_int(c)} is not in the subgroup G")

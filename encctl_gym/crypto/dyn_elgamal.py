@@ -29,7 +29,7 @@ __all__ = [
 ]
 
 
-@dataclasses.dataclass(frozen=True, slots=True)
+@dataclasses.dataclass(frozen=True, slots=True, repr=False)
 class UpdateToken:
     """Update token sigma_t = (h, d) of Example ex:dyn_elgamal (``d`` hidden from ``repr``).
 
@@ -61,9 +61,12 @@ class UpdateToken:
         integer_field(self, "d", ParameterError)
         step_field(self, "t", ParameterError, optional=True)
         if self.h == 1 or not grp.contains(self.h):
-            raise KeyMismatchError(f"update token h = {self.h} is not an element of the group other than 1")
+            raise KeyMismatchError(f"update token h = {arith.format_int(self.h)} is not an element of the group other than 1")
         if not 0 <= self.d < grp.q:
             raise KeyMismatchError("update token d is outside [0, q) for its group")
+
+    def __repr__(self) -> str:
+        return f"UpdateToken(bits={self.group.bits}, h={arith.format_int(self.h)}, t={self.t})"
 
 
 def key_update(

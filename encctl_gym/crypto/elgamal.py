@@ -29,6 +29,7 @@ import numpy as np
 from ..errors import CiphertextError, KeyMismatchError, ParameterError, PlaintextError
 from . import arith
 from .arith import RngLike
+from .arith import format_int as fmt
 from .checks import (
     check_component,
     check_group_of,
@@ -56,7 +57,7 @@ __all__ = [
 ]
 
 
-@dataclasses.dataclass(frozen=True, slots=True)
+@dataclasses.dataclass(frozen=True, slots=True, repr=False)
 class PublicKey:
     """Public key pk = (p, q, g, h) of Example ex:elgamal, at time step ``t``.
 
@@ -90,10 +91,13 @@ class PublicKey:
                 "public key h = 1 is degenerate: Enc would output c2 = m, the message in the clear"
             )
         if not self.group.contains(self.h):
-            raise KeyMismatchError(f"public key h = {self.h} is not an element of the group")
+            raise KeyMismatchError(f"public key h = {fmt(self.h)} is not an element of the group")
+
+    def __repr__(self) -> str:
+        return f"PublicKey(bits={self.group.bits}, h={fmt(self.h)}, t={self.t})"
 
 
-@dataclasses.dataclass(frozen=True, slots=True)
+@dataclasses.dataclass(frozen=True, slots=True, repr=False)
 class SecretKey:
     """Secret key sk = s of Example ex:elgamal (with its group), at time step ``t``.
 
@@ -121,13 +125,16 @@ class SecretKey:
                 "give the public key h = 1)"
             )
 
+    def __repr__(self) -> str:
+        return f"SecretKey(bits={self.group.bits}, t={self.t})"
+
     def public_key(self) -> PublicKey:
         """The matching public key ``(p, q, g, g^s mod p)`` at the same step (one exponentiation)."""
         grp = self.group
         return PublicKey(grp, int(arith.powmod(grp.g, self.s, grp.p)), self.t)
 
 
-@dataclasses.dataclass(frozen=True, slots=True)
+@dataclasses.dataclass(frozen=True, slots=True, repr=False)
 class Ciphertext:
     """Ciphertext ct = (c1, c2) = (g^r, m h^r) mod p of Example ex:elgamal, in ``group``.
 
@@ -146,6 +153,9 @@ class Ciphertext:
         integer_field(self, "c1", CiphertextError)
         integer_field(self, "c2", CiphertextError)
         step_field(self, "t", CiphertextError, optional=True)
+
+    def __repr__(self) -> str:
+        return f"Ciphertext(bits={self.group.bits}, c1={fmt(self.c1)}, c2={fmt(self.c2)}, t={self.t})"
 
 
 # ---------------------------------------------------------------------- checks
@@ -169,9 +179,9 @@ def check_plaintext(group: GroupParams, m: Any) -> int:
     if m == 0:
         raise PlaintextError("plaintext m = 0 is not an element of G (0 has no order)")
     if not 0 < m < group.p:
-        raise PlaintextError(f"plaintext m = {m} is outside [1, p) for p = {group.p}")
+        raise PlaintextError(f"plaintext m = {fmt(m)} is outside [1, p) for p = {fmt(group.p)}")
     if not group.contains(m):
-        raise PlaintextError(f"plaintext m = {m} is not in the order-q subgroup G")
+        raise PlaintextError(f"plaintext m = {fmt(m)} is not in the order-q subgroup G")
     return m
 
 

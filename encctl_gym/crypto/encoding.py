@@ -44,6 +44,7 @@ import numpy as np
 from .._validation import check_int, check_positive
 from ..errors import EncodingOverflowError, ParameterError, PlaintextError
 from . import arith
+from .arith import format_int as fmt
 from .group import GroupParams
 
 __all__ = [
@@ -134,7 +135,7 @@ def nearest_member(group: GroupParams, v: int, max_shift: int) -> tuple[int, int
         if _is_member_residue(group, (v - k) % p):
             return v - k, k
     raise PlaintextError(
-        f"no element of the order-q subgroup within max_shift = {max_shift} of v = {v}"
+        f"no element of the order-q subgroup within max_shift = {max_shift} of v = {fmt(v)}"
     )
 
 
@@ -145,11 +146,12 @@ def encode_int(group: GroupParams, v: int, max_shift: Optional[int] = None) -> i
     :class:`EncodingOverflowError` if ``|w| > (p - 1)/2`` (it would not decode back).
     """
     v = _as_int("v", v)
+    group.verify()
     ms = default_max_shift(group) if max_shift is None else check_int("max_shift", max_shift, 0)
     w, _ = nearest_member(group, v, ms)
     if abs(w) > group.half:
         raise EncodingOverflowError(
-            f"v = {v} encodes to w = {w}, outside the representable range |w| <= (p-1)/2"
+            f"v = {fmt(v)} encodes to w = {fmt(w)}, outside the representable range |w| <= (p-1)/2"
         )
     return w % group.p
 
@@ -169,7 +171,7 @@ def decode_int(group: GroupParams, m: int) -> int:
     """
     m = _as_int("m", m, PlaintextError)
     if not 0 <= m < group.p:
-        raise PlaintextError(f"plaintext m = {m} is outside [0, p) for p = {group.p}")
+        raise PlaintextError(f"plaintext m = {fmt(m)} is outside [0, p) for p = {fmt(group.p)}")
     return lift(group, m)
 
 
@@ -200,7 +202,7 @@ def decode_scaled(w: int, delta_ratio: tuple[int, int], power: int = 1) -> float
         return (w * den**power) / num**power
     except OverflowError as exc:
         raise EncodingOverflowError(
-            f"decoded value {w} / Delta^{power} does not fit in a float"
+            f"decoded value {fmt(w)} / Delta^{power} does not fit in a float"
         ) from exc
 
 
@@ -215,7 +217,10 @@ def _as_int(name: str, value: Any, err: type = ParameterError) -> int:
 def _as_finite(name: str, x: Any) -> float:
     if isinstance(x, bool) or not isinstance(x, (numbers.Real, np.floating, np.integer)):
         raise ParameterError(f"{name} must be a real number, got {x!r}")
-    xf = float(x)
+    try:
+        xf = float(x)
+    except OverflowError:
+        raise EncodingOverflowError(f"{name} = {fmt(x)} is too large for a float") from None
     if not math.isfinite(xf):
         raise ParameterError(f"{name} must be finite, got {x!r}")
     return xf
@@ -274,6 +279,8 @@ class Encoder:
 
     Raises
     ------
+    GroupError
+        If ``group`` does not verify (:meth:`~.group.GroupParams.verify`).
     ParameterError
         If ``delta`` is not a finite number > 0, or ``x_bound`` is not finite and >= 0.
     EncodingOverflowError
@@ -296,7 +303,7 @@ class Encoder:
     ) -> None:
         if not isinstance(group, GroupParams):
             raise ParameterError(f"group must be a GroupParams, got {group!r}")
-        self.group = group
+        self.group = group.verify()  # membership tests are only meaningful in a verified group
         self.delta = check_positive("delta", delta)
         self.delta_ratio: tuple[int, int] = self.delta.as_integer_ratio()
         self.max_shift = (
@@ -321,7 +328,7 @@ class Encoder:
         if abs(v) + self.max_shift > self.group.half:
             raise EncodingOverflowError(
                 f"{name} = {x!r} is not representable: |round(Delta x)| + max_shift = "
-                f"{abs(v) + self.max_shift} > (p-1)/2 for a {self.group.bits}-bit group "
+                f"{fmt(abs(v) + self.max_shift)} > (p-1)/2 for a {self.group.bits}-bit group "
                 f"and Delta = {self.delta!r}"
             )
 

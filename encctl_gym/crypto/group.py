@@ -40,6 +40,7 @@ from .._validation import check_int, check_positive
 from ..errors import GroupError, ParameterError, ResourceLimitError
 from . import arith
 from .arith import RngLike
+from .arith import format_int as fmt
 
 __all__ = [
     "GroupParams",
@@ -123,16 +124,16 @@ class GroupParams:
     def __post_init__(self) -> None:
         p, q, g = _as_int("p", self.p), _as_int("q", self.q), _as_int("g", self.g)
         if p < 5:
-            raise GroupError(f"p must be a prime >= 5, got p = {p}")
+            raise GroupError(f"p must be a prime >= 5, got p = {fmt(p)}")
         if q < 3:
             raise GroupError(
-                f"q must be an odd prime >= 3, got q = {q} (for q = 2 the group is {{1, p - 1}} "
+                f"q must be an odd prime >= 3, got q = {fmt(q)} (for q = 2 the group is {{1, p - 1}} "
                 "and the only secret key s = 1 is public)"
             )
         if (p - 1) % q != 0:
-            raise GroupError(f"q = {q} does not divide p - 1 = {p - 1} (need p = n q + 1)")
+            raise GroupError(f"q = {fmt(q)} does not divide p - 1 = {fmt(p - 1)} (need p = n q + 1)")
         if not 1 < g < p:
-            raise GroupError(f"g must satisfy 1 < g < p = {p}, got g = {g}")
+            raise GroupError(f"g must satisfy 1 < g < p = {fmt(p)}, got g = {fmt(g)}")
         object.__setattr__(self, "p", p)
         object.__setattr__(self, "q", q)
         object.__setattr__(self, "g", g)
@@ -195,12 +196,12 @@ class GroupParams:
         if key in _VERIFIED and not recheck:
             return self
         if not arith.is_prime(self.q):
-            raise GroupError(f"q is not prime: q = {self.q}")
+            raise GroupError(f"q is not prime: q = {fmt(self.q)}")
         if not arith.is_prime(self.p):
-            raise GroupError(f"p is not prime: p = {self.p}")
+            raise GroupError(f"p is not prime: p = {fmt(self.p)}")
         if self.g == 1 or arith.powmod(self.g, self.q, self.p) != 1:
             raise GroupError(
-                f"g = {self.g} does not have order q = {self.q} modulo p = {self.p} (g^q != 1)"
+                f"g = {fmt(self.g)} does not have order q = {fmt(self.q)} modulo p = {fmt(self.p)} (g^q != 1)"
             )
         _VERIFIED.add(key)
         return self
@@ -233,11 +234,14 @@ class GroupParams:
         try:
             group = cls(data["p"], data["q"], data["g"])
         except (KeyError, TypeError) as exc:
-            raise GroupError(f"group data must have fields p, q, g, got {data!r}") from exc
+            raise GroupError(
+                f"group data must be a mapping with fields p, q, g, got {type(data).__name__} "
+                f"with fields {sorted(map(str, data)) if isinstance(data, Mapping) else None}"
+            ) from exc
         for name in ("bits", "cofactor"):
             if name in data and _as_int(name, data[name]) != getattr(group, name):
                 raise GroupError(
-                    f"declared {name} = {data[name]} does not match the parameters "
+                    f"declared {name} = {fmt(data[name])} does not match the parameters "
                     f"({name} = {getattr(group, name)})"
                 )
         return group
@@ -254,7 +258,7 @@ class GroupParams:
         except json.JSONDecodeError as exc:
             raise GroupError(f"invalid group JSON: {exc}") from exc
         if not isinstance(data, dict):
-            raise GroupError(f"group JSON must be an object, got {data!r}")
+            raise GroupError(f"group JSON must be an object, got a {type(data).__name__}")
         return cls.from_dict(data)
 
     def save(self, path: Union[str, Path]) -> None:
@@ -268,12 +272,10 @@ class GroupParams:
         return group.verify() if verify else group
 
     def __repr__(self) -> str:
-        return f"GroupParams(bits={self.bits}, cofactor={self.cofactor}, p={_short(self.p)}, g={self.g})"
-
-
-def _short(n: int) -> str:
-    s = hex(n)
-    return s if len(s) <= 24 else f"{s[:12]}...{s[-8:]}"
+        return (
+            f"GroupParams(bits={self.bits}, cofactor={fmt(self.cofactor)}, p={fmt(self.p)}, "
+            f"g={fmt(self.g)})"
+        )
 
 
 # ---------------------------------------------------------------------- generation

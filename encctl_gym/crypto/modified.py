@@ -32,7 +32,7 @@ from .group import GroupParams
 __all__ = ["ModifiedCiphertext", "modified_eval", "modified_decrypt", "check_modified_ciphertext"]
 
 
-@dataclasses.dataclass(frozen=True, slots=True)
+@dataclasses.dataclass(frozen=True, slots=True, repr=False)
 class ModifiedCiphertext:
     """Three-component ciphertext (c1, c2, c3) = (c11, c21, c12 c22 mod p) of Definition def:modification.
 
@@ -54,6 +54,13 @@ class ModifiedCiphertext:
             integer_field(self, name, CiphertextError)
         step_field(self, "t1", CiphertextError, optional=True)
         step_field(self, "t2", CiphertextError, optional=True)
+
+    def __repr__(self) -> str:
+        fmt = arith.format_int
+        return (
+            f"ModifiedCiphertext(bits={self.group.bits}, c1={fmt(self.c1)}, c2={fmt(self.c2)}, "
+            f"c3={fmt(self.c3)}, t1={self.t1}, t2={self.t2})"
+        )
 
 
 def modified_eval(pk: PublicKey, ct1: Ciphertext, ct2: Ciphertext) -> ModifiedCiphertext:
