@@ -336,12 +336,21 @@ def test_error_messages_survive_integers_beyond_the_int_to_str_limit():
     big = 10**5000 + 1  # 5001 decimal digits; str(big) raises ValueError in Python >= 3.11
     assert arith.format_int(23) == "23" and arith.format_int(-(2**255)) == str(-(2**255))
     assert arith.format_int(big).endswith("(16610 bits)") and arith.format_int("x") == "'x'"
-    with pytest.raises(GroupError, match=r"p is not prime: p = 0x[0-9a-f]+\.\.\.[0-9a-f]+ \(16610 bits\)"):
-        GroupParams(big, 5, 4).verify()  # 5 divides 10^5000
-    with pytest.raises(GroupError, match="does not divide"):
-        GroupParams(big, 7, 4)
-    with pytest.raises(GroupError, match="declared bits"):
-        GroupParams.from_dict({"p": big, "q": 5, "g": 4, "bits": big})
+    with pytest.raises(GroupError, match=r"p has 16610 bits, more than MAX_GROUP_BITS = 16384"):
+        GroupParams(big, 5, 4)
+    composite = 10**1000 + 1  # 3322 bits, composite; p - 1 = 10^1000 is divisible by 5
+    with pytest.raises(GroupError, match=r"p is not prime: p = 0x[0-9a-f]+\.\.\.[0-9a-f]+ \(3322 bits\)"):
+        GroupParams(composite, 5, 4).verify()
+    with pytest.raises(GroupError, match=r"q = 11 does not divide p - 1 = 0x.*\(3322 bits\)"):
+        GroupParams(composite, 11, 4)
+    with pytest.raises(GroupError, match=r"declared bits = 0x.*\(16610 bits\)"):
+        GroupParams.from_dict({"p": composite, "q": 5, "g": 4, "bits": big})
+    with pytest.raises(GroupError, match=r"\(100001 characters\)"):
+        GroupParams("9" * 100_001, 5, 4)  # beyond int()'s digit limit too
+    # Sizes beyond any float: the estimate is infinite, generation refused at once.
+    assert estimate_generation_seconds(10**400) == math.inf
+    with pytest.raises(ResourceLimitError, match="estimated to take inf s"):
+        generate_safe_prime_group(10**400)
     with pytest.raises(GroupError, match="fields"):
         GroupParams.from_dict([big])
     with pytest.raises(ParameterError, match="no inverse"):

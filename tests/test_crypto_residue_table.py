@@ -78,10 +78,17 @@ def test_memory_is_estimated_and_refused_before_allocating():
 
 
 def test_memory_estimate_bounds_the_measured_peak():
-    limit = 2_000_000
+    limit = 1_000_000
     tracemalloc.start()
     ResidueTable(G128.p, limit)
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
     est = residue_table_bytes(limit)
     assert peak <= est < 2.5 * peak
+
+
+def test_absurd_limits_are_refused_with_their_numbers():
+    with pytest.raises(ResourceLimitError, match=r"limit = 0x.*\(1329 bits\) needs about 0x"):
+        ResidueTable(G64.p, 10**400)
+    with pytest.raises(GroupError, match="MAX_GROUP_BITS"):
+        ResidueTable((1 << 20000) + 3, 10)  # = 3 mod 4, far too large: refused before any test

@@ -45,6 +45,7 @@ from .arith import format_int as fmt
 __all__ = [
     "GroupParams",
     "MIN_GENERATE_BITS",
+    "MAX_GROUP_BITS",
     "SHIPPED_BITS",
     "DEFAULT_MAX_GENERATION_SECONDS",
     "estimate_generation_seconds",
@@ -61,6 +62,11 @@ __all__ = [
 #: known-answer tests.
 MIN_GENERATE_BITS = 16
 
+#: Largest bit length of p accepted by :class:`GroupParams`: above it a single verification or
+#: exponentiation takes from seconds to hours (NIST SP 800-57 asks 15360 bits of p for the
+#: highest, 256-bit, security level of finite-field discrete logarithms).
+MAX_GROUP_BITS = 16384
+
 #: Bit lengths of the groups shipped in ``crypto/data/groups.json``.
 SHIPPED_BITS: tuple[int, ...] = (64, 128, 256, 512, 712, 1024, 2048)
 
@@ -75,7 +81,8 @@ def _as_int(name: str, value: Any) -> int:
         try:
             return int(value, 0)
         except ValueError as exc:
-            raise GroupError(f"{name} must be an integer, got {value!r}") from exc
+            shown = value if len(value) <= 60 else f"{value[:40]}... ({len(value)} characters)"
+            raise GroupError(f"{name} must be an integer (decimal or 0x hex), got {shown!r}: {exc}") from None
     if type(value).__name__ == "mpz":
         return int(value)
     try:
@@ -88,8 +95,8 @@ def _as_int(name: str, value: Any) -> int:
 class GroupParams:
     """Group parameters (p, q, g) of Example ex:elgamal.
 
-    Construction performs the cheap structural checks (integers, p >= 5, q >= 3, q | p - 1,
-    1 < g < p); :meth:`verify` performs the expensive ones (primality of p and q,
+    Construction performs the cheap structural checks (integers, p >= 5 of at most
+    :data:`MAX_GROUP_BITS` bits, q >= 3, q | p - 1, 1 < g < p); :meth:`verify` performs the expensive ones (primality of p and q,
     g^q = 1 mod p) and is cached per process. No minimum size is enforced here (see
     :data:`MIN_GENERATE_BITS`).
 
@@ -113,8 +120,8 @@ class GroupParams:
     Raises
     ------
     GroupError
-        If a value is not an integer, p < 5, q < 3, q does not divide p - 1, or g is not
-        in (1, p).
+        If a value is not an integer, p < 5 or p has more than :data:`MAX_GROUP_BITS` bits,
+        q < 3, q does not divide p - 1, or g is not in (1, p).
     """
 
     p: int
@@ -125,6 +132,11 @@ class GroupParams:
         p, q, g = _as_int("p", self.p), _as_int("q", self.q), _as_int("g", self.g)
         if p < 5:
             raise GroupError(f"p must be a prime >= 5, got p = {fmt(p)}")
+        if p.bit_length() > MAX_GROUP_BITS:
+            raise GroupError(
+                f"p has {p.bit_length()} bits, more than MAX_GROUP_BITS = {MAX_GROUP_BITS} (every "
+                "verification and exponentiation would take from seconds to hours)"
+            )
         if q < 3:
             raise GroupError(
                 f"q must be an odd prime >= 3, got q = {fmt(q)} (for q = 2 the group is {{1, p - 1}} "
@@ -348,9 +360,10 @@ def _search_plan(bits: int, window: int | None = None) -> tuple[int, int]:
     """(window, sieve limit) of the safe-prime search for ``bits`` (shared with the estimate)."""
     large = bits >= 1536
     window = check_int("window", (1 << 16 if large else 1 << 14) if window is None else window, minimum=16)
-    q_low = 1 << (bits - 2)
-    # Sieve only with primes below q_low, so that a prime q is never struck out by itself.
-    limit = min(1 << (20 if large else 16), max(3, q_low))
+    cap = 1 << (20 if large else 16)
+    # Sieve only with primes below q_low = 2^(bits - 2), so that a prime q is never struck out
+    # by itself (q_low is not built for huge bits: it exceeds the cap from 23 bits on).
+    limit = cap if bits - 2 > 21 else min(cap, max(3, 1 << (bits - 2)))
     return window, limit
 
 
@@ -362,7 +375,10 @@ def _powmod_seconds(bits: float) -> float:
     for (b0, t0), (b1, t1) in zip(table, table[1:]):
         if bits <= b1 or (b1, t1) == table[-1]:
             slope = math.log(t1 / t0) / math.log(b1 / b0)
-            return t0 * math.exp(slope * math.log(bits / b0))
+            try:
+                return t0 * math.exp(slope * (math.log(bits) - math.log(b0)))
+            except OverflowError:
+                return math.inf
     raise AssertionError("unreachable")  # pragma: no cover
 
 
@@ -412,6 +428,8 @@ def estimate_generation_seconds(bits: int, window: int | None = None) -> float:
     """
     bits = _check_bits(bits)
     window, limit = _search_plan(bits, window)
+    if bits > 1 << 60:  # beyond any float model (and any memory)
+        return math.inf
     ln_q = (bits - 1.5) * math.log(2.0)  # q uniform in [2^(bits-2), 2^(bits-1))
     ln_p = ln_q + math.log(2.0)
     candidates = ln_q * ln_p / (4.0 * _TWIN_PRIME_CONSTANT)
@@ -475,7 +493,7 @@ def generate_safe_prime_group(
     estimate = estimate_generation_seconds(bits, window)
     if estimate > max_seconds:
         raise ResourceLimitError(
-            f"generating a {bits}-bit safe-prime group is estimated to take {estimate:.3g} s, "
+            f"generating a {fmt(bits)}-bit safe-prime group is estimated to take {estimate:.3g} s, "
             f"more than max_seconds = {max_seconds:g} s; use a shipped size {SHIPPED_BITS}, load "
             "a group made elsewhere (GroupParams.load), or raise max_seconds"
         )

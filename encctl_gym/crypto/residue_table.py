@@ -57,7 +57,7 @@ def residue_table_bytes(limit: int) -> int:
     """
     limit = check_int("limit", limit, minimum=0)
     n = limit + _PAD + 1
-    primes = int(1.26 * n / max(1.0, math.log(n))) + 64
+    primes = n * 126 // int(100 * max(1.0, math.log(n))) + 64  # integers: no float overflow
     sieve_phase = n + 8 * primes + 64 * min(primes, _BLOCK)  # + one chunk of the prime list
     mask_phase = 5 * n
     offset_phase = 2 * n + 2 * (2 * limit + 1) + 48 * _BLOCK
@@ -95,9 +95,12 @@ def _safe_prime(group_or_p: Union[GroupParams, int]) -> int:
             )
         return group_or_p.verify().p
     p = check_int("p", group_or_p, minimum=5)
-    if not (arith.is_prime(p) and arith.is_prime((p - 1) // 2)):
-        raise GroupError(f"the residue table needs a safe prime p = 2q + 1 (p and q prime), got p = {p}")
-    return p
+    if p % 4 != 3:  # p = 2q + 1 with q odd
+        raise GroupError(f"the residue table needs a safe prime p = 2q + 1, got p = {arith.format_int(p)}")
+    try:  # the group's own checks: size, primality of p and q (4 = 2^2 has order q)
+        return GroupParams(p, (p - 1) // 2, 4).verify().p
+    except GroupError as exc:
+        raise GroupError(f"the residue table needs a safe prime p = 2q + 1: {exc}") from None
 
 
 class ResidueTable:
@@ -137,9 +140,10 @@ class ResidueTable:
         need = residue_table_bytes(max(limit, 0))
         if need > max_bytes:
             raise ResourceLimitError(
-                f"a residue table for |v| <= limit = {limit} needs about {need / 2**20:.0f} MiB "
-                f"to build, more than max_bytes = {max_bytes / 2**20:.0f} MiB; use a smaller "
-                "Delta or a smaller declared range (x_bound), or raise max_bytes"
+                f"a residue table for |v| <= limit = {arith.format_int(limit)} needs about "
+                f"{arith.format_int(need >> 20)} MiB to build, more than max_bytes = "
+                f"{max_bytes >> 20} MiB; use a smaller Delta or a smaller declared range "
+                "(x_bound), or raise max_bytes"
             )
         p = _safe_prime(p)
         if limit < 2 or 4 * limit >= p:
