@@ -201,3 +201,21 @@ def test_controller_from_one_seed_is_reproducible():
     assert a.pk0 == b.pk0 and a.server.ct_phi == b.server.ct_phi
     x = np.array([1.0, -2.0])
     assert np.array_equal(a.step(x), b.step(x)) and a.last_state_ciphertexts == b.last_state_ciphertexts
+
+
+def test_parties_built_from_one_int_seed_do_not_share_a_stream():
+    """A server and a plant side made with the same int must not draw the same numbers (the
+    server's first CtUpd exponent would be the plant's secret key s_0): purposes differ."""
+    from encctl_gym.crypto.controller import PlantCryptoSide, QuantizedLinearController, TokenControllerServer
+
+    quant = QuantizedLinearController(PHI, Encoder(G128, 2.0**8), 10.0)
+    plant = PlantCryptoSide(quant, "token", rng=9)
+    server = TokenControllerServer(plant.pk0, plant.encrypt_parameter(), rng=9)
+    token = plant.update_keys()
+    before = server.ct_phi[0][0]
+    server.receive_token(token)
+    # c1' = c1 g^r with the server's r; with a shared stream r would equal the plant's s_0.
+    after = server.ct_phi[0][0]
+    # (Negative control: with one stream seeded_random(9) given to both, r == s_0 exactly.)
+    assert after.c1 != before.c1 * plant.pk0.h % G128.p  # g^r != g^(s_0), i.e. r != s_0
+    assert plant.pk0 == PlantCryptoSide(quant, "token", rng=9).pk0  # still reproducible

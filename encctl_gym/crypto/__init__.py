@@ -42,6 +42,7 @@ from .elgamal import Ciphertext, PublicKey, SecretKey, decrypt, encrypt, keygen,
 from .encoding import Encoder, decode_int, encode_int
 from .group import (
     DEFAULT_MAX_GENERATION_SECONDS,
+    MAX_GROUP_BITS,
     MIN_GENERATE_BITS,
     SHIPPED_BITS,
     GroupParams,
@@ -60,6 +61,7 @@ __all__ = [
     "as_random_stream",
     "GroupParams",
     "MIN_GENERATE_BITS",
+    "MAX_GROUP_BITS",
     "SHIPPED_BITS",
     "DEFAULT_MAX_GENERATION_SECONDS",
     "estimate_generation_seconds",

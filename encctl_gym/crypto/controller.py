@@ -318,7 +318,7 @@ class TokenControllerServer:
                 check_ciphertext(pk.group, c)
         self._pk = pk
         self._ct_phi = [list(r) for r in rows]
-        self._rng = arith.as_random_source(rng)
+        self._rng = arith.as_random_source(rng, "token server")
         self.t = pk.t
         self.last_token: Optional[UpdateToken] = None
 
@@ -415,7 +415,7 @@ class PlantCryptoSide:
         self.scheme = scheme
         self.quantization = quantization
         self.group = quantization.group
-        self._rng = arith.as_random_source(rng)
+        self._rng = arith.as_random_source(rng, "plant")
         self.pk0, self._sk0 = keygen(self.group, self._rng)
         self.pk, self._sk = self.pk0, self._sk0
         self._mask0: dict[int, Any] = {}
@@ -597,7 +597,7 @@ class EncryptedLinearController:
     ) -> None:
         if scheme not in SCHEMES:
             raise ParameterError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
-        src = arith.as_random_source(rng)
+        src = arith.as_random_source(rng, "controller")
         self.group = as_group(group, rng=src)
         self.scheme = scheme
         self.encoder = Encoder(self.group, delta, max_shift=max_shift)
