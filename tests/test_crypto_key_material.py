@@ -15,7 +15,7 @@ from encctl_gym.crypto.dyn_elgamal import UpdateToken, ciphertext_update, key_up
 from encctl_gym.crypto.elgamal import Ciphertext, PublicKey, SecretKey, decrypt, encrypt, keygen, mult
 from encctl_gym.crypto.encoding import Encoder
 from encctl_gym.crypto.group import GroupParams, generate_safe_prime_group, shipped_group
-from encctl_gym.crypto.modified import ModifiedCiphertext, modified_decrypt, modified_eval
+from encctl_gym.crypto.modified import modified_decrypt, modified_eval
 from encctl_gym.errors import GroupError, KeyMismatchError, ParameterError
 
 TOY = GroupParams(23, 11, 4)  # G = {1, 2, 3, 4, 6, 8, 9, 12, 13, 16, 18}
