@@ -345,6 +345,8 @@ def test_error_messages_survive_integers_beyond_the_int_to_str_limit():
         GroupParams(composite, 11, 4)
     with pytest.raises(GroupError, match=r"declared bits = 0x.*\(16610 bits\)"):
         GroupParams.from_dict({"p": composite, "q": 5, "g": 4, "bits": big})
+    with pytest.raises(GroupError, match="invalid group JSON: Exceeds the limit"):
+        GroupParams.from_json('{"p": ' + "9" * 5000 + ', "q": 5, "g": 4}')
     with pytest.raises(GroupError, match=r"\(100001 characters\)"):
         GroupParams("9" * 100_001, 5, 4)  # beyond int()'s digit limit too
     # Sizes beyond any float: the estimate is infinite, generation refused at once.

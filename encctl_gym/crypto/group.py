@@ -267,8 +267,8 @@ class GroupParams:
         """Parse :meth:`to_json` output; raises :class:`GroupError` on malformed JSON."""
         try:
             data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise GroupError(f"invalid group JSON: {exc}") from exc
+        except ValueError as exc:  # malformed, or a decimal number beyond the int-to-str limit
+            raise GroupError(f"invalid group JSON: {exc}") from None
         if not isinstance(data, dict):
             raise GroupError(f"group JSON must be an object, got a {type(data).__name__}")
         return cls.from_dict(data)
@@ -538,7 +538,7 @@ def generate_safe_prime_group(
 def _shipped_data() -> dict[int, dict[str, Any]]:
     try:
         data = json.loads(_DATA_FILE.read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError) as exc:
+    except (OSError, ValueError) as exc:
         raise GroupError(f"cannot read the shipped groups from {_DATA_FILE}: {exc}") from exc
     return {int(entry["bits"]): entry for entry in data["groups"]}
 
