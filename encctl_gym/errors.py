@@ -82,5 +82,6 @@ class ModelRangeError(ParameterError):
 
 class ResourceLimitError(ParameterError):
     """An input would need more time or memory than the package allows (a file above the size
-    bound, YAML aliases expanding past the node bound, an SDP too large to solve); the message
-    names the estimate and the bound."""
+    bound, YAML aliases expanding past the node bound, an SDP too large to solve, a safe prime
+    too slow to generate, an episode or table too large to allocate); the message names the
+    estimate and the bound."""

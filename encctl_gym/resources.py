@@ -1,14 +1,16 @@
 """Bounds on what a call may allocate, checked before allocating.
 
-Every place that sizes an allocation from user input (the episode's arrays, the ideal backend's
-residue table) estimates the bytes first and calls :func:`check_memory`, so a bad value is a
-clear error naming the estimate, never a process killed for memory.
+Every place that sizes an allocation from user input estimates the bytes first and refuses too
+much with :class:`~encctl_gym.errors.ResourceLimitError`, naming the estimate: the episode's
+arrays here (:func:`check_memory`), the residue table in its own module
+(:func:`encctl_gym.crypto.residue_table.residue_table_bytes`). A bad value is a clear error,
+never a process killed for memory.
 """
 
 from __future__ import annotations
 
 from ._validation import check_int
-from .errors import ParameterError
+from .errors import ResourceLimitError
 
 __all__ = ["MEMORY_LIMIT", "check_memory"]
 
@@ -17,7 +19,7 @@ MEMORY_LIMIT = 8 * 2**30
 
 
 def check_memory(what: str, need: int, limit: int | None = None, advice: str = "") -> None:
-    """Raise :class:`ParameterError` if ``need`` bytes exceed ``limit`` (default :data:`MEMORY_LIMIT`).
+    """Raise :class:`ResourceLimitError` if ``need`` bytes exceed ``limit`` (default :data:`MEMORY_LIMIT`).
 
     Parameters
     ----------
@@ -33,4 +35,4 @@ def check_memory(what: str, need: int, limit: int | None = None, advice: str = "
     cap = MEMORY_LIMIT if limit is None else check_int("memory_limit", limit, minimum=1)
     if need > cap:
         msg = f"{what} needs about {need / 2**30:.3g} GiB, above the limit of {cap / 2**30:.3g} GiB (memory_limit)"
-        raise ParameterError(msg + (f"; {advice}" if advice else ""))
+        raise ResourceLimitError(msg + (f"; {advice}" if advice else ""))

@@ -261,16 +261,16 @@ def test_server_rejects_bad_state_ciphertexts():
     with pytest.raises(CiphertextError, match="expected 4 state ciphertexts, got 3"):
         ctrl.server.evaluate(cts[:3])
     with pytest.raises(CiphertextError, match="expected an ElGamal Ciphertext"):
-        ctrl.server.evaluate(cts[:3] + [ModifiedCiphertext(4, 4, 4)])
+        ctrl.server.evaluate(cts[:3] + [ModifiedCiphertext(G64, 4, 4, 4)])
     with pytest.raises(CiphertextError, match="outside"):
-        ctrl.server.evaluate(cts[:3] + [Ciphertext(G64.p + 1, 4)])
+        ctrl.server.evaluate(cts[:3] + [Ciphertext(G64, G64.p + 1, 4)])
     with pytest.raises(CiphertextError, match="rectangular"):
         ControllerServer(ctrl.pk0, [[cts[0]], [cts[0], cts[1]]])
     with pytest.raises(CiphertextError, match="matrix"):
         ControllerServer(ctrl.pk0, 5)
     token = EncryptedLinearController(PHI, G64, 2.0**10, 10.0, scheme="token", rng=8)
     with pytest.raises(KeyMismatchError, match="token is for step t = 5"):
-        token.server.receive_token(UpdateToken(4, 1, 5))
+        token.server.receive_token(UpdateToken(G64, 4, 1, 5))
     old = token.plant.encrypt_state(_x(1))
     token.step(_x(1))
     with pytest.raises(KeyMismatchError, match="state ciphertext is of step t = 0"):
@@ -331,17 +331,17 @@ def test_injection_bad_input():
         injection_value([1.0], ctrl.encoder, 0)
     # Forged with a stale public key: the plant detects the wrong step.
     ctrl.step(_x(0))
-    stale = forge_injection(ctrl.pk0, ctrl.pk0, np.ones(4), ctrl.encoder, 4, 1)
+    stale = forge_injection(ctrl.pk0, ctrl.pk0, np.ones(4), ctrl.encoder, 4, seeded_random(1))
     with pytest.raises(KeyMismatchError, match=r"\(t1, t2\) = \(0, 0\)"):
         ctrl.step(_x(1), inject=stale)
     # Wrong shape or type.
-    good = forge_injection(ctrl.pk0, ctrl.pk, np.ones(4), ctrl.encoder, 4, 1)
+    good = forge_injection(ctrl.pk0, ctrl.pk, np.ones(4), ctrl.encoder, 4, seeded_random(1))
     with pytest.raises(CiphertextError, match="shape"):
         ctrl.step(_x(1), inject=[row[:3] for row in good])
     with pytest.raises(CiphertextError, match="ModifiedCiphertext"):
-        ctrl.step(_x(1), inject=[[Ciphertext(4, 4)] * 4] * 4)
+        ctrl.step(_x(1), inject=[[Ciphertext(G64, 4, 4)] * 4] * 4)
     bad = [list(r) for r in good]
-    bad[2][1] = ModifiedCiphertext(good[2][1].c1, good[2][1].c2, 0, 0, ctrl.t)
+    bad[2][1] = ModifiedCiphertext(G64, good[2][1].c1, good[2][1].c2, 0, 0, ctrl.t)
     with pytest.raises(CiphertextError, match="c3 = 0"):
         ctrl.step(_x(1), inject=bad)
 
@@ -369,6 +369,6 @@ def test_encrypted_controller_at_712_bits(bits):
             x = _x(t, bound=100.0)
             assert np.array_equal(ctrl.step(x), ctrl.reference(x))
         a = np.array([1.5, -2.25, 0.0, 7.0])
-        forged = (forge_injection(ctrl.pk0, ctrl.pk, a, ctrl.encoder, 4, 1) if scheme == "modified"
-                  else forge_injection_token(ctrl.pk, a, ctrl.encoder, 4, 1))
+        forged = (forge_injection(ctrl.pk0, ctrl.pk, a, ctrl.encoder, 4, seeded_random(1)) if scheme == "modified"
+                  else forge_injection_token(ctrl.pk, a, ctrl.encoder, 4, seeded_random(1)))
         assert np.array_equal(ctrl.step(_x(9), inject=forged), injection_value(a, ctrl.encoder, 4))

@@ -46,16 +46,16 @@ from .._validation import as_finite_array, check_int, check_nonnegative
 from ..errors import CiphertextError, EncodingOverflowError, KeyMismatchError, ParameterError
 from . import arith
 from .arith import RandomSource, RngLike
+from .checks import check_group_of, check_instance
 from .dyn_elgamal import UpdateToken, ciphertext_update, key_update
 from .elgamal import (
     Ciphertext,
     PublicKey,
     SecretKey,
-    _check_key,
-    _encrypt_member,
     check_ciphertext,
     check_same_group,
     encrypt,
+    encrypt_member,
     keygen,
 )
 from .encoding import Encoder, lift
@@ -227,7 +227,7 @@ class ControllerServer:
     __slots__ = ("_pk0", "_ct_phi")
 
     def __init__(self, pk0: PublicKey, ct_phi: Sequence[Sequence[Ciphertext]]) -> None:
-        _check_key(pk0, PublicKey, "pk0")
+        check_instance(pk0, PublicKey, "pk0")
         rows = _ct_matrix("ct_phi", ct_phi, Ciphertext)
         for r in rows:
             for c in r:
@@ -279,7 +279,7 @@ class ControllerServer:
         for row in self._ct_phi:
             out.append(
                 [
-                    ModifiedCiphertext(a.c1, b.c1, int(arith.mulmod(a.c2, b.c2, p)), a.t, b.t)
+                    ModifiedCiphertext(grp, a.c1, b.c1, int(arith.mulmod(a.c2, b.c2, p)), a.t, b.t)
                     for a, b in zip(row, cts)
                 ]
             )
@@ -311,14 +311,14 @@ class TokenControllerServer:
     __slots__ = ("_pk", "_ct_phi", "_rng", "t", "last_token")
 
     def __init__(self, pk: PublicKey, ct_phi: Sequence[Sequence[Ciphertext]], rng: RngLike = None) -> None:
-        _check_key(pk, PublicKey, "pk")
+        check_instance(pk, PublicKey, "pk")
         rows = _ct_matrix("ct_phi", ct_phi, Ciphertext)
         for r in rows:
             for c in r:
                 check_ciphertext(pk.group, c)
         self._pk = pk
         self._ct_phi = [list(r) for r in rows]
-        self._rng = arith.as_random_source(rng)
+        self._rng = arith.as_random_source(rng, "token server")
         self.t = pk.t
         self.last_token: Optional[UpdateToken] = None
 
@@ -374,7 +374,7 @@ class TokenControllerServer:
         p = grp.p
         return [
             [
-                Ciphertext(int(arith.mulmod(a.c1, b.c1, p)), int(arith.mulmod(a.c2, b.c2, p)), self.t)
+                Ciphertext(grp, int(arith.mulmod(a.c1, b.c1, p)), int(arith.mulmod(a.c2, b.c2, p)), self.t)
                 for a, b in zip(row, cts)
             ]
             for row in self._ct_phi
@@ -415,7 +415,7 @@ class PlantCryptoSide:
         self.scheme = scheme
         self.quantization = quantization
         self.group = quantization.group
-        self._rng = arith.as_random_source(rng)
+        self._rng = arith.as_random_source(rng, "plant")
         self.pk0, self._sk0 = keygen(self.group, self._rng)
         self.pk, self._sk = self.pk0, self._sk0
         self._mask0: dict[int, Any] = {}
@@ -443,7 +443,7 @@ class PlantCryptoSide:
         """``Enc(pk_t, Ecd(x_j; Delta))`` for j = 1..beta (checks the range |x_j| <= x_bound)."""
         p = self.group.p
         # The encoder only returns members of G, so the plaintext check can be skipped.
-        return [_encrypt_member(self.pk, w % p, self._rng) for w in self.quantization.encode_state(x)]
+        return [encrypt_member(self.pk, w % p, self._rng) for w in self.quantization.encode_state(x)]
 
     @property
     def secret_key(self) -> SecretKey:
@@ -478,6 +478,7 @@ class PlantCryptoSide:
                 for c in row:
                     if not isinstance(c, ModifiedCiphertext):
                         check_modified_ciphertext(grp, c)  # raises CiphertextError
+                    check_group_of(c, grp)
                     if not (0 < c.c1 < p and 0 < c.c2 < p and grp.contains(c.c3)):
                         check_modified_ciphertext(grp, c)  # raises, naming the component
                     if (c.t1 is not None and c.t1 != self._sk0.t) or (c.t2 is not None and c.t2 != t):
@@ -596,7 +597,7 @@ class EncryptedLinearController:
     ) -> None:
         if scheme not in SCHEMES:
             raise ParameterError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
-        src = arith.as_random_source(rng)
+        src = arith.as_random_source(rng, "controller")
         self.group = as_group(group, rng=src)
         self.scheme = scheme
         self.encoder = Encoder(self.group, delta, max_shift=max_shift)
@@ -761,7 +762,8 @@ def forge_injection(
         The plant's encoder.
     n_cols : int
         beta (the plant checks the output shape).
-    rng : None, int, RandomSource or numpy.random.Generator
+    rng : None, RandomSource or numpy.random.Generator
+        A stream (an int seed is refused: it would repeat (r, r') in every forgery).
 
     Returns
     -------
@@ -774,13 +776,13 @@ def forge_injection(
     EncodingOverflowError
         If some ``a_i`` is not representable.
     """
-    _check_key(pk_0, PublicKey, "pk_0")
-    _check_key(pk_t, PublicKey, "pk_t")
+    check_instance(pk_0, PublicKey, "pk_0")
+    check_instance(pk_t, PublicKey, "pk_t")
     grp = check_same_group(pk_0, pk_t, "pk_0 and pk_t")
     if isinstance(encoder, Encoder) and encoder.group != grp:
         raise KeyMismatchError("the encoder's group differs from the public keys' group")
     plain = _injection_plaintexts(a, encoder, n_cols)
-    src = arith.as_random_source(rng)
+    src = arith.as_random_stream(rng, "forge_injection")
     p, q, g = grp.p, grp.q, grp.g
     # One pair (r, r') for the whole matrix: 4 exponentiations per forgery. Every entry is still
     # a valid ciphertext of its plaintext; how an attacker randomises its own forgeries does not
@@ -789,7 +791,7 @@ def forge_injection(
     c1, c2 = int(arith.powmod(g, r, p)), int(arith.powmod(g, r2, p))
     mask = arith.mulmod(arith.powmod(pk_0.h, r, p), arith.powmod(pk_t.h, r2, p), p)
     return [
-        [ModifiedCiphertext(c1, c2, int(arith.mulmod(m, mask, p)), pk_0.t, pk_t.t) for m in row]
+        [ModifiedCiphertext(grp, c1, c2, int(arith.mulmod(m, mask, p)), pk_0.t, pk_t.t) for m in row]
         for row in plain
     ]
 
@@ -808,13 +810,13 @@ def forge_injection_token(
     EncodingOverflowError
         If some ``a_i`` is not representable.
     """
-    _check_key(pk_t, PublicKey, "pk_t")
+    check_instance(pk_t, PublicKey, "pk_t")
     if isinstance(encoder, Encoder) and encoder.group != pk_t.group:
         raise KeyMismatchError("the encoder's group differs from the public key's group")
     plain = _injection_plaintexts(a, encoder, n_cols)
-    src = arith.as_random_source(rng)
+    src = arith.as_random_stream(rng, "forge_injection_token")
     grp = pk_t.group
     p = grp.p
     r = src.between(1, grp.q)  # one r for the matrix (see forge_injection): 2 exponentiations
     c1, mask = int(arith.powmod(grp.g, r, p)), arith.powmod(pk_t.h, r, p)
-    return [[Ciphertext(c1, int(arith.mulmod(m, mask, p)), pk_t.t) for m in row] for row in plain]
+    return [[Ciphertext(grp, c1, int(arith.mulmod(m, mask, p)), pk_t.t) for m in row] for row in plain]

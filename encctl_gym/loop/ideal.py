@@ -15,8 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import EncodingOverflowError
-from ..resources import check_memory
+from ..errors import EncodingOverflowError, ResourceLimitError
 from .backend import lqr_gain, table_limit
 from .quantize import OK, Quantization, collect_states, forge_inputs
 
@@ -37,20 +36,20 @@ class IdealLoop:
     batched = True
 
     def __init__(self, params: Any, group: Any) -> None:
-        from ..crypto.residue_table import residue_table, table_bytes
+        from ..crypto.residue_table import residue_table
 
         self.delta = float(params.delta)
         self.x_bound = float(params.x_bound)
         self.n, self.m = params.n, params.m
         self.Phi = -lqr_gain(params.A, params.B)
         limit = table_limit(params, self.Phi)
-        check_memory(
-            f"the quantisation table for |round(Delta v)| <= {limit} (Delta = {params.delta}, x_bound = {params.x_bound}, "
-            f"u_max = {params.u_max:.4g})",
-            table_bytes(limit),
-            advice="use a smaller x_bound or delta",
-        )
-        self.table = residue_table(int(group.p), limit)
+        try:
+            self.table = residue_table(group, limit)
+        except ResourceLimitError as exc:
+            raise ResourceLimitError(
+                f"the quantisation table for x_bound = {params.x_bound}, Delta = {params.delta}, u_max = "
+                f"{params.u_max:.4g} is too large ({exc}); use a smaller x_bound or delta"
+            ) from None
         self.Phi_int = self.encode_int(self.Phi)
         self.quantization = Quantization(
             delta=self.delta,
