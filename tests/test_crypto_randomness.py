@@ -18,7 +18,8 @@ from encctl_gym.crypto.arith import (
     as_random_stream,
     seeded_random,
 )
-from encctl_gym.crypto.controller import EncryptedLinearController, forge_injection, forge_injection_token
+from encctl_gym.attacks.forgery import forge_injection, forge_injection_token
+from encctl_gym.crypto.controller import EncryptedLinearController
 from encctl_gym.crypto.dyn_elgamal import ciphertext_update, key_update
 from encctl_gym.crypto.elgamal import decrypt, encrypt, keygen
 from encctl_gym.crypto.encoding import Encoder
@@ -206,10 +207,12 @@ def test_controller_from_one_seed_is_reproducible():
 def test_parties_built_from_one_int_seed_do_not_share_a_stream():
     """A server and a plant side made with the same int must not draw the same numbers (the
     server's first CtUpd exponent would be the plant's secret key s_0): purposes differ."""
-    from encctl_gym.crypto.controller import PlantCryptoSide, QuantizedLinearController, TokenControllerServer
+    from encctl_gym.crypto.plant_side import TokenPlant
+    from encctl_gym.crypto.quantized import QuantizedLinearController
+    from encctl_gym.crypto.servers import TokenControllerServer
 
     quant = QuantizedLinearController(PHI, Encoder(G128, 2.0**8), 10.0)
-    plant = PlantCryptoSide(quant, "token", rng=9)
+    plant = TokenPlant(quant, rng=9)
     server = TokenControllerServer(plant.pk0, plant.encrypt_parameter(), rng=9)
     token = plant.update_keys()
     before = server.ct_phi[0][0]
@@ -218,4 +221,4 @@ def test_parties_built_from_one_int_seed_do_not_share_a_stream():
     after = server.ct_phi[0][0]
     # (Negative control: with one stream seeded_random(9) given to both, r == s_0 exactly.)
     assert after.c1 != before.c1 * plant.pk0.h % G128.p  # g^r != g^(s_0), i.e. r != s_0
-    assert plant.pk0 == PlantCryptoSide(quant, "token", rng=9).pk0  # still reproducible
+    assert plant.pk0 == TokenPlant(quant, rng=9).pk0  # still reproducible

@@ -32,6 +32,7 @@ __all__ = [
     "check_same_group",
     "check_group_of",
     "check_component",
+    "check_ciphertext_matrix",
 ]
 
 _MPZ = type(arith.mpz(0))
@@ -112,3 +113,29 @@ def check_component(group: GroupParams, c: int, name: str) -> None:
         raise CiphertextError(f"ciphertext component {name} = {arith.format_int(c)} is outside [1, p)")
     if not group.contains(c):
         raise CiphertextError(f"ciphertext component {name} = {arith.format_int(c)} is not in the subgroup G")
+
+
+def check_ciphertext_matrix(name: str, mat: Any, cls: type, shape: tuple[int, int] | None = None) -> list[list[Any]]:
+    """``mat`` as a list of rows after checking it is a non-empty rectangular matrix of ``cls``.
+
+    The shape check of every party that receives a matrix of ciphertexts (the controller
+    parameter at a server, the server's output at the plant of eq:ec).
+
+    Raises
+    ------
+    CiphertextError
+        For something that is not a matrix, ragged rows, another ``shape`` or another entry type.
+    """
+    try:
+        rows = [list(r) for r in mat]
+    except TypeError as exc:
+        raise CiphertextError(f"{name} must be a matrix of {cls.__name__}, got {type(mat).__name__}") from exc
+    if not rows or not rows[0] or any(len(r) != len(rows[0]) for r in rows):
+        raise CiphertextError(f"{name} must be a non-empty rectangular matrix, got row lengths {[len(r) for r in rows]}")
+    if shape is not None and (len(rows), len(rows[0])) != shape:
+        raise CiphertextError(f"{name} must have shape {shape}, got {(len(rows), len(rows[0]))}")
+    for r in rows:
+        for c in r:
+            if not isinstance(c, cls):
+                raise CiphertextError(f"{name} must contain {cls.__name__} entries, got {type(c).__name__}")
+    return rows

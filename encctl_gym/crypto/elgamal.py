@@ -51,6 +51,7 @@ __all__ = [
     "decrypt",
     "decrypt_components",
     "mult",
+    "mult_members",
     "check_plaintext",
     "check_ciphertext",
     "check_same_group",
@@ -319,8 +320,14 @@ def mult(pk: PublicKey, ct1: Ciphertext, ct2: Ciphertext) -> Ciphertext:
         raise KeyMismatchError(
             f"Eval needs ciphertexts of the same time step, got t = {ct1.t} and t = {ct2.t}"
         )
-    t = ct1.t if ct1.t is not None else ct2.t
-    p = grp.p
-    return Ciphertext(
-        grp, int(arith.mulmod(ct1.c1, ct2.c1, p)), int(arith.mulmod(ct1.c2, ct2.c2, p)), t
-    )
+    return mult_members(grp, ct1, ct2, ct1.t if ct1.t is not None else ct2.t)
+
+
+def mult_members(group: GroupParams, ct1: Ciphertext, ct2: Ciphertext, t: Optional[int]) -> Ciphertext:
+    """Eval of Example ex:elgamal on ciphertexts already checked to belong to ``group`` (no checks).
+
+    The raw algorithm under :func:`mult`, for a caller that checks its inputs once (the
+    conventional controller server). Two modular multiplications; the result records step ``t``.
+    """
+    p = group.p
+    return Ciphertext(group, int(arith.mulmod(ct1.c1, ct2.c1, p)), int(arith.mulmod(ct1.c2, ct2.c2, p)), t)

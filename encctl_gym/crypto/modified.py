@@ -29,7 +29,7 @@ from .checks import (
 from .elgamal import Ciphertext, PublicKey, SecretKey, check_ciphertext, decrypt_components
 from .group import GroupParams
 
-__all__ = ["ModifiedCiphertext", "modified_eval", "modified_decrypt", "check_modified_ciphertext"]
+__all__ = ["ModifiedCiphertext", "modified_eval", "modified_eval_members", "modified_decrypt", "check_modified_ciphertext"]
 
 
 @dataclasses.dataclass(frozen=True, slots=True, repr=False)
@@ -79,8 +79,17 @@ def modified_eval(pk: PublicKey, ct1: Ciphertext, ct2: Ciphertext) -> ModifiedCi
     grp = pk.group
     check_ciphertext(grp, ct1)
     check_ciphertext(grp, ct2)
-    c3 = arith.mulmod(ct1.c2, ct2.c2, grp.p)
-    return ModifiedCiphertext(grp, ct1.c1, ct2.c1, int(c3), ct1.t, ct2.t)
+    return modified_eval_members(grp, ct1, ct2)
+
+
+def modified_eval_members(group: GroupParams, ct1: Ciphertext, ct2: Ciphertext) -> ModifiedCiphertext:
+    """Eval_bar of Definition def:modification on ciphertexts already checked to belong to ``group``.
+
+    The raw algorithm under :func:`modified_eval`, for a caller that checks its inputs once
+    (the controller server of eq:ec checks each state ciphertext once per step, its own
+    parameter ciphertexts once at set-up). One modular multiplication.
+    """
+    return ModifiedCiphertext(group, ct1.c1, ct2.c1, int(arith.mulmod(ct1.c2, ct2.c2, group.p)), ct1.t, ct2.t)
 
 
 def check_modified_ciphertext(grp: GroupParams, ct: Any) -> ModifiedCiphertext:

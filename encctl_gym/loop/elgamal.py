@@ -46,10 +46,12 @@ def party_random_sources(crypto_seed: int | None) -> dict[str, Any]:
 class ElGamalLoop:
     """Real dynamic-key ElGamal ciphertexts through the loop (one copy).
 
-    The plant side (:class:`~encctl_gym.crypto.controller.PlantCryptoSide`) holds the keys,
-    encrypts the state under ``pk_t``, decrypts (two-key ``Dec_bar(sk_0, sk_t, .)`` in the
-    modified scheme, ``Dec(sk_t, .)`` otherwise), sums and decodes; the controller server holds
-    public keys and ciphertexts only. ``"modified"``: Phi encrypted once under ``pk_0``, keys
+    The parties come from the scheme (:data:`encctl_gym.crypto.schemes.SCHEMES`): the plant
+    side (:mod:`encctl_gym.crypto.plant_side`) holds the keys, encrypts the state under
+    ``pk_t``, decrypts (two-key ``Dec_bar(sk_0, sk_t, .)`` in the modified scheme, ``Dec(sk_t,
+    .)`` otherwise), sums and decodes; the controller server (:mod:`encctl_gym.crypto.servers`)
+    holds public keys and ciphertexts only; the forged input comes from
+    :func:`encctl_gym.attacks.forgery.forge`. ``"modified"``: Phi encrypted once under ``pk_0``, keys
     updated every period, no token leaves the plant. ``"token"``: the server receives every
     update token and CtUpds Phi's ciphertexts. ``"static"``: one key pair, never updated.
 
@@ -62,11 +64,13 @@ class ElGamalLoop:
 
     def __init__(self, params: Any, group: Any) -> None:
         from ..crypto.encoding import Encoder
+        from ..crypto.schemes import get_scheme
 
         self.params = params
         self.group = group
         self.n, self.m = params.n, params.m
         self.scheme = params.scheme
+        self._scheme = get_scheme(params.scheme)
         self.encoder = Encoder(group, float(params.delta))
         self.Phi = -lqr_gain(params.A, params.B)
         #: each party's random source (privileged: who holds which randomness), see :func:`party_random_sources`
@@ -77,16 +81,11 @@ class ElGamalLoop:
         self.last_output_ciphertexts: list[list[Any]] | None = None
 
     def start_episode(self) -> None:
-        """Fresh keys (KeyGen) and Phi encrypted under ``pk_0``; the server is set up."""
-        from ..crypto.controller import ControllerServer, PlantCryptoSide, QuantizedLinearController, TokenControllerServer
+        """Fresh keys (KeyGen) and Phi encrypted under ``pk_0``; the server of the scheme is set up."""
+        from ..crypto.quantized import QuantizedLinearController
 
         quant = QuantizedLinearController(self.Phi, self.encoder, self.params.x_bound)
-        self.plant = PlantCryptoSide(quant, "modified" if self.scheme == "modified" else "token", self.random_sources["plant"])
-        ct_phi = self.plant.encrypt_parameter()
-        if self.scheme == "modified":
-            self.server = ControllerServer(self.plant.pk0, ct_phi)
-        else:
-            self.server = TokenControllerServer(self.plant.pk0, ct_phi, self.random_sources["server"])
+        self.plant, self.server = self._scheme.parties(quant, self.random_sources["plant"], self.random_sources["server"])
 
     @staticmethod
     def _single(v: np.ndarray) -> np.ndarray:
@@ -114,21 +113,16 @@ class ElGamalLoop:
 
     def inject(self, a: np.ndarray) -> np.ndarray:
         """The adversary forges the input ciphertexts from public keys only; the plant decrypts."""
-        from ..crypto.controller import forge_injection, forge_injection_token
+        from ..attacks.forgery import forge
 
         a0 = self._single(a)
-        if self.scheme == "modified":
-            out = forge_injection(self.plant.pk0, self.plant.pk, a0, self.encoder, self.n, self.random_sources["adversary"])
-        else:
-            out = forge_injection_token(self.plant.pk, a0, self.encoder, self.n, self.random_sources["adversary"])
+        out = forge(self.scheme, self.plant.pk0, self.plant.pk, a0, self.encoder, self.n, self.random_sources["adversary"])
         self.last_output_ciphertexts = out
         return self.plant.decrypt_output(out)[None]
 
     def tick(self) -> None:
         """KeyUpd at the end of the period (none for static keys); the token scheme sends the
         token to the server, which CtUpds Phi's ciphertexts."""
-        if self.scheme == "static":
-            return
         token = self.plant.update_keys()
-        if self.scheme == "token":
+        if self._scheme.token_to_server:
             self.server.receive_token(token)
