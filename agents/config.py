@@ -174,19 +174,21 @@ def _check_algo(algo: Any) -> None:
         raise ConfigError(f"unknown algorithm {algo!r}; choose one of {', '.join(algos)}")
 
 
-def plant_config(path: str | Path) -> dict[str, Any]:
-    """The environment entries read from a plant file (``A``, ``B``; JSON, YAML or NPZ).
+def plant_config(path: str | Path, preset: str | None = None) -> dict[str, Any]:
+    """The environment entries of a plant file: ``A``, ``B`` and every design value.
 
-    The one place ``train --system FILE`` reads a plant; it uses the ``design`` command's
-    reader, so both accept the same files. A YAML plant file first passes :func:`read_yaml`'s
-    guards (size, no aliases), which that reader does not have.
+    The one place ``train --system FILE`` reads a plant, through the package's one plant-file
+    schema (:func:`encctl_gym.plant_file.load_plant_file`, the reader of ``encctl-gym design``):
+    the values the file gives (variances, gamma_c, tau_c, Upsilon) are used, the others come
+    from ``preset`` (the system the configuration names, kept as the source of defaults) or,
+    without one, the paper's defaults. Every value is written out, so the environment takes
+    nothing from the preset silently.
     """
-    from encctl_gym.security.design_cli import load_system
+    from encctl_gym.plant_file import load_plant_file
+    from encctl_gym.presets import get_preset
 
-    if Path(path).suffix.lower() in (".yaml", ".yml") and Path(path).is_file():
-        read_yaml(path)
-    A, B = load_system(path)
-    return {"A": A.tolist(), "B": B.tolist()}
+    spec = load_plant_file(path, defaults=get_preset(preset) if preset is not None else None)
+    return {"preset": preset, "A": spec.A.tolist(), "B": spec.B.tolist(), **spec.values()}
 
 
 def load_config(
@@ -209,9 +211,9 @@ def load_config(
     path : path, optional
         An explicit config file (instead of the preset's tuned file).
     system : path, optional
-        A plant file whose ``A`` and ``B`` replace the preset's (:func:`plant_config`); the
-        other design parameters (noise variances, ``gamma_c``, ``tau_c``, Upsilon) stay the
-        preset's unless set in ``env``.
+        A plant file whose ``A`` and ``B`` (and the design values it gives) replace the preset's
+        (:func:`plant_config`); the design values it does not give (noise variances,
+        ``gamma_c``, ``tau_c``, Upsilon) are the preset's.
     quick : bool
         Apply the ``quick:`` sections (a smoke test of a few thousand steps).
 
@@ -250,7 +252,7 @@ def load_config(
         if not isinstance(cfg.get("env"), dict):
             raise ConfigError(f"env must be a mapping, got {cfg.get('env')!r}")
     if system is not None:
-        cfg["env"].update(plant_config(system))
+        cfg["env"].update(plant_config(system, cfg["env"].get("preset")))
         cfg["system"] = Path(system).stem
     else:
         cfg["system"] = str(cfg["env"].get("preset"))

@@ -35,12 +35,14 @@ def env_config(config: dict[str, Any] | None = None, **overrides: Any) -> dict[s
 def budget_config(config: dict[str, Any], N: int) -> dict[str, Any]:
     """``config`` with an attack of exactly ``N`` samples set by the deciphering budget.
 
-    Keeps the security parameter (and so the cost of a sample) of ``config`` and shortens the
-    defense period to ``tau_c = (N + 1/2) 2^lambda / Upsilon``, so the episode ends by
-    *termination* after ``N`` samples and the observed budget fraction is the fraction of the
-    attack elapsed, as in a full attack. (``max_samples`` would cut the episode instead, with
-    the budget fraction stuck near 0.) Schemes where one break reveals every sample have no
-    deciphering budget: there ``max_samples = N`` is used.
+    Keeps the key (its length, or the security parameter, and so the cost of every sample
+    under the configured deciphering model) and shortens the defense period to half a
+    per-key cost past ``tau(N)``: ``tau_c = (N + 1/2) 2^lambda / Upsilon`` under the paper's
+    model, ``tau(N) + C_key / (2 Upsilon)`` under a model with a precomputation. The episode
+    then ends by *termination* after ``N`` samples and the observed budget fraction is the
+    fraction of the attack's deciphering time spent, as in a full attack. (``max_samples``
+    would cut the episode instead, with the budget fraction stuck near 0.) Schemes where one
+    break reveals every sample have no deciphering budget: there ``max_samples = N`` is used.
 
     Parameters
     ----------
@@ -60,9 +62,16 @@ def budget_config(config: dict[str, Any], N: int) -> dict[str, Any]:
         cfg["max_samples"] = N
         return cfg
     cfg.pop("max_samples", None)
-    cfg.pop("key_length", None)
-    cfg["security_parameter"] = base.security_parameter
-    cfg["tau_c"] = (N + 0.5) * base.sample_cost
+    if cfg.get("key_length") is None:  # pin the key the configuration resolved to
+        if base.deciphering_model == "paper":
+            cfg["security_parameter"] = base.security_parameter
+        else:
+            cfg.pop("security_parameter", None)
+            cfg["key_length"] = base.key_length
+    if base.cost.first == base.cost.next:  # every key alike: (N + 1/2) keys
+        cfg["tau_c"] = (N + 0.5) * base.sample_cost
+    else:
+        cfg["tau_c"] = float(base.deciphering_time(N)) + 0.5 * base.next_sample_cost
     got = resolve_params(env_config(cfg)).horizon
     if got != N:  # pragma: no cover - guards the arithmetic above
         raise ParameterError(f"budget_config: expected a horizon of {N}, got {got}")
@@ -72,12 +81,13 @@ def budget_config(config: dict[str, Any], N: int) -> dict[str, Any]:
 def elgamal_config(config: dict[str, Any], N: int, *, key_length: int = 64, crypto_seed: int | None = 0) -> dict[str, Any]:
     """``config`` on the real ElGamal backend with a small key, for an attack of ``N`` samples.
 
-    The key length sets lambda (eq:opt_key read backwards), so the deciphering budget is set
-    again for ``N`` samples (:func:`budget_config`): the attack has the same length and the
+    The key length sets the cost of a sample under the configured deciphering model (lambda =
+    log2 Omega(k) under the paper's, eq:opt_key read backwards), so the deciphering budget is
+    set again for ``N`` samples (:func:`budget_config`): the attack has the same length and the
     observed budget fractions the same meaning as on the ideal backend. ``crypto_seed`` makes
     the ciphertexts reproducible (unsafe for deployment; this is a simulation).
     """
-    cfg = {k: v for k, v in config.items() if k not in ("security_parameter", "tau_c", "max_samples", "crypto", "crypto_seed")}
+    cfg = {k: v for k, v in config.items() if k not in ("security_parameter", "max_samples", "crypto", "crypto_seed")}
     cfg["key_length"] = check_int("key_length", key_length, minimum=16)
     cfg = budget_config(cfg, N)
     cfg.update(crypto="elgamal", crypto_seed=crypto_seed)

@@ -18,7 +18,7 @@ from agents.runs import find_runs, new_run_dir, read_run
 from agents.sb3 import ALGORITHMS, SB3VecEnv, algorithm_class, load_attacker
 from encctl_gym import cli
 from encctl_gym.envs.config import resolve_params
-from encctl_gym.errors import ConfigError
+from encctl_gym.errors import ConfigError, ResourceLimitError
 from encctl_gym.presets import get_preset
 
 
@@ -79,10 +79,18 @@ def test_system_file_replaces_a_and_b(tmp_path):
     base = get_preset("paper-example")  # the rest from the preset
     assert (p.sigma_w2, p.sigma_u2, p.sigma_x2, p.gamma_c, p.upsilon) == (base.sigma_w2, base.sigma_u2, base.sigma_x2, base.gamma_c, base.upsilon)
     assert p.horizon == cfg["horizon"] == 256
-    bomb = tmp_path / "bomb.yaml"
-    bomb.write_text("a: &a [1, 1, 1]\nb: &b [*a, *a, *a]\nA: [*b, *b]\nB: [[1]]\n")
-    with pytest.raises(ConfigError, match="alias"):
+    bomb = tmp_path / "bomb.yaml"  # 484 bytes whose aliases expand to 9^9 numbers
+    levels = ["x0: &x0 [1, 1, 1, 1, 1, 1, 1, 1, 1]"] + [f"x{i}: &x{i} [{', '.join([f'*x{i - 1}'] * 9)}]" for i in range(1, 9)]
+    bomb.write_text("\n".join(levels + ["A: *x8", "B: [[1]]"]) + "\n")
+    with pytest.raises(ResourceLimitError, match="alias"):
         load_config("ppo", system=bomb)
+    extra = tmp_path / "extra.json"
+    extra.write_text(json.dumps({"A": A, "B": B, "sigma_u2": 2.5, "colour": 1}))
+    with pytest.raises(ConfigError, match="colour"):
+        load_config("ppo", system=extra)
+    extra.write_text(json.dumps({"A": A, "B": B, "sigma_u2": 2.5, "tau_c": "1y"}))
+    q = resolve_params(env_config(load_config("ppo", system=extra)))
+    assert q.sigma_u2 == 2.5 and q.sources["sigma_u2"] == "config" and q.sigma_w2 == base.sigma_w2  # the file's values are used
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({"A": [[2.0]], "B": [[1.0]]}))
     with pytest.raises(ConfigError, match="env:.*"):

@@ -278,8 +278,8 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     raw = {key: pick(key, 1.0 if key == "sigma_x2" else None) for key in SOURCE_KEYS[2:]}
     if missing:
         raise ParameterError(f"without a preset these values must be given too: {', '.join(missing)}")
-    if preset is not None and {"A", "B"} & set(merged):
-        inherited = [k for k in SOURCE_KEYS if sources[k].startswith("preset")]
+    inherited = [k for k in SOURCE_KEYS if sources.get(k, "").startswith("preset")]
+    if preset is not None and {"A", "B"} & set(merged) and inherited:
         warnings.warn(
             f"A/B are given and the other values come from preset {preset.name!r}: {', '.join(inherited)}; "
             "pass preset=None to give them all yourself",

@@ -55,6 +55,10 @@ def system_config(run: RunInfo, system: str | None = None) -> dict[str, Any]:
     layout, reward, encoder) carried over."""
     rest = {k: v for k, v in run.env.items() if k not in _LENGTH_KEYS}
     if system is None or system == run.system:
+        # the system's own defense period (before the training shortened it) sets the full budget
+        own = (run.meta.get("config") or {}).get("env") or {}
+        if own.get("tau_c") is not None:
+            rest["tau_c"] = own["tau_c"]
         return rest
     return {**{k: v for k, v in rest.items() if k not in _SYSTEM_KEYS}, "preset": system}
 
