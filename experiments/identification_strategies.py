@@ -18,11 +18,12 @@ contains the three sample sizes of the table: small (``n + m + 1``), medium (the
 mean) and ``N*`` (or the cap).
 
 Security consequence. For every attacker and estimator, the sample size that reaches the
-preset's ``gamma_c`` is read from the mean curve when it gets there, else extrapolated from a
-fit ``c / (N - 1)`` to the upper half of the grid
-(:func:`experiments.attackers_vs_bounds.samples_to_reach`); where the curve does not fall like
-``1/N`` there (log-log slope above -0.8, e.g. least squares with forgetting), it is reported as
-not reached. Then ``lambda = floor(log2(Upsilon tau_c / N_c)) + 1`` (Theorem thm:opt_sec) and the
+preset's ``gamma_c`` is ``floor(c / gamma_c) + 2`` for the rate ``c`` of a fit
+``E[epsilon] ~ c / (N - 1)`` to the upper half of the grid
+(:func:`experiments.attackers_vs_bounds.fit_rate`), flagged as inside the grid or extrapolated
+(and how far), and as transient where the log-log slope there is outside [-1.1, -0.9]; where the
+curve does not fall like ``1/N`` (slope above -0.8, e.g. least squares with forgetting) it is
+reported as not reached. Then ``lambda = floor(log2(Upsilon tau_c / N_c)) + 1`` (Theorem thm:opt_sec) and the
 key length of eq:opt_key, next to the paper's ``N*``, ``lambda*`` and ``k*``.
 
 Outputs under ``--out`` (default ``results/strategies``): ``curves.csv`` (system, attacker,
@@ -58,9 +59,9 @@ from agents.evaluate import budget_config
 from encctl_gym.errors import ParameterError
 from encctl_gym.ident.estimator import Estimator, estimate_errors
 from encctl_gym.ident.registry import estimator_names, make_estimator
-from encctl_gym.security.design import minimum_key_length, optimal_security_parameter
+from encctl_gym.security.design import minimum_key_length, optimal_security_parameter, sample_size_for_rate
 from encctl_gym.sim.montecarlo import log_grid
-from experiments.attackers_vs_bounds import Setting, attackers_for, bound_rows, find_runs, fit_rate, make_setting, samples_to_reach
+from experiments.attackers_vs_bounds import Setting, attackers_for, bound_rows, find_runs, fit_rate, make_setting
 from experiments.common import add_common_arguments, ensure_out_dir, script_main
 
 __all__ = [
@@ -190,7 +191,7 @@ class Result:
     settings: list[Setting]
     estimators: list[Estimator]
     curves: dict[str, list[Curve]]  # system -> curves
-    env_check: dict[str, float]  # system -> max |LS estimator - env epsilon| / epsilon
+    env_check: dict[str, float]  # system -> max |LS estimator - env epsilon| / epsilon, N >= 2 (n + m) + 1
     sizes: dict[str, tuple[int, int, int, bool]]
     seconds: float
     security: list[dict[str, Any]] = field(default_factory=list)
@@ -244,7 +245,7 @@ def compute(
                         continue
                     e = estimate_errors(est.fit(x, u), p.A, p.B)
                     errs[est.label][:, k] = e  # type: ignore[attr-defined]
-                    if est.name == "ls" and not est.params:  # type: ignore[attr-defined]
+                    if est.name == "ls" and not est.params and N >= 2 * (p.n + p.m) + 1:  # type: ignore[attr-defined]
                         worst = max(worst, float(np.max(np.abs(e - eps_env) / eps_env)))
             for est in ests:
                 curves[system].append(Curve(att.name, att.oracle, est.label, grid, errs[est.label]))  # type: ignore[attr-defined]
@@ -265,25 +266,37 @@ def _slope(N: np.ndarray, mean: np.ndarray) -> float:
 
 
 def security_rows(result: Result) -> list[dict[str, Any]]:
-    """Per system, attacker and estimator: samples to reach gamma_c, lambda and k (module docstring)."""
+    """Per system, attacker and estimator: samples to reach gamma_c, lambda and k (module docstring).
+
+    ``N_to_gamma_c`` is ``floor(c / gamma_c) + 2`` for the rate ``c`` fitted to the upper half of
+    the grid (:func:`experiments.attackers_vs_bounds.fit_rate`; finer than the grid where the
+    curve crosses gamma_c inside it), or None where the curve does not fall like 1/N (slope
+    above :data:`ONE_OVER_N_SLOPE`). ``N_how`` says which, how far beyond the grid, and whether
+    the slope is still away from -1 (a transient, so the extrapolation is not a measurement).
+    ``first_below`` is the first grid point whose mean error is below gamma_c.
+    """
     rows = []
     for s in result.settings:
         b = s.base
         for c in result.curves[s.system]:
             mean = c.mean
+            ok = np.isfinite(mean)
             slope = _slope(c.N, mean)
-            below = np.isfinite(mean) & (mean < b.gamma_c)
-            if below.any():
-                N_c, how = samples_to_reach(c.N, mean, b.gamma_c)
-            elif slope < ONE_OVER_N_SLOPE:
-                N_c, how = samples_to_reach(c.N, mean, b.gamma_c)
-            else:
+            below = np.flatnonzero(ok & (mean < b.gamma_c))
+            first = int(c.N[below[0]]) if below.size else None
+            rate = fit_rate(c.N, mean) if ok.sum() >= 2 else float("nan")
+            if not (slope <= ONE_OVER_N_SLOPE):
                 N_c, how = None, f"not reached (slope {slope:.2f})"
+            else:
+                N_c = sample_size_for_rate(rate, b.gamma_c)
+                top = int(c.N[ok][-1])
+                how = "fit, inside the grid" if N_c <= top else f"fit, extrapolated {N_c / top:.3g}x beyond N = {top}"
+                if not (-1.1 <= slope <= -0.9):
+                    how += f", transient slope {slope:.2f}"
             lam = optimal_security_parameter(N_c, tau_c=b.tau_c, upsilon=b.upsilon) if N_c else None
             rows.append({
                 "system": s.system, "attacker": c.attacker, "oracle": c.oracle, "estimator": c.estimator,
-                "gamma_c": b.gamma_c, "slope": slope,
-                "rate_c": fit_rate(c.N, mean) if np.isfinite(mean).sum() >= 2 else float("nan"),
+                "gamma_c": b.gamma_c, "slope": slope, "rate_c": rate, "first_below": first,
                 "N_to_gamma_c": N_c, "N_how": how, "lambda_needed": lam,
                 "k_needed": minimum_key_length(lam) if lam else None,
             })
@@ -293,8 +306,8 @@ def security_rows(result: Result) -> list[dict[str, Any]]:
 # --------------------------------------------------------------------------- outputs
 CURVE_COLUMNS = ("system", "attacker", "oracle", "estimator", "N", "mean_error", "se", "ci95_low", "ci95_high",
                  "episodes", "gamma", "gamma_opt")
-SECURITY_COLUMNS = ("system", "attacker", "oracle", "estimator", "gamma_c", "slope", "rate_c", "N_to_gamma_c", "N_how",
-                    "lambda_needed", "k_needed")
+SECURITY_COLUMNS = ("system", "attacker", "oracle", "estimator", "gamma_c", "slope", "rate_c", "first_below", "N_to_gamma_c",
+                    "N_how", "lambda_needed", "k_needed")
 
 
 def _fmt(v: Any) -> str:
@@ -446,7 +459,7 @@ def findings(result: Result) -> list[str]:
                 fin = {k: v for k, v in row.items() if np.isfinite(v)}
                 if "ls" in fin and fin:
                     k_best = min(fin, key=fin.get)  # type: ignore[arg-type]
-                    best.append(f"{att}: {k_best} ({fin[k_best] / fin['ls']:.3g}x ls)")
+                    best.append(f"{att}: {k_best} ({fin[k_best] / fin['ls']:.4g} x ls)")
             out.append(f"{s.system} at N = {N} ({what}): best estimator per attacker {'; '.join(best)}.")
         rows = [r for r in result.security if r["system"] == s.system and r["N_to_gamma_c"]]
         if rows:
@@ -468,7 +481,7 @@ def summary_markdown(result: Result, *, command: str, plots: Sequence[Path]) -> 
     for s in result.settings:
         small, medium, top, capped = result.sizes[s.system]
         lines.append(f"### {s.system} (gamma_c = {s.base.gamma_c:g}; least squares of this script vs the environment's "
-                     f"info['epsilon']: max relative difference {result.env_check[s.system]:.1e})")
+                     f"info['epsilon'] for N >= 2 (n + m) + 1: max relative difference {result.env_check[s.system]:.1e})")
         lines.append("")
         lines.append(f"| attacker | estimator | E[eps] at N = {small} | N = {medium} | N = {top}{' (cap)' if capped else ' (N*)'} "
                      "| N to gamma_c | lambda | k |")
@@ -476,7 +489,7 @@ def summary_markdown(result: Result, *, command: str, plots: Sequence[Path]) -> 
         sec = {(r["attacker"], r["estimator"]): r for r in result.security if r["system"] == s.system}
         for c in result.curves[s.system]:
             r = sec[(c.attacker, c.estimator)]
-            Nc = f"{r['N_to_gamma_c']} ({r['N_how'][:5]}.)" if r["N_to_gamma_c"] else r["N_how"]
+            Nc = f"{r['N_to_gamma_c']} ({r['N_how']})" if r["N_to_gamma_c"] else r["N_how"]
             lines.append(f"| {c.attacker}{' (oracle)' if c.oracle else ''} | {c.estimator} | {_cell(c, small)} | {_cell(c, medium)} | "
                          f"{_cell(c, top)} | {Nc} | {r['lambda_needed'] or '—'} | {r['k_needed'] or '—'} |")
         for b in bound_rows(s):
