@@ -76,3 +76,20 @@ def test_bad_options_are_refused() -> None:
         strat.compute(("small",), episodes=1, cap=20, points=2)
     with pytest.raises(ParameterError, match="unknown preset"):
         strat.compute(("nope",), episodes=2, cap=20, points=2)
+
+
+def test_a_learned_attacker_from_a_run_directory_joins(tmp_path: Path) -> None:
+    pytest.importorskip("stable_baselines3")
+    import json
+
+    from agents.sb3 import SB3VecEnv, algorithm_class
+
+    env_cfg = {"preset": "small", "decipher_delay": 0, "gamma_opt": False, "max_samples": 32}
+    model = algorithm_class("ppo")("MlpPolicy", SB3VecEnv(env_cfg, 2, "full"), n_steps=8, batch_size=16, seed=0, device="cpu")
+    run = tmp_path / "ppo_full"
+    run.mkdir()
+    model.save(str(run / "model.zip"))  # an untrained policy in the format of agents.train
+    (run / "run.json").write_text(json.dumps({"algo": "ppo", "observation": "full", "env": env_cfg, "config": {"quick": False}}))
+    res = strat.compute(("small",), estimators=("ls", "bayes"), episodes=2, cap=16, points=2, runs=strat.find_runs([tmp_path]))
+    learned = [c for c in res.curves["small"] if c.attacker == "ppo"]
+    assert [c.estimator for c in learned] == ["ls", "bayes(evidence)"] and np.all(np.isfinite(learned[0].errors))
