@@ -2,8 +2,10 @@
 
 The ``reproduce`` subcommand of ``encctl-gym`` (``add_arguments`` / ``run``); also
 ``python -m experiments.reproduce``. Runs :mod:`experiments.fig1_variance_ratio`
-(fig:variance_ratio), :mod:`experiments.fig2_gramian` (fig:gramian) and
-:mod:`experiments.design_example` (Theorem thm:opt_sec, eq:opt_key) with the same options.
+(fig:variance_ratio), :mod:`experiments.fig2_gramian` (fig:gramian),
+:mod:`experiments.design_example` (Theorem thm:opt_sec, eq:opt_key) and
+:mod:`experiments.identification_strategies` (attackers times estimators against gamma(N)) with
+the same options.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ STEPS = (
     ("fig1", "experiments.fig1_variance_ratio"),
     ("fig2", "experiments.fig2_gramian"),
     ("design", "experiments.design_example"),
+    ("strategies", "experiments.identification_strategies"),
 )
 
 

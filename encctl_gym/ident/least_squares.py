@@ -37,6 +37,7 @@ __all__ = [
     "identification_errors",
     "prefix_estimates",
     "GRAM_COND_LIMIT",
+    "solve_normal_equations",
 ]
 
 _EPS = np.finfo(np.float64).eps
@@ -133,18 +134,61 @@ def least_squares(x: Any, u: Any) -> tuple[np.ndarray, np.ndarray]:
     return theta[..., :n], theta[..., n:]
 
 
-def _scaled_solve(G: np.ndarray, C: np.ndarray) -> np.ndarray:
-    """Solve ``G theta^T = C`` for stacked SPD ``G`` (..., d, d), with symmetric Jacobi scaling.
+def solve_normal_equations(G: Any, C: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Solve the normal equations ``G theta^T = C`` of eq:estimate for stacked SPD ``G``.
 
-    Scaling by ``diag(G)^{-1/2}`` removes the effect of badly scaled regressors (e.g. a tiny
-    input variance next to large states) on the conditioning; what is left is the intrinsic
-    collinearity of the regressors.
+    Jacobi-scaled Cholesky: ``G_s = S G S`` with ``S = diag(G)^{-1/2}``, ``G_s = L L^T``,
+    ``theta^T = S L^{-T} L^{-1} S C``. The one implementation behind
+    :meth:`RecursiveLeastSquares.estimate` and the online least-squares estimators of
+    :mod:`encctl_gym.ident` (a stack computes each matrix exactly as a lone one).
+
+    Parameters
+    ----------
+    G : array_like, shape (..., d, d)
+        Regressor Gram matrices ``sum_t z_t z_t^T``.
+    C : array_like, shape (..., d, k)
+        Cross terms ``sum_t z_t y_t^T``.
+
+    Returns
+    -------
+    theta : numpy.ndarray, shape (..., k, d)
+        The solutions (transposed: ``[A_hat B_hat]`` for ``y = x_{t+1}``); NaN where not ``ok``.
+    ok : numpy.ndarray of bool, shape (...)
+        False where ``G`` is singular or numerically singular: a zero diagonal entry, a failed
+        Cholesky factorisation, or a Jacobi-scaled reciprocal condition number (estimated from
+        the Cholesky factor) below ``d * eps``.
     """
-    diag = np.diagonal(G, axis1=-2, axis2=-1)
-    s = 1.0 / np.sqrt(np.where(diag > 0, diag, 1.0))
-    Gs = G * s[..., :, None] * s[..., None, :]
-    Cs = C * s[..., :, None]
-    return np.linalg.solve(Gs, Cs) * s[..., :, None]
+    G = np.asarray(G, dtype=np.float64)
+    C = np.asarray(C, dtype=np.float64)
+    lead, d, k = G.shape[:-2], G.shape[-1], C.shape[-1]
+    Gf = G.reshape(-1, d, d)
+    Cf = C.reshape(-1, d, k)
+    diag = np.diagonal(Gf, axis1=1, axis2=2)
+    ok = np.all(diag > 0, axis=1)
+    theta_T = np.full(Cf.shape, np.nan)
+    idx = np.flatnonzero(ok)
+    if idx.size:
+        s = 1.0 / np.sqrt(diag[idx])
+        Gs = Gf[idx] * s[:, :, None] * s[:, None, :]
+        L = np.zeros_like(Gs)
+        chol = np.ones(idx.size, dtype=bool)
+        try:
+            L[:] = np.linalg.cholesky(Gs)
+        except np.linalg.LinAlgError:  # some copy is not positive definite: factor one by one
+            for i in range(idx.size):
+                try:
+                    L[i] = np.linalg.cholesky(Gs[i])
+                except np.linalg.LinAlgError:
+                    chol[i] = False
+        ld = np.diagonal(L, axis1=1, axis2=2)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            good = chol & ((ld.min(axis=1) / ld.max(axis=1)) ** 2 >= d * _EPS)
+        if good.any():
+            Lg, sg = L[good], s[good]
+            theta_T[idx[good]] = np.linalg.solve(np.swapaxes(Lg, -1, -2), np.linalg.solve(Lg, Cf[idx[good]] * sg[:, :, None])) * sg[:, :, None]
+        ok[idx[~good]] = False
+    theta = np.swapaxes(theta_T, -1, -2).reshape(*lead, k, d)
+    return theta, ok.reshape(lead)
 
 
 class RecursiveLeastSquares:
@@ -268,20 +312,11 @@ class RecursiveLeastSquares:
         self._fold()
         d = self._d
         G, C = self._M[:d, :d], self._M[:d, d:]
-        diag = np.diag(G)
-        if not np.all(diag > 0):
+        if not np.all(np.diag(G) > 0):
             raise ParameterError("the regressor Gram matrix is singular (a regressor has been identically zero)")
-        s = 1.0 / np.sqrt(diag)
-        Gs = G * s[:, None] * s[None, :]
-        try:
-            L = np.linalg.cholesky(Gs)
-        except np.linalg.LinAlgError:
-            raise ParameterError("the regressor Gram matrix is singular: the data do not excite all of [x; u]") from None
-        ld = np.diag(L)
-        if (ld.min() / ld.max()) ** 2 < d * _EPS:
+        theta, ok = solve_normal_equations(G, C)
+        if not ok:
             raise ParameterError("the regressor Gram matrix is numerically singular: the data do not excite all of [x; u]")
-        theta_T = np.linalg.solve(L.T, np.linalg.solve(L, C * s[:, None])) * s[:, None]
-        theta = theta_T.T
         self._cache = (np.ascontiguousarray(theta[:, : self.n]), np.ascontiguousarray(theta[:, self.n :]))
         return self._cache[0].copy(), self._cache[1].copy()
 
@@ -470,13 +505,16 @@ def identification_errors(
     sample_sizes: Any,
     *,
     method: Literal["auto", "gram", "qr"] = "auto",
+    estimator: Any = None,
 ) -> np.ndarray:
     """The estimation error ``epsilon(N)`` of Definition def:error on a grid of ``N``.
 
     ``epsilon(N) = ||[A B] - [A_hat B_hat]||_F^2 / (n (n + m))`` where ``[A_hat B_hat]`` is the
-    least-squares estimate eq:estimate on the first ``N`` pairs of each trajectory. The
-    estimates come from :func:`prefix_estimates` (one pass over the data, no re-solve from
-    scratch per ``N``); the error from :func:`encctl_gym.ident.error.estimation_error`.
+    estimate on the first ``N`` pairs of each trajectory: by default the least-squares estimate
+    eq:estimate from :func:`prefix_estimates` (one pass over the data, no re-solve from scratch
+    per ``N``), else the ``prefix_estimates`` of the given estimator
+    (:mod:`encctl_gym.ident.registry`); the error from
+    :func:`encctl_gym.ident.error.estimation_error`.
 
     Parameters
     ----------
@@ -487,18 +525,24 @@ def identification_errors(
     A, B : array_like
         The true system of eq:system.
     sample_sizes : array_like of int
-        Strictly increasing, each ``>= n + m + 1`` and ``<= N_max``.
+        Strictly increasing, each ``<= N_max`` and at least the estimator's minimum sample
+        size (``n + m + 1`` for least squares).
     method
-        ``"auto"`` (default), ``"gram"`` or ``"qr"``; see :func:`prefix_estimates`.
+        ``"auto"`` (default), ``"gram"`` or ``"qr"``: the least-squares solver (see
+        :func:`prefix_estimates`); only with the default estimator.
+    estimator : str, mapping or Estimator, optional
+        Anything :func:`encctl_gym.ident.registry.make_estimator` takes. ``None`` (default) is
+        least squares, with exactly the numbers of :func:`prefix_estimates`.
 
     Returns
     -------
     numpy.ndarray, shape (runs, K) (or (K,) for 2-D input)
+        NaN where the estimator has no estimate (see the estimator).
 
     Raises
     ------
     ParameterError, ShapeError
-        On a bad system, bad data or bad grid.
+        On a bad system, bad data, bad grid or bad estimator.
     """
     A, B = check_system(A, B)
     x_arr = as_finite_array("x", x)
@@ -509,5 +553,16 @@ def identification_errors(
             f"data dimensions (n={x_arr.shape[-1]}, m={u_arr.shape[-1]}) do not match the system "
             f"(n={n}, m={m})"
         )
+    if estimator is not None:
+        from .estimator import estimate_errors
+        from .registry import make_estimator
+
+        est = make_estimator(estimator)
+        if method != "auto":
+            raise ParameterError(
+                f"method={method!r} is the least-squares solver; pass it to the estimator instead "
+                "(make_estimator('ls', method=...))"
+            )
+        return estimate_errors(est.prefix_estimates(x_arr, u_arr, sample_sizes), A, B)
     theta = prefix_estimates(x_arr, u_arr, sample_sizes, method=method)
     return np.asarray(estimation_error(A, B, theta[..., :n], theta[..., n:]), dtype=np.float64)

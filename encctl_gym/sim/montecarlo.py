@@ -2,7 +2,8 @@
 
 One task = one system: ``runs`` trajectories of length ``N_max`` under i.i.d. Gaussian attack
 inputs (Theorem thm:sic), and the error ``epsilon(N)`` of Definition def:error on a whole grid
-of sample sizes from each trajectory (:func:`~encctl_gym.ident.least_squares.identification_errors`).
+of sample sizes from each trajectory (:func:`~encctl_gym.ident.least_squares.identification_errors`),
+by least squares (eq:estimate) or any estimator of :mod:`encctl_gym.ident.registry`.
 A sweep spreads systems over workers with :func:`~encctl_gym.parallel.run_tasks`, one
 child seed per system.
 """
@@ -16,7 +17,9 @@ import numpy as np
 
 from .._validation import check_int, check_nonnegative
 from ..errors import ParameterError
+from ..ident.estimator import check_grid
 from ..ident.least_squares import check_sample_sizes, identification_errors
+from ..ident.registry import make_estimator
 from ..parallel import SeedLike, run_tasks
 from .plant import LinearPlant, simulate_gaussian_attack
 
@@ -73,12 +76,13 @@ def gaussian_attack_errors(
     sigma_u2: float,
     seed: SeedLike,
     method: Literal["auto", "gram", "qr"] = "auto",
+    estimator: Any = None,
 ) -> np.ndarray:
     """Errors ``epsilon(N)`` (Definition def:error) of ``runs`` independent Gaussian attacks.
 
     Each run simulates one trajectory of length ``max(sample_sizes)`` with
-    ``u_t ~ N(0, sigma_u2 I)`` (Theorem thm:sic) and identifies ``(A, B)`` by eq:estimate on
-    every prefix in ``sample_sizes``.
+    ``u_t ~ N(0, sigma_u2 I)`` (Theorem thm:sic) and identifies ``(A, B)`` on every prefix in
+    ``sample_sizes``, by eq:estimate unless another estimator is given.
 
     Parameters
     ----------
@@ -93,22 +97,34 @@ def gaussian_attack_errors(
     seed
         Integer or SeedSequence (see :func:`~encctl_gym.sim.plant.simulate_gaussian_attack`).
     method
-        Solver for the prefix estimates (see :func:`~encctl_gym.ident.least_squares.prefix_estimates`).
+        Least-squares solver for the prefix estimates (see
+        :func:`~encctl_gym.ident.least_squares.prefix_estimates`); default estimator only.
+    estimator : str, mapping or Estimator, optional
+        Anything :func:`~encctl_gym.ident.registry.make_estimator` takes; ``None`` (default) is
+        least squares with exactly the numbers of eq:estimate's grid
+        (:func:`~encctl_gym.ident.least_squares.identification_errors`). The same seed gives
+        the same trajectories whatever the estimator, so estimators compare on common data.
 
     Returns
     -------
     numpy.ndarray, shape (runs, len(sample_sizes))
+        NaN where the estimator has no estimate.
     """
-    grid = check_sample_sizes(sample_sizes, plant.n, plant.m)
-    sim = simulate_gaussian_attack(plant, N=int(grid[-1]), runs=runs, sigma_u2=sigma_u2, seed=seed)
-    return identification_errors(sim.states, sim.inputs, plant.A, plant.B, grid, method=method)
+    if estimator is None:
+        grid = check_sample_sizes(sample_sizes, plant.n, plant.m)
+    else:
+        estimator = make_estimator(estimator)
+        grid = check_grid(estimator, sample_sizes, plant.n, plant.m)
+    sim = simulate_gaussian_attack(plant, N=max(int(grid[-1]), 2), runs=runs, sigma_u2=sigma_u2, seed=seed)
+    return identification_errors(sim.states, sim.inputs, plant.A, plant.B, grid, method=method, estimator=estimator)
 
 
-def _task(job: tuple[AttackSpec, np.ndarray, int, str], seed: np.random.SeedSequence) -> np.ndarray:
-    spec, grid, runs, method = job
+def _task(job: tuple[AttackSpec, np.ndarray, int, str, Any], seed: np.random.SeedSequence) -> np.ndarray:
+    spec, grid, runs, method, estimator = job
     plant = LinearPlant(spec.A, spec.B, sigma_w2=spec.sigma_w2, sigma_x2=spec.sigma_x2)
     return gaussian_attack_errors(
-        plant, sample_sizes=grid, runs=runs, sigma_u2=spec.sigma_u2, seed=seed, method=method  # type: ignore[arg-type]
+        plant, sample_sizes=grid, runs=runs, sigma_u2=spec.sigma_u2, seed=seed, method=method,  # type: ignore[arg-type]
+        estimator=estimator,
     )
 
 
@@ -122,6 +138,7 @@ def sweep_gaussian_attack(
     scheduler: Any = None,
     cluster_kwargs: dict[str, Any] | None = None,
     method: Literal["auto", "gram", "qr"] = "auto",
+    estimator: Any = None,
     progress: bool = False,
     desc: str | None = None,
 ) -> np.ndarray:
@@ -131,8 +148,8 @@ def sweep_gaussian_attack(
     ----------
     systems
         The systems (:class:`AttackSpec`).
-    sample_sizes, runs, method
-        As in :func:`gaussian_attack_errors` (the same grid for every system).
+    sample_sizes, runs, method, estimator
+        As in :func:`gaussian_attack_errors` (the same grid and estimator for every system).
     seed
         System ``i`` uses child ``i`` of ``SeedSequence(seed)``; the result does not depend on
         ``n_jobs`` or ``scheduler``.
@@ -147,6 +164,8 @@ def sweep_gaussian_attack(
     if not systems:
         raise ParameterError("systems must not be empty")
     runs = check_int("runs", runs, minimum=1)
+    if estimator is not None:
+        estimator = make_estimator(estimator)  # refuse a bad estimator before any worker starts
     jobs = []
     for i, s in enumerate(systems):
         if not isinstance(s, AttackSpec):
@@ -154,8 +173,11 @@ def sweep_gaussian_attack(
         # Validate in the caller, so a bad system fails before any worker starts.
         plant = LinearPlant(s.A, s.B, sigma_w2=s.sigma_w2, sigma_x2=s.sigma_x2)
         check_nonnegative("sigma_u2", s.sigma_u2)
-        grid = check_sample_sizes(sample_sizes, plant.n, plant.m)
-        jobs.append((s, grid, runs, method))
+        if estimator is None:
+            grid = check_sample_sizes(sample_sizes, plant.n, plant.m)
+        else:
+            grid = check_grid(estimator, sample_sizes, plant.n, plant.m)
+        jobs.append((s, grid, runs, method, estimator))
     out = run_tasks(
         _task, jobs, seed=seed, n_jobs=n_jobs, scheduler=scheduler,
         cluster_kwargs=cluster_kwargs, progress=progress, desc=desc,

@@ -1,0 +1,237 @@
+"""Bayesian least squares: a Gaussian prior on ``[A B]`` and its posterior mean (ridge).
+
+Model (eq:data with Gaussian noise): row ``i`` of ``theta = [A B]`` has the prior
+``theta_i ~ N(m0_i, diag(V_i))`` and the targets ``x_{t+1, i} = theta_i z_t + w_{t, i}`` with
+``w ~ N(0, sigma_w2)``. The posterior of ``theta_i`` given the data is Gaussian with precision
+``(Lambda_i + G) / sigma_w2`` and mean
+
+``theta_hat_i = (Lambda_i + G)^{-1} (Lambda_i m0_i + C_i)``,  ``Lambda_i = sigma_w2 diag(V_i)^{-1}``,
+
+where ``G = sum_t z_t z_t^T`` and ``C = sum_t z_t x_{t+1}^T`` (the moments of eq:estimate):
+ridge regression towards ``m0`` with weight ``Lambda``, ordinary least squares as
+``Lambda -> 0``. The posterior does not depend on how the inputs were chosen (as long as not on
+``theta`` itself), so it holds for feedback attackers too. Its expected error is in
+:mod:`encctl_gym.security.bayes_complexity`.
+
+Default prior (an attacker that knows neither ``(A, B)`` nor ``sigma_w2``): prior mean 0 and
+an isotropic prior whose scale is chosen from the data by *empirical Bayes*: with the
+conjugate form ``V = v sigma_w2 I`` (so ``Lambda = I / v``), ``v`` maximises the marginal
+likelihood of the delivered targets with ``sigma_w2`` profiled out (MacKay, "Bayesian
+interpolation", Neural Computation 4(3), 1992; Bishop, *Pattern Recognition and Machine
+Learning*, 2006, Section 3.5). Everything it needs is in the moments the attacker already
+keeps (``G``, ``C`` and ``sum_t x_{t+1} x_{t+1}^T``), so the online update is unchanged. With a
+fixed ``prior_variance`` and ``noise_variance`` the estimator is the textbook posterior mean.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError, ShapeError
+from .estimator import MomentEstimator
+
+__all__ = ["BayesianLeastSquares", "EVIDENCE_GRID"]
+
+#: Grid of the empirical-Bayes search: ``v * mean(diag G)`` on these values (log10), i.e. from
+#: a prior ten thousand times stronger than the data to one a million times weaker; the best
+#: grid point is refined by golden-section search between its neighbours (to 1e-9 decades),
+#: so the estimate depends continuously on the data.
+EVIDENCE_GRID = np.linspace(-4.0, 6.0, 201)
+_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
+_GOLDEN_STEPS = 40
+
+
+def _positive_array(name: str, value: Any) -> np.ndarray:
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be a positive number or array, got {value!r}") from None
+    if arr.ndim > 2:
+        raise ShapeError(f"{name} must be a scalar, an (n + m,) vector or an (n, n + m) array, got shape {arr.shape}")
+    if arr.size == 0 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise ParameterError(f"{name} must be finite and > 0, got {value!r}")
+    return arr
+
+
+class BayesianLeastSquares(MomentEstimator):
+    """Posterior mean of ``[A B]`` under a Gaussian prior (registry name ``"bayes"``).
+
+    Parameters
+    ----------
+    prior_mean : float or array_like of shape (n, n + m), default 0.0
+        ``m0``: the prior mean of ``[A B]``.
+    prior_variance : float or array_like of shape (n + m,) or (n, n + m), optional
+        ``V``: the prior variance of each entry of ``[A B]`` (a vector is one variance per
+        column of ``[A B]``, shared by the rows). Needs ``noise_variance``.
+    noise_variance : float, optional
+        ``sigma_w2`` assumed by the posterior. Needs ``prior_variance``.
+
+    With neither (the default), the isotropic scale is chosen by empirical Bayes (see the
+    module docstring): the attacker needs neither ``(A, B)`` nor ``sigma_w2``.
+
+    Costs: batch and grid estimates from the same moments as least squares; per estimate and
+    copy, ``n`` solves of ``d x d`` (fixed prior) or one symmetric eigendecomposition plus a
+    search over :data:`EVIDENCE_GRID` (empirical Bayes), ``d = n + m``. The estimate exists from
+    the first sample on (the prior mean before any column).
+
+    Raises
+    ------
+    ParameterError
+        For a non-positive or non-finite variance, or only one of ``prior_variance`` and
+        ``noise_variance``.
+    ShapeError
+        (at :meth:`fit` / :meth:`start`) for a prior mean or variance of the wrong shape.
+    """
+
+    name = "bayes"
+
+    def __init__(self, prior_mean: Any = 0.0, prior_variance: Any = None, noise_variance: Any = None) -> None:
+        super().__init__()
+        try:
+            m0 = np.asarray(prior_mean, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ParameterError(f"prior_mean must be a number or an (n, n + m) array, got {prior_mean!r}") from None
+        if m0.ndim not in (0, 2) or not np.all(np.isfinite(m0)):
+            raise ShapeError(f"prior_mean must be a finite scalar or an (n, n + m) array, got {prior_mean!r}")
+        self.prior_mean = m0
+        if (prior_variance is None) != (noise_variance is None):
+            missing = "noise_variance" if noise_variance is None else "prior_variance"
+            raise ParameterError(
+                f"give prior_variance and noise_variance together (the posterior mean depends on their ratio); "
+                f"{missing} is missing (neither: empirical Bayes)"
+            )
+        self.prior_variance = None if prior_variance is None else _positive_array("prior_variance", prior_variance)
+        if noise_variance is None:
+            self.noise_variance = None
+        else:
+            nv = _positive_array("noise_variance", noise_variance)
+            if nv.ndim:
+                raise ShapeError(f"noise_variance must be a scalar, got shape {nv.shape}")
+            self.noise_variance = float(nv)
+
+    # ------------------------------------------------------------------ description
+    @property
+    def empirical(self) -> bool:
+        """True when the prior scale is chosen by empirical Bayes."""
+        return self.prior_variance is None
+
+    @property
+    def params(self) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        if self.prior_mean.ndim or float(self.prior_mean) != 0.0:
+            out["prior_mean"] = self.prior_mean.tolist()
+        if not self.empirical:
+            assert self.prior_variance is not None
+            out["prior_variance"] = self.prior_variance.tolist()
+            out["noise_variance"] = self.noise_variance
+        return out
+
+    @property
+    def label(self) -> str:
+        if self.empirical:
+            return "bayes(evidence)"
+        v = self.prior_variance
+        assert v is not None
+        scale = f"{float(v):g}" if v.ndim == 0 else "V"
+        return f"bayes(var={scale}, noise={self.noise_variance:g})"
+
+    def min_sample_size(self, n: int, m: int) -> int:
+        """1: the prior mean is an estimate before any regression column."""
+        return 1
+
+    def check_dimensions(self, n: int, m: int) -> None:
+        """The prior's shapes must fit an (n, m) plant."""
+        d = n + m
+        if self.prior_mean.ndim and self.prior_mean.shape != (n, d):
+            raise ShapeError(f"prior_mean must have shape ({n}, {d}) for n={n}, m={m}, got {self.prior_mean.shape}")
+        v = self.prior_variance
+        if v is not None and v.ndim and v.shape not in ((d,), (n, d)):
+            raise ShapeError(f"prior_variance must be a scalar or have shape ({d},) or ({n}, {d}) for n={n}, m={m}, got {v.shape}")
+
+    # ------------------------------------------------------------------ the prior
+    def mean_matrix(self, n: int, m: int) -> np.ndarray:
+        """``m0`` as an ``(n, n + m)`` array."""
+        self.check_dimensions(n, m)
+        return np.broadcast_to(self.prior_mean, (n, n + m)).astype(np.float64)
+
+    def precision(self, n: int, m: int) -> np.ndarray:
+        """The ridge weights ``Lambda_i = sigma_w2 diag(V_i)^{-1}`` of a fixed prior, ``(n, d, d)``.
+
+        Raises
+        ------
+        ParameterError
+            For the empirical-Bayes default (its weight is chosen from the data).
+        """
+        if self.empirical:
+            raise ParameterError("the empirical-Bayes prior has no fixed precision; give prior_variance and noise_variance")
+        self.check_dimensions(n, m)
+        d = n + m
+        assert self.prior_variance is not None and self.noise_variance is not None
+        V = np.broadcast_to(self.prior_variance, (n, d))
+        return self.noise_variance * np.einsum("ij,jk->ijk", 1.0 / V, np.eye(d))
+
+    # ------------------------------------------------------------------ the solve
+    def solve(self, M: np.ndarray, columns: int, n: int, m: int) -> np.ndarray:
+        """Posterior means from the moments ``M = sum_t [z; y][z; y]^T`` (see the class docstring)."""
+        d = n + m
+        G, C, YY = M[..., :d, :d], M[..., :d, d:], M[..., d:, d:]
+        m0 = self.mean_matrix(n, m)
+        if not self.empirical:
+            Lam = self.precision(n, m)  # (n, d, d)
+            lhs = G[..., None, :, :] + Lam  # (..., n, d, d)
+            rhs = np.einsum("ijk,ik->ij", Lam, m0) + np.swapaxes(C, -1, -2)  # (..., n, d)
+            return np.linalg.solve(lhs, rhs[..., None])[..., 0]
+        return self._evidence_solve(G, C, YY, columns, m0)
+
+    def _evidence_solve(self, G: np.ndarray, C: np.ndarray, YY: np.ndarray, T: int, m0: np.ndarray) -> np.ndarray:
+        """Empirical Bayes: the posterior mean at the ``v`` of largest profiled marginal likelihood."""
+        lead, d, n = G.shape[:-2], G.shape[-1], C.shape[-1]
+        Gf, Cf, YYf = G.reshape(-1, d, d), C.reshape(-1, d, n), YY.reshape(-1, n, n)
+        out = np.broadcast_to(m0, (Gf.shape[0], n, d)).copy()
+        gbar = np.trace(Gf, axis1=1, axis2=2) / d
+        live = np.flatnonzero(gbar > 0)
+        if T == 0 or live.size == 0:
+            return out.reshape(*lead, n, d)
+        g, Q = np.linalg.eigh(Gf[live])  # (L, d), (L, d, d)
+        g = np.maximum(g, 0.0)
+        ct = Cf[live] - Gf[live] @ m0.T  # D (y - D^T m0): (L, d, n)
+        S = (np.trace(YYf[live], axis1=1, axis2=2) - 2.0 * np.einsum("ij,lji->l", m0, Cf[live])
+             + np.einsum("ij,ljk,ik->l", m0, Gf[live], m0))
+        b = np.swapaxes(Q, -1, -2) @ ct  # (L, d, n)
+        beta = np.sum(b**2, axis=2)  # (L, d)
+        logv = EVIDENCE_GRID[None, :] - np.log10(gbar[live])[:, None]  # (L, P)
+        ll = self._profiled_evidence(10.0**logv, g, beta, S, n, T)
+        best = np.argmax(ll, axis=1)
+        rows = np.arange(live.size)
+        lo = logv[rows, np.maximum(best - 1, 0)]
+        hi = logv[rows, np.minimum(best + 1, EVIDENCE_GRID.size - 1)]
+        for _ in range(_GOLDEN_STEPS):  # golden-section search inside the best grid cell's bracket
+            p1 = hi - _GOLDEN * (hi - lo)
+            p2 = lo + _GOLDEN * (hi - lo)
+            f1 = self._profiled_evidence(10.0 ** p1[:, None], g, beta, S, n, T)[:, 0]
+            f2 = self._profiled_evidence(10.0 ** p2[:, None], g, beta, S, n, T)[:, 0]
+            left = f1 >= f2
+            hi = np.where(left, p2, hi)
+            lo = np.where(left, lo, p1)
+        v = 10.0 ** (0.5 * (lo + hi))
+        w = v[:, None] / (1.0 + v[:, None] * g)  # (G + I/v)^{-1} in the eigenbasis
+        delta = Q @ (w[:, :, None] * b)  # (L, d, n)
+        out[live] = m0[None] + np.swapaxes(delta, -1, -2)
+        return out.reshape(*lead, n, d)
+
+    @staticmethod
+    def _profiled_evidence(v: np.ndarray, g: np.ndarray, beta: np.ndarray, S: np.ndarray, n: int, T: int) -> np.ndarray:
+        """``log p(targets | v)`` up to a constant, ``sigma_w2`` profiled out: ``(L, P)``.
+
+        Per output row the marginal is ``N(D^T m0_i, sigma^2 (I + v D^T D))``; with
+        ``G = Q diag(g) Q^T``, ``log det(I + v D^T D) = sum_k log(1 + v g_k)`` and the residual
+        quadratic form is ``S - sum_k beta_k v / (1 + v g_k)``.
+        """
+        vg = v[:, :, None] * g[:, None, :]  # (L, P, d)
+        logdet = np.sum(np.log1p(vg), axis=2)
+        quad = S[:, None] - np.sum(beta[:, None, :] * v[:, :, None] / (1.0 + vg), axis=2)
+        floor = 1e-300 + 1e-15 * np.abs(S)[:, None]
+        return -0.5 * n * logdet - 0.5 * n * T * np.log(np.maximum(quad, floor))

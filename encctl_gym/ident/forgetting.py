@@ -1,0 +1,69 @@
+"""Least squares with exponential forgetting: eq:estimate with weights ``lambda^(T - 1 - j)``.
+
+After ``T`` regression columns the estimate minimises
+``sum_j lambda^(T - 1 - j) ||x_{j+1} - [A B] z_j||^2`` (``z_j = [x_j; u_j]``, eq:data): recent
+columns count fully, a column ``k`` steps old counts ``lambda^k``. It is the classical
+recursive least squares for slowly varying plants (Ljung, *System Identification*, 2nd ed.,
+Section 11.2); its memory is about ``1 / (1 - lambda)`` columns. The plant of eq:system does not
+vary, so for this plant forgetting only discards information: with ``lambda < 1`` the error stops
+falling once ``N`` exceeds the memory. ``lambda = 1`` is ordinary least squares.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from .estimator import MomentEstimator
+from .ordinary import gram_solve
+
+__all__ = ["ForgettingLeastSquares", "DEFAULT_FORGETTING_FACTOR"]
+
+#: Memory of about 1000 columns.
+DEFAULT_FORGETTING_FACTOR = 0.999
+
+
+class ForgettingLeastSquares(MomentEstimator):
+    """Exponentially weighted least squares (registry name ``"forgetting"``).
+
+    Parameters
+    ----------
+    forgetting_factor : float in (0, 1], default 0.999
+        ``lambda``: the weight of a column one step older.
+
+    Costs: as :class:`~encctl_gym.ident.ordinary.OrdinaryLeastSquares` (the weights are applied
+    to the rows of each segment and to the moments between segments); the same Jacobi-scaled
+    Cholesky solve, with the minimum-norm solution where the weighted Gram matrix is singular.
+    """
+
+    name = "forgetting"
+
+    def __init__(self, forgetting_factor: float = DEFAULT_FORGETTING_FACTOR) -> None:
+        super().__init__()
+        try:
+            lam = float(forgetting_factor)
+        except (TypeError, ValueError):
+            raise ParameterError(f"forgetting_factor must be a number in (0, 1], got {forgetting_factor!r}") from None
+        if isinstance(forgetting_factor, bool) or not (math.isfinite(lam) and 0.0 < lam <= 1.0):
+            raise ParameterError(f"forgetting_factor must lie in (0, 1], got {forgetting_factor!r}")
+        self.forgetting_factor = lam
+        self.decay = lam
+
+    @property
+    def params(self) -> dict[str, Any]:
+        return {"forgetting_factor": self.forgetting_factor}
+
+    @property
+    def label(self) -> str:
+        return f"forgetting({self.forgetting_factor:g})"
+
+    def min_sample_size(self, n: int, m: int) -> int:
+        """``n + m + 1``, as eq:estimate."""
+        return n + m + 1
+
+    def solve(self, M: np.ndarray, columns: int, n: int, m: int) -> np.ndarray:
+        """The weighted normal equations (see :func:`~encctl_gym.ident.ordinary.gram_solve`)."""
+        return gram_solve(M, n, m)

@@ -1,0 +1,115 @@
+"""Estimators by name: one dict, so a new estimator is one row.
+
+::
+
+    make_estimator("bayes")                        # the registry's defaults
+    make_estimator("forgetting", forgetting_factor=0.99)
+    make_estimator({"name": "iv", "lags": 2})      # the form a configuration file holds
+
+=============  ==============================================  =================================
+name           estimator                                       parameters (defaults)
+=============  ==============================================  =================================
+``ls``         ordinary least squares, eq:estimate             ``method`` ("auto")
+``bayes``      Bayesian least squares (ridge posterior mean)   ``prior_mean`` (0),
+                                                               ``prior_variance`` and
+                                                               ``noise_variance`` (None: the
+                                                               scale by empirical Bayes)
+``forgetting`` least squares with exponential forgetting       ``forgetting_factor`` (0.999)
+``iv``         instrumental variables, lagged inputs           ``lags`` (ceil(n / m))
+=============  ==============================================  =================================
+
+Total least squares and subspace methods are not in the registry: see ``docs/ident.md`` for why
+they mean nothing for this full-state problem.
+"""
+
+from __future__ import annotations
+
+import inspect
+from typing import Any, Mapping
+
+from ..errors import ParameterError
+from .bayes import BayesianLeastSquares
+from .estimator import Estimator, MomentEstimator
+from .forgetting import ForgettingLeastSquares
+from .instrumental import InstrumentalVariables
+from .ordinary import OrdinaryLeastSquares
+
+__all__ = ["ESTIMATORS", "DEFAULT_ESTIMATOR", "estimator_names", "make_estimator", "estimator_spec"]
+
+#: name -> class; each class validates its own parameters.
+ESTIMATORS: dict[str, type[MomentEstimator]] = {
+    "ls": OrdinaryLeastSquares,
+    "bayes": BayesianLeastSquares,
+    "forgetting": ForgettingLeastSquares,
+    "iv": InstrumentalVariables,
+}
+
+#: The paper's estimator (eq:estimate).
+DEFAULT_ESTIMATOR = "ls"
+
+
+def estimator_names() -> list[str]:
+    """The registered names."""
+    return list(ESTIMATORS)
+
+
+def _parameters(cls: type) -> list[str]:
+    return [p for p in inspect.signature(cls.__init__).parameters if p != "self"]
+
+
+def make_estimator(spec: Any = None, **params: Any) -> Estimator:
+    """An estimator from a name, a ``{"name": ..., **params}`` mapping, or an estimator.
+
+    Parameters
+    ----------
+    spec : str, mapping, Estimator or None
+        ``None`` is the default (``"ls"``); an :class:`~encctl_gym.ident.estimator.Estimator`
+        instance is returned as it is (then ``params`` must be empty).
+    **params
+        The estimator's parameters (see the table in the module docstring).
+
+    Returns
+    -------
+    Estimator
+        A new instance (except when ``spec`` already is one).
+
+    Raises
+    ------
+    ParameterError
+        For an unknown name, unknown parameters or parameter values the estimator refuses
+        (each message names the value).
+    """
+    if spec is None:
+        spec = DEFAULT_ESTIMATOR
+    if isinstance(spec, Mapping):
+        merged = dict(spec)
+        if "name" not in merged:
+            raise ParameterError(f"an estimator mapping needs a 'name' key, got {dict(spec)!r}")
+        spec = merged.pop("name")
+        overlap = sorted(set(merged) & set(params))
+        if overlap:
+            raise ParameterError(f"estimator parameter(s) {overlap} given twice")
+        params = {**merged, **params}
+    if not isinstance(spec, str):
+        if isinstance(spec, Estimator):
+            if params:
+                raise ParameterError(f"parameters {sorted(params)} cannot be applied to an existing estimator {spec!r}")
+            return spec
+        raise ParameterError(f"estimator must be a name, a mapping or an Estimator, got {spec!r}")
+    try:
+        cls = ESTIMATORS[spec]
+    except KeyError:
+        raise ParameterError(f"unknown estimator {spec!r}; choose one of {', '.join(ESTIMATORS)}") from None
+    known = _parameters(cls)
+    unknown = sorted(set(params) - set(known))
+    if unknown:
+        raise ParameterError(
+            f"unknown parameter(s) {unknown} for estimator {spec!r}; it takes {', '.join(known) or 'none'}"
+        )
+    return cls(**params)
+
+
+def estimator_spec(estimator: Estimator) -> dict[str, Any]:
+    """The ``{"name": ..., **params}`` mapping that :func:`make_estimator` turns back into it."""
+    params = getattr(estimator, "params", {})
+    return {"name": estimator.name, **params}

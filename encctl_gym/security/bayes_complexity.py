@@ -1,0 +1,271 @@
+"""The expected error of Bayesian least squares and its sample identifying complexity.
+
+The Bayesian attacker of :class:`encctl_gym.ident.bayes.BayesianLeastSquares` estimates row
+``i`` of ``theta = [A B]`` by the posterior mean ``theta_hat_i = (Lambda_i + G)^{-1}
+(Lambda_i m0_i + C_i)`` under the prior ``theta_i ~ N(m0_i, sigma_w2 Lambda_i^{-1})``, with
+``G = D D^T`` the regressor Gram matrix of eq:data (``D = [X_p; U_p]``, ``d = n + m`` rows) and
+``Lambda_i`` the prior precision in units of the noise (the ridge weight). ``c = n d`` as in
+Definition def:error. Three results, derived along the proof of Theorem thm:sic:
+
+**(F) Error at a fixed plant, given the data matrix** (:func:`bayesian_error_given_gram`).
+With ``P_i = (Lambda_i + G)^{-1}`` and ``delta_i = theta_i - m0_i``, eq:data gives
+``theta_hat_i - theta_i = P_i (Lambda_i (m0_i - theta_i) + D w_i)``, so, for ``W_p``
+independent of ``D``,
+
+``E[epsilon | D] = (1/c) sum_i [ ||P_i Lambda_i delta_i||^2 + sigma_w2 tr(P_i G P_i) ]``:
+
+a bias from the prior and a variance below that of least squares. ``Lambda = 0`` gives
+``(sigma_w2 / (n + m)) tr(G^{-1})``, the first identity of the proof of Theorem thm:sic, which
+makes the same independence step. It is exact for a fixed design; for eq:system, whose
+regressors depend on earlier noise, it is the paper's approximation.
+
+**(B) Bayes risk** (:func:`bayes_risk_given_gram`). Averaged over plants drawn from the prior,
+the error of the posterior mean is the trace of the posterior covariance
+``sigma_w2 P_i``:
+
+``E[epsilon] = (sigma_w2 / c) sum_i E[tr (Lambda_i + G)^{-1}]``.
+
+This needs no independence step: the Gaussian likelihood of a trajectory of eq:system given
+``theta`` is that of a linear regression whatever the inputs, as long as the attacker chooses
+them without knowing ``theta`` (any input that depends only on delivered data, feedback
+included: V. Peterka, "Bayesian system identification", Automatica 17(1), 1981), and the mean
+square error of a posterior mean is the expected trace of the posterior covariance (S. M. Kay,
+*Fundamentals of Statistical Signal Processing: Estimation Theory*, 1993, Chapter 11).
+
+**(C) Sample identifying complexity of the Bayesian attacker** (:func:`bayesian_sic_from_traces`).
+As in the proof of Theorem thm:sic, Jensen's inequality (``X -> tr X^{-1}`` is convex, then
+``tr X^{-1} >= d^2 / tr X`` and ``x -> 1/x`` is convex) and the Gramian bound
+``E[tr G] <= sigma_x2 tr Psi_w + (N - 1)[sigma_u2 (tr Psi_u + m) + sigma_w2 tr Psi_w]`` for
+i.i.d. ``N(0, sigma_u2 I)`` attack inputs and a Schur-stable plant turn (B) into
+
+``gamma_B(N) = (1/n) sum_i (m + n) sigma_w2 / (tr Lambda_i + sigma_x2 tr Psi_w + (N - 1)[sigma_u2 (tr Psi_u + m) + sigma_w2 tr Psi_w])``,
+
+eq:sic with ``sigma_x2 tr Psi_w`` increased by ``tr Lambda_i``: the prior adds to the
+information of the data exactly where the initial state does. It is a lower bound of the Bayes
+risk (B) (a sample identifying complexity in the sense of Definition def:sic for plants drawn from
+the prior; with the traces of the Gramians averaged over the prior, or those of the plant the
+prior concentrates on). A prior is worth ``tr Lambda_i / [sigma_u2 (tr Psi_u + m) + sigma_w2 tr Psi_w]``
+samples (:func:`prior_sample_equivalent`).
+
+Assumptions: Gaussian noise of the variance the posterior assumes; the attack inputs do not
+use ``theta``; for (C) i.i.d. Gaussian inputs of Theorem thm:sic and stable plants; for (F) the
+independence of ``W_p`` and ``D`` (as the paper). At a fixed plant (the defender's view) no
+prior-free lower bound exists: a prior mean close to the plant makes the error small for any
+``N``; (F) gives the error of a given prior at a given plant.
+
+Pure math: numpy only (and the Gramians of :mod:`encctl_gym.security.gramians`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .._validation import as_finite_array, check_int, check_positive, check_system
+from ..errors import ParameterError, ShapeError
+from .complexity import sic_from_traces
+from .gramians import controllability_gramian, noise_gramian
+
+__all__ = [
+    "bayesian_error_given_gram",
+    "bayes_risk_given_gram",
+    "bayesian_sic_from_traces",
+    "bayesian_sample_identifying_complexity",
+    "prior_sample_equivalent",
+]
+
+
+def _precision(precision: Any, n: int, d: int) -> np.ndarray:
+    """``Lambda`` as ``(n, d, d)``: one symmetric positive semidefinite matrix per row of theta."""
+    lam = as_finite_array("precision", precision)
+    if lam.shape == (d, d):
+        lam = np.broadcast_to(lam, (n, d, d))
+    if lam.shape != (n, d, d):
+        raise ShapeError(f"precision must have shape ({d}, {d}) or ({n}, {d}, {d}), got {lam.shape}")
+    if not np.allclose(lam, np.swapaxes(lam, -1, -2), rtol=1e-12, atol=0.0):
+        raise ParameterError("precision must be symmetric")
+    if np.min(np.linalg.eigvalsh(lam)) < -1e-12 * max(1.0, float(np.abs(lam).max())):
+        raise ParameterError("precision must be positive semidefinite")
+    return np.array(lam)
+
+
+def _gram(G: Any, d: int) -> np.ndarray:
+    G = as_finite_array("G", G)
+    if G.ndim < 2 or G.shape[-2:] != (d, d):
+        raise ShapeError(f"G must have shape (..., {d}, {d}), got {G.shape}")
+    return G
+
+
+def bayesian_error_given_gram(
+    A: Any, B: Any, G: Any, *, prior_mean: Any, precision: Any, sigma_w2: float
+) -> float | np.ndarray:
+    """(F): the expected error of the posterior mean at the plant ``(A, B)``, given ``G = D D^T``.
+
+    ``E[epsilon | D] = (1/c) sum_i [ ||P_i Lambda_i (theta_i - m0_i)||^2 + sigma_w2 tr(P_i G P_i) ]``,
+    ``P_i = (Lambda_i + G)^{-1}`` (see the module docstring; exact for noise independent of ``D``).
+
+    Parameters
+    ----------
+    A, B : array_like
+        The true plant of eq:system.
+    G : array_like, shape (..., n + m, n + m)
+        Regressor Gram matrices.
+    prior_mean : float or array_like of shape (n, n + m)
+        ``m0``.
+    precision : array_like, shape (n + m, n + m) or (n, n + m, n + m)
+        ``Lambda_i`` (zero: least squares, then ``G`` must be invertible).
+    sigma_w2 : float
+        Noise variance (> 0).
+
+    Returns
+    -------
+    float or ndarray
+        Shape of the leading dimensions of ``G``.
+    """
+    A, B = check_system(A, B)
+    n, m = B.shape
+    d = n + m
+    sw = check_positive("sigma_w2", sigma_w2)
+    G = _gram(G, d)
+    lam = _precision(precision, n, d)
+    m0 = np.broadcast_to(as_finite_array("prior_mean", prior_mean), (n, d)) if np.ndim(prior_mean) else np.full((n, d), float(prior_mean))
+    delta = np.hstack([A, B]) - m0  # (n, d)
+    P = np.linalg.inv(G[..., None, :, :] + lam)  # (..., n, d, d)
+    bias = np.einsum("...ijk,ikl,il->...ij", P, lam, delta)  # P_i Lambda_i delta_i
+    var = np.einsum("...ijk,...kl,...ilj->...i", P, G, P)  # tr(P_i G P_i)
+    out = (np.sum(bias**2, axis=(-2, -1)) + sw * np.sum(var, axis=-1)) / (n * d)
+    return float(out) if out.ndim == 0 else out
+
+
+def bayes_risk_given_gram(G: Any, *, precision: Any, sigma_w2: float, n: int) -> float | np.ndarray:
+    """(B): ``(sigma_w2 / c) sum_i tr (Lambda_i + G)^{-1}``, the posterior covariance's trace.
+
+    Its expectation over the data is the error of the posterior mean averaged over plants drawn
+    from the prior (see the module docstring).
+
+    Parameters
+    ----------
+    G : array_like, shape (..., d, d)
+    precision : array_like, shape (d, d) or (n, d, d)
+    sigma_w2 : float
+    n : int
+        Number of states (rows of ``theta``).
+
+    Returns
+    -------
+    float or ndarray
+    """
+    n = check_int("n", n, minimum=1)
+    sw = check_positive("sigma_w2", sigma_w2)
+    G = as_finite_array("G", G)
+    d = G.shape[-1]
+    if d <= n:
+        raise ShapeError(f"G must be (n + m) x (n + m) with m >= 1 for n={n}, got {G.shape}")
+    G = _gram(G, d)
+    lam = _precision(precision, n, d)
+    tr = np.trace(np.linalg.inv(G[..., None, :, :] + lam), axis1=-2, axis2=-1)  # (..., n)
+    out = sw * np.sum(tr, axis=-1) / (n * d)
+    return float(out) if out.ndim == 0 else out
+
+
+def _trace_per_row(tr_precision: Any, n: int) -> np.ndarray:
+    tr = np.atleast_1d(as_finite_array("tr_precision", tr_precision))
+    if tr.ndim != 1 or tr.size not in (1, n):
+        raise ShapeError(f"tr_precision must be a scalar or have shape ({n},), got {np.shape(tr_precision)}")
+    if np.any(tr < 0):
+        raise ParameterError(f"tr_precision must be >= 0, got {np.asarray(tr_precision).tolist()}")
+    return np.broadcast_to(tr, (n,))
+
+
+def bayesian_sic_from_traces(
+    N: Any,
+    tr_psi_u: float,
+    tr_psi_w: float,
+    m: int,
+    n: int,
+    sigma_u2: float,
+    sigma_w2: float,
+    sigma_x2: float = 1.0,
+    *,
+    tr_precision: Any,
+) -> float | np.ndarray:
+    """(C): ``gamma_B(N)``, eq:sic with ``sigma_x2 tr Psi_w`` increased by ``tr Lambda_i``.
+
+    ``gamma_B(N) = (1/n) sum_i (m+n) sigma_w2 / (tr Lambda_i + sigma_x2 tr Psi_w + (N-1)[sigma_u2 (tr Psi_u + m) + sigma_w2 tr Psi_w])``,
+    computed by :func:`~encctl_gym.security.complexity.sic_from_traces` with the initial-state
+    variance ``sigma_x2 + tr Lambda_i / tr Psi_w`` (the same formula; ``tr Lambda = 0`` is
+    ``gamma(N)`` exactly).
+
+    Parameters
+    ----------
+    N : int or array_like of int
+        Sample sizes (>= 2).
+    tr_psi_u, tr_psi_w, m, n, sigma_u2, sigma_w2, sigma_x2
+        As in :func:`~encctl_gym.security.complexity.sic_from_traces`.
+    tr_precision : float or array_like of shape (n,)
+        ``tr Lambda_i`` (>= 0), one for all rows or one per row.
+
+    Returns
+    -------
+    float or ndarray
+        Same shape as ``N``.
+    """
+    n = check_int("n", n, minimum=1)
+    tr_w = check_positive("tr_psi_w", tr_psi_w)
+    rows = _trace_per_row(tr_precision, n)
+    parts = [sic_from_traces(N, tr_psi_u, tr_w, m, n, sigma_u2, sigma_w2, sigma_x2 + float(t) / tr_w) for t in rows]
+    out = np.mean(np.stack([np.asarray(p, dtype=float) for p in parts]), axis=0)
+    return float(out) if np.ndim(out) == 0 else out
+
+
+def bayesian_sample_identifying_complexity(
+    N: Any, A: Any, B: Any, *, sigma_u2: float, sigma_w2: float, sigma_x2: float = 1.0, precision: Any
+) -> float | np.ndarray:
+    """(C) for the plant ``(A, B)``: :func:`bayesian_sic_from_traces` with its Gramians.
+
+    Parameters
+    ----------
+    N : int or array_like of int
+    A, B : array_like
+        Plant of eq:system (``A`` Schur stable).
+    sigma_u2, sigma_w2, sigma_x2 : float
+    precision : array_like, shape (n + m, n + m) or (n, n + m, n + m)
+        ``Lambda_i`` of the prior (e.g. ``BayesianLeastSquares(...).precision(n, m)``).
+
+    Returns
+    -------
+    float or ndarray
+    """
+    A, B = check_system(A, B)
+    n, m = B.shape
+    lam = _precision(precision, n, n + m)
+    tr_u = float(np.trace(controllability_gramian(A, B)))
+    tr_w = float(np.trace(noise_gramian(A)))
+    tr_lam = np.trace(lam, axis1=-2, axis2=-1)
+    return bayesian_sic_from_traces(N, tr_u, tr_w, m, n, sigma_u2, sigma_w2, sigma_x2, tr_precision=tr_lam)
+
+
+def prior_sample_equivalent(tr_precision: Any, tr_psi_u: float, tr_psi_w: float, m: int, *, sigma_u2: float, sigma_w2: float) -> float:
+    """Samples a prior is worth in (C): ``tr Lambda / [sigma_u2 (tr Psi_u + m) + sigma_w2 tr Psi_w]``.
+
+    ``gamma_B(N) = gamma(N + s)`` with ``s`` this number (for one ``tr Lambda`` shared by the
+    rows): the attacker with the prior reaches an error level ``s`` samples earlier.
+
+    Parameters
+    ----------
+    tr_precision : float
+        ``tr Lambda`` (>= 0).
+    tr_psi_u, tr_psi_w : float
+        Gramian traces.
+    m : int
+    sigma_u2, sigma_w2 : float
+
+    Returns
+    -------
+    float
+    """
+    t = float(_trace_per_row(tr_precision, 1)[0])
+    m = check_int("m", m, minimum=1)
+    K = check_positive("sigma_u2", sigma_u2) * (float(tr_psi_u) + m) + check_positive("sigma_w2", sigma_w2) * check_positive("tr_psi_w", tr_psi_w)
+    return t / K

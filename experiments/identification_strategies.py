@@ -1,0 +1,562 @@
+"""Identification strategies: input strategies (attackers) times estimators, against gamma(N).
+
+For each system (default: the paper's design example, Figure 1 (c) and (g), and the ``small``
+plant, which is not a multiple of the identity) and each attacker of ``agents`` (the paper's
+Gaussian input, random binary, AR(1), the A-optimal design, and the learned attackers of the
+training runs under ``--runs``), the attacks are played through ``EncryptedLTIAttack-v0`` (ideal
+backend, ``decipher_delay = 0``): one set of ``--episodes`` episodes of exactly ``N`` samples for
+every ``N`` of a log grid, with the energy budget ``m sigma_u2 N`` of that length
+(:func:`agents.evaluate.budget_config`, as ``encctl-gym compare`` does), so every point compares
+inputs at equal energy. From each episode the deciphered and delivered data
+(``episode.delivered_data()``: states ``(K, N, n)`` and inputs ``(K, N - 1, m)`` in float64) are
+identified by every estimator of ``--estimators`` (:mod:`encctl_gym.ident.registry`) on the
+*same* data, and scored by Definition def:error.
+
+The grid runs from ``n + m + 1`` (the least-squares minimum) to ``N*`` of Theorem thm:opt_sec
+(eq:opt_sec for the preset's ``gamma_c``), or to ``--max-samples`` if ``N*`` is larger; it
+contains the three sample sizes of the table: small (``n + m + 1``), medium (their geometric
+mean) and ``N*`` (or the cap).
+
+Security consequence. For every attacker and estimator, the sample size that reaches the
+preset's ``gamma_c`` is ``floor(c / gamma_c) + 2`` for the rate ``c`` of a fit
+``E[epsilon] ~ c / (N - 1)`` to the upper half of the grid
+(:func:`experiments.attackers_vs_bounds.fit_rate`), flagged as inside the grid or extrapolated
+(and how far), and as transient where the log-log slope there is outside [-1.1, -0.9]; where the
+curve does not fall like ``1/N`` (slope above -0.8, e.g. least squares with forgetting) it is
+reported as not reached. Then ``lambda = floor(log2(Upsilon tau_c / N_c)) + 1`` (Theorem thm:opt_sec) and the
+key length of eq:opt_key, next to the paper's ``N*``, ``lambda*`` and ``k*``.
+
+Outputs under ``--out`` (default ``results/strategies``): ``curves.csv`` (system, attacker,
+estimator, N, mean, standard error, 95 % band, gamma, gamma_opt), ``episodes.csv`` (every
+episode's error per estimator), ``security.csv``, ``identification_strategies.png`` (mean error
+against N with bands, gamma(N) and gamma_opt(N); rows systems, columns attackers),
+``identification_strategies_ratio.png`` (each estimator's mean error over least squares') and
+``summary.md`` (the tables and the finding in words).
+
+Usage: ``python -m experiments.identification_strategies [--quick] [--out DIR] [--seed S]
+[--episodes E] [--systems a,b] [--estimators ls,bayes] [--runs DIR] [--max-samples N]``; also
+``encctl-gym reproduce`` (step ``strategies``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Sequence
+
+if __package__ in (None, ""):  # run as a script: make the repository importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import numpy as np
+
+from agents import Attacker
+from agents.evaluate import budget_config
+from encctl_gym.errors import ParameterError
+from encctl_gym.ident.estimator import Estimator, estimate_errors
+from encctl_gym.ident.registry import estimator_names, make_estimator
+from encctl_gym.security.design import minimum_key_length, optimal_security_parameter, sample_size_for_rate
+from encctl_gym.sim.montecarlo import log_grid
+from experiments.attackers_vs_bounds import Setting, attackers_for, bound_rows, find_runs, fit_rate, make_setting
+from experiments.common import add_common_arguments, ensure_out_dir, script_main
+
+__all__ = [
+    "DEFAULT_SYSTEMS",
+    "DEFAULT_ESTIMATORS",
+    "Curve",
+    "Result",
+    "collect",
+    "attack_lengths",
+    "table_sizes",
+    "compute",
+    "security_rows",
+    "plot",
+    "summary_markdown",
+    "add_arguments",
+    "run",
+    "main",
+]
+
+#: The design example, Figure 1 (c) and (g) (R_sigma = 100 and 0.01), and a plant that is not a
+#: multiple of the identity.
+DEFAULT_SYSTEMS = ("paper-example", "fig1-c", "fig1-g", "small")
+DEFAULT_ESTIMATORS = ("ls", "bayes", "forgetting", "iv")
+#: The design example's N* (13159): no system is attacked longer.
+DEFAULT_CAP = 13159
+DEFAULT_EPISODES = 50
+DEFAULT_POINTS = 12
+QUICK_SYSTEMS = ("small",)
+QUICK_CAP = 40
+QUICK_EPISODES = 4
+QUICK_POINTS = 4
+#: Below this log-log slope of the mean error over the upper half of the grid, the curve is in
+#: the 1/N regime and c / (N - 1) may be extrapolated.
+ONE_OVER_N_SLOPE = -0.8
+
+
+# --------------------------------------------------------------------------- data
+def collect(attacker: Attacker, config: dict[str, Any], *, episodes: int, seed: int, batch: int = 64) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Play ``episodes`` attacks through the vector environment; return what was delivered.
+
+    Episode ``e`` is reset with ``seed + e`` and the attacker is seeded per batch as in
+    :func:`agents.evaluate.rollout`, so the data are those of ``encctl-gym compare`` for the same
+    seeds.
+
+    Returns
+    -------
+    states : ndarray (episodes, N, n)
+    inputs : ndarray (episodes, N - 1, m)
+        ``episode.delivered_data()`` at the end of each attack (float64).
+    epsilon : ndarray (episodes,)
+        The environment's own ``info["epsilon"]`` (least squares) at the end.
+    """
+    from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
+
+    B = min(episodes, batch)
+    env = EncryptedLTIAttackVectorEnv(B, config=config)
+    xs, us, eps = [], [], []
+    done, chunk = 0, 0
+    try:
+        while done < episodes:
+            obs, info = env.reset(seed=seed + done)
+            attacker.reset(seed=np.random.SeedSequence([seed, chunk]))
+            while True:
+                obs, _, te, tr, info = env.step(attacker.act(obs))
+                if te[0] or tr[0]:
+                    break
+            take = min(B, episodes - done)
+            x, u = env.episode.delivered_data()
+            xs.append(x[:take])
+            us.append(u[:take])
+            eps.append(info["epsilon"][:take])
+            done += take
+            chunk += 1
+    finally:
+        env.close()
+    return np.concatenate(xs), np.concatenate(us), np.concatenate(eps)
+
+
+def table_sizes(setting: Setting, cap: int | None) -> tuple[int, int, int, bool]:
+    """(small, medium, N*, capped): ``n + m + 1``, their geometric mean, ``N*`` or the cap."""
+    p = setting.base
+    N_star = int(bound_rows(setting)[0]["N_to_gamma_c"])
+    capped = cap is not None and N_star > cap
+    top = int(cap) if capped else N_star
+    small = p.n + p.m + 1
+    return small, int(round(math.sqrt(small * top))), top, capped
+
+
+def attack_lengths(setting: Setting, cap: int | None, points: int) -> np.ndarray:
+    """The log grid of attack lengths, with the three table sizes in it."""
+    small, medium, top, _ = table_sizes(setting, cap)
+    return np.unique(np.concatenate([log_grid(small, top, points), [small, medium, top]])).astype(np.int64)
+
+
+@dataclass
+class Curve:
+    """Errors of one attacker and one estimator on every attack length."""
+
+    attacker: str
+    oracle: bool
+    estimator: str
+    N: np.ndarray
+    errors: np.ndarray  # (E, len(N)), NaN where the estimator has no estimate
+
+    @property
+    def mean(self) -> np.ndarray:
+        """Mean over the episodes with an estimate (NaN where none has one)."""
+        ok = np.isfinite(self.errors)
+        cnt = ok.sum(axis=0)
+        tot = np.where(ok, self.errors, 0.0).sum(axis=0)
+        return np.where(cnt > 0, tot / np.maximum(cnt, 1), np.nan)
+
+    @property
+    def se(self) -> np.ndarray:
+        """Standard error of :attr:`mean` (NaN with fewer than two estimates)."""
+        ok = np.isfinite(self.errors)
+        cnt = ok.sum(axis=0)
+        dev = np.where(ok, self.errors - self.mean, 0.0)
+        var = (dev**2).sum(axis=0) / np.maximum(cnt - 1, 1)
+        return np.where(cnt > 1, np.sqrt(var / np.maximum(cnt, 1)), np.nan)
+
+
+@dataclass
+class Result:
+    """Everything the tables and plots show."""
+
+    settings: list[Setting]
+    estimators: list[Estimator]
+    curves: dict[str, list[Curve]]  # system -> curves
+    env_check: dict[str, float]  # system -> max |LS estimator - env epsilon| / epsilon, N >= 2 (n + m) + 1
+    sizes: dict[str, tuple[int, int, int, bool]]
+    seconds: float
+    security: list[dict[str, Any]] = field(default_factory=list)
+
+
+def _mean_se(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    c = Curve("", False, "", np.zeros(a.shape[1]), a)
+    return c.mean, c.se
+
+
+def compute(
+    systems: Sequence[str] = DEFAULT_SYSTEMS,
+    *,
+    estimators: Sequence[Any] = DEFAULT_ESTIMATORS,
+    episodes: int = DEFAULT_EPISODES,
+    seed: int = 0,
+    cap: int | None = DEFAULT_CAP,
+    points: int = DEFAULT_POINTS,
+    runs: Sequence[Path] = (),
+    which: str = "best",
+    progress: bool = False,
+) -> Result:
+    """Run the experiment (see the module docstring); every number of the outputs comes from here."""
+    t0 = time.perf_counter()
+    ests = [make_estimator(e) for e in estimators]
+    if not ests:
+        raise ParameterError("estimators must not be empty")
+    if episodes < 2:
+        raise ParameterError(f"episodes must be >= 2 (standard errors), got {episodes}")
+    settings, curves, checks, sizes = [], {}, {}, {}
+    for system in systems:
+        s = make_setting(system, 0, cap)
+        settings.append(s)
+        sizes[system] = table_sizes(s, cap)
+        grid = attack_lengths(s, cap, points)
+        p = s.params
+        for est in ests:
+            est.check_dimensions(p.n, p.m)  # type: ignore[attr-defined]
+        atts = attackers_for(s, runs, which)
+        curves[system] = []
+        worst = 0.0
+        for att in atts:
+            errs = {est.label: np.full((episodes, grid.size), np.nan) for est in ests}  # type: ignore[attr-defined]
+            if progress:
+                print(f"identification strategies: {system}, {att.name}, {grid.size} attack lengths up to {grid[-1]}",
+                      file=sys.stderr, flush=True)
+            for k, N in enumerate(grid):
+                x, u, eps_env = collect(att, budget_config(s.config, int(N)), episodes=episodes, seed=seed)
+                for est in ests:
+                    if N < est.min_sample_size(p.n, p.m):
+                        continue
+                    e = estimate_errors(est.fit(x, u), p.A, p.B)
+                    errs[est.label][:, k] = e  # type: ignore[attr-defined]
+                    if est.name == "ls" and not est.params and N >= 2 * (p.n + p.m) + 1:  # type: ignore[attr-defined]
+                        worst = max(worst, float(np.max(np.abs(e - eps_env) / eps_env)))
+            for est in ests:
+                curves[system].append(Curve(att.name, att.oracle, est.label, grid, errs[est.label]))  # type: ignore[attr-defined]
+        checks[system] = worst
+    res = Result(settings, ests, curves, checks, sizes, time.perf_counter() - t0)
+    res.security = security_rows(res)
+    return res
+
+
+# --------------------------------------------------------------------------- security
+def _slope(N: np.ndarray, mean: np.ndarray) -> float:
+    ok = np.isfinite(mean) & (mean > 0)
+    N, mean = N[ok], mean[ok]
+    tail = np.log(N) >= 0.5 * (np.log(N[0]) + np.log(N[-1]))
+    if tail.sum() < 2:
+        return float("nan")
+    return float(np.polyfit(np.log(N[tail] - 1.0), np.log(mean[tail]), 1)[0])
+
+
+def security_rows(result: Result) -> list[dict[str, Any]]:
+    """Per system, attacker and estimator: samples to reach gamma_c, lambda and k (module docstring).
+
+    ``N_to_gamma_c`` is ``floor(c / gamma_c) + 2`` for the rate ``c`` fitted to the upper half of
+    the grid (:func:`experiments.attackers_vs_bounds.fit_rate`; finer than the grid where the
+    curve crosses gamma_c inside it), or None where the curve does not fall like 1/N (slope
+    above :data:`ONE_OVER_N_SLOPE`). ``N_how`` says which, how far beyond the grid, and whether
+    the slope is still away from -1 (a transient, so the extrapolation is not a measurement).
+    ``first_below`` is the first grid point whose mean error is below gamma_c.
+    """
+    rows = []
+    for s in result.settings:
+        b = s.base
+        for c in result.curves[s.system]:
+            mean = c.mean
+            ok = np.isfinite(mean)
+            slope = _slope(c.N, mean)
+            below = np.flatnonzero(ok & (mean < b.gamma_c))
+            first = int(c.N[below[0]]) if below.size else None
+            rate = fit_rate(c.N, mean) if ok.sum() >= 2 else float("nan")
+            if not (slope <= ONE_OVER_N_SLOPE):
+                N_c, how = None, f"not reached (slope {slope:.2f})"
+            else:
+                N_c = sample_size_for_rate(rate, b.gamma_c)
+                top = int(c.N[ok][-1])
+                how = "fit, inside the grid" if N_c <= top else f"fit, extrapolated {N_c / top:.3g}x beyond N = {top}"
+                if not (-1.1 <= slope <= -0.9):
+                    how += f", transient slope {slope:.2f}"
+            lam = optimal_security_parameter(N_c, tau_c=b.tau_c, upsilon=b.upsilon) if N_c else None
+            rows.append({
+                "system": s.system, "attacker": c.attacker, "oracle": c.oracle, "estimator": c.estimator,
+                "gamma_c": b.gamma_c, "slope": slope, "rate_c": rate, "first_below": first,
+                "N_to_gamma_c": N_c, "N_how": how, "lambda_needed": lam,
+                "k_needed": minimum_key_length(lam) if lam else None,
+            })
+    return rows
+
+
+# --------------------------------------------------------------------------- outputs
+CURVE_COLUMNS = ("system", "attacker", "oracle", "estimator", "N", "mean_error", "se", "ci95_low", "ci95_high",
+                 "episodes", "gamma", "gamma_opt")
+SECURITY_COLUMNS = ("system", "attacker", "oracle", "estimator", "gamma_c", "slope", "rate_c", "first_below", "N_to_gamma_c",
+                    "N_how", "lambda_needed", "k_needed")
+
+
+def _fmt(v: Any) -> str:
+    if v is None:
+        return ""
+    if isinstance(v, (float, np.floating)):
+        return "" if not np.isfinite(v) else repr(float(v))
+    return str(v)
+
+
+def write_csvs(result: Result, out: Path) -> list[Path]:
+    """``curves.csv``, ``episodes.csv``, ``security.csv`` (tidy)."""
+    by = {s.system: s for s in result.settings}
+    with (out / "curves.csv").open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(CURVE_COLUMNS)
+        for system, cs in result.curves.items():
+            s = by[system]
+            for c in cs:
+                for N, m, se in zip(c.N, c.mean, c.se):
+                    w.writerow(_fmt(v) for v in (system, c.attacker, c.oracle, c.estimator, int(N), m, se, m - 1.96 * se,
+                                                 m + 1.96 * se, c.errors.shape[0], float(s.params.gamma(int(N))),
+                                                 float(s.design.gamma(int(N)))))
+    with (out / "episodes.csv").open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(("system", "attacker", "estimator", "N", "episode", "error"))
+        for system, cs in result.curves.items():
+            for c in cs:
+                for k, N in enumerate(c.N):
+                    for e, v in enumerate(c.errors[:, k]):
+                        w.writerow(_fmt(x) for x in (system, c.attacker, c.estimator, int(N), e, v))
+    with (out / "security.csv").open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(SECURITY_COLUMNS)
+        for r in result.security:
+            w.writerow(_fmt(r[k]) for k in SECURITY_COLUMNS)
+    return [out / "curves.csv", out / "episodes.csv", out / "security.csv"]
+
+
+def _grid_axes(plt: Any, result: Result) -> tuple[Any, Any, list[str], list[str]]:
+    systems = [s.system for s in result.settings]
+    attackers = list(dict.fromkeys(c.attacker for cs in result.curves.values() for c in cs))
+    fig, axes = plt.subplots(len(systems), len(attackers), figsize=(3.6 * len(attackers), 3.0 * len(systems)),
+                             squeeze=False, sharex="row")
+    return fig, axes, systems, attackers
+
+
+def plot(result: Result, out: Path) -> list[Path]:
+    """``identification_strategies.png`` and ``identification_strategies_ratio.png`` (module docstring)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    labels = [e.label for e in result.estimators]  # type: ignore[attr-defined]
+    color = {lab: colors[i % len(colors)] for i, lab in enumerate(labels)}
+    by = {s.system: s for s in result.settings}
+    paths = []
+    fig, axes, systems, attackers = _grid_axes(plt, result)
+    for i, system in enumerate(systems):
+        s = by[system]
+        for j, att in enumerate(attackers):
+            ax = axes[i, j]
+            cs = [c for c in result.curves[system] if c.attacker == att]
+            if not cs:
+                ax.axis("off")
+                continue
+            N = cs[0].N
+            Nl = np.unique(np.round(np.geomspace(N[0], N[-1], 200)).astype(int))
+            for c in cs:
+                mean, se = c.mean, c.se
+                ok = np.isfinite(mean)
+                top = c.estimator == "ls"  # the paper's estimator on top of the others
+                ax.plot(c.N[ok], mean[ok], color=color[c.estimator], lw=2.0 if top else 1.2, marker="o", ms=2,
+                        label=c.estimator, zorder=3 if top else 2, ls="--" if top else "-")
+                lo = np.maximum(mean - 1.96 * se, 0.05 * mean)
+                ax.fill_between(c.N[ok], lo[ok], (mean + 1.96 * se)[ok], color=color[c.estimator], alpha=0.2, lw=0)
+            ax.plot(Nl, s.params.gamma(Nl), "k--", lw=1.0, label="gamma(N), eq:sic")
+            ax.plot(Nl, s.design.gamma(Nl), "k:", lw=1.4, label="gamma_opt(N)")
+            ax.axhline(s.base.gamma_c, color="0.5", lw=0.7, ls="-.", label="gamma_c")
+            ax.set(xscale="log", yscale="log")
+            ax.grid(True, which="major", alpha=0.3)
+            if i == 0:
+                ax.set_title(f"{att}{' (oracle)' if cs[0].oracle else ''}", fontsize=9)
+            if j == 0:
+                ax.set_ylabel(f"{system}\nE[eps(N)]", fontsize=9)
+            if i == len(systems) - 1:
+                ax.set_xlabel("attack length N", fontsize=9)
+            lo_y = float(np.nanmin([np.nanmin(c.mean) for c in cs] + [float(np.min(s.design.gamma(Nl)))]))
+            hi_y = float(np.nanmax([np.nanmax(c.mean[np.isfinite(c.mean)]) if np.isfinite(c.mean).any() else lo_y for c in cs]))
+            ax.set_ylim(0.5 * lo_y, 2.0 * max(hi_y, lo_y))
+    axes[0, 0].legend(fontsize=6, loc="lower left")
+    E = result.curves[systems[0]][0].errors.shape[0]
+    fig.suptitle(f"Identification strategies: mean error (95 % band, {E} attacks per N at energy m sigma_u2 N) "
+                 "of each estimator on the same delivered data", fontsize=10)
+    fig.tight_layout()
+    path = out / "identification_strategies.png"
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    paths.append(path)
+
+    fig, axes, systems, attackers = _grid_axes(plt, result)
+    for i, system in enumerate(systems):
+        for j, att in enumerate(attackers):
+            ax = axes[i, j]
+            cs = {c.estimator: c for c in result.curves[system] if c.attacker == att}
+            ref = next((c for c in cs.values() if c.estimator == "ls"), None)
+            if ref is None:
+                ax.axis("off")
+                continue
+            for lab, c in cs.items():
+                r = c.mean / ref.mean
+                ok = np.isfinite(r)
+                ax.plot(c.N[ok], r[ok], color=color[lab], lw=1.3, marker="o", ms=2, label=lab)
+            ax.axhline(1.0, color="k", lw=0.6)
+            ax.set(xscale="log", yscale="log")
+            ax.grid(True, which="both", alpha=0.3)
+            if i == 0:
+                ax.set_title(att, fontsize=9)
+            if j == 0:
+                ax.set_ylabel(f"{system}\nE[eps] / E[eps of ls]", fontsize=9)
+            if i == len(systems) - 1:
+                ax.set_xlabel("attack length N", fontsize=9)
+    axes[0, 0].legend(fontsize=6, loc="lower right")
+    fig.suptitle("Each estimator's mean error over that of least squares (eq:estimate), same data", fontsize=10)
+    fig.tight_layout()
+    path = out / "identification_strategies_ratio.png"
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    paths.append(path)
+    return paths
+
+
+def _cell(c: Curve, N: int) -> str:
+    k = int(np.searchsorted(c.N, N))
+    m, se = c.mean[k], c.se[k]
+    return "—" if not np.isfinite(m) else f"{m:.3g} ± {se:.1g}"
+
+
+def findings(result: Result) -> list[str]:
+    """Plain-words statements computed from the numbers (no fixed conclusion)."""
+    out = []
+    for s in result.settings:
+        small, medium, top, capped = result.sizes[s.system]
+        cs = result.curves[s.system]
+        for N, what in ((small, "small"), (top, "N*" if not capped else "the cap")):
+            best = []
+            for att in dict.fromkeys(c.attacker for c in cs):
+                row = {c.estimator: c.mean[int(np.searchsorted(c.N, N))] for c in cs if c.attacker == att}
+                fin = {k: v for k, v in row.items() if np.isfinite(v)}
+                if "ls" in fin and fin:
+                    k_best = min(fin, key=fin.get)  # type: ignore[arg-type]
+                    best.append(f"{att}: {k_best} ({fin[k_best] / fin['ls']:.4g} x ls)")
+            out.append(f"{s.system} at N = {N} ({what}): best estimator per attacker {'; '.join(best)}.")
+        rows = [r for r in result.security if r["system"] == s.system and r["N_to_gamma_c"]]
+        steady = [r for r in rows if "transient" not in r["N_how"]]
+        if rows:
+            r = min(steady or rows, key=lambda r: r["N_to_gamma_c"])
+            paper = bound_rows(s)[0]
+            text = (f"{s.system}: fewest samples to reach gamma_c = {s.base.gamma_c:g}: {r['N_to_gamma_c']} "
+                    f"({r['attacker']} + {r['estimator']}, {r['N_how']}) against the paper's N* = {paper['N_to_gamma_c']}; "
+                    f"lambda {r['lambda_needed']} against lambda* = {paper['lambda_needed']}")
+            lower = [q for q in rows if q["N_to_gamma_c"] < r["N_to_gamma_c"]]
+            if steady and lower:
+                q = min(lower, key=lambda q: q["N_to_gamma_c"])
+                text += (f" (fewer, {q['N_to_gamma_c']}, only from an extrapolation of a transient curve: "
+                         f"{q['attacker']} + {q['estimator']}, {q['N_how']})")
+            out.append(text + ".")
+    return out
+
+
+def summary_markdown(result: Result, *, command: str, plots: Sequence[Path]) -> str:
+    """The tables (errors at small, medium N and N*; samples to gamma_c) and the findings."""
+    lines = ["## Identification strategies (`experiments/identification_strategies.py`)", "",
+             f"Reproduce: `{command}` ({result.seconds / 60:.1f} min on this machine).", ""]
+    lines += [f"![{p.stem}]({p.as_posix()})" for p in plots] + [""]
+    for s in result.settings:
+        small, medium, top, capped = result.sizes[s.system]
+        lines.append(f"### {s.system} (gamma_c = {s.base.gamma_c:g}; least squares of this script vs the environment's "
+                     f"info['epsilon'] for N >= 2 (n + m) + 1: max relative difference {result.env_check[s.system]:.1e})")
+        lines.append("")
+        lines.append(f"| attacker | estimator | E[eps] at N = {small} | N = {medium} | N = {top}{' (cap)' if capped else ' (N*)'} "
+                     "| N to gamma_c | lambda | k |")
+        lines.append("|---|---|---|---|---|---|---|---|")
+        sec = {(r["attacker"], r["estimator"]): r for r in result.security if r["system"] == s.system}
+        for c in result.curves[s.system]:
+            r = sec[(c.attacker, c.estimator)]
+            Nc = f"{r['N_to_gamma_c']} ({r['N_how']})" if r["N_to_gamma_c"] else r["N_how"]
+            lines.append(f"| {c.attacker}{' (oracle)' if c.oracle else ''} | {c.estimator} | {_cell(c, small)} | {_cell(c, medium)} | "
+                         f"{_cell(c, top)} | {Nc} | {r['lambda_needed'] or '—'} | {r['k_needed'] or '—'} |")
+        for b in bound_rows(s):
+            lines.append(f"| *{b['attacker']}* | | | | | {b['N_to_gamma_c']} | {b['lambda_needed']} | {b['k_needed']} |")
+        lines.append("")
+    lines.append("Findings: " + " ".join(findings(result)))
+    return "\n".join(lines) + "\n"
+
+
+# --------------------------------------------------------------------------- command line
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options: the common ones of the reproduction scripts plus the experiment's own."""
+    add_common_arguments(parser)
+    add_own_arguments(parser)
+
+
+def add_own_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options that ``encctl-gym reproduce`` does not have (their defaults apply there)."""
+    parser.add_argument("--episodes", type=int, default=None, help=f"attacks per attacker and N (default {DEFAULT_EPISODES}; quick {QUICK_EPISODES})")
+    parser.add_argument("--systems", default=None, help=f"comma-separated presets (default {','.join(DEFAULT_SYSTEMS)})")
+    parser.add_argument("--estimators", default=None, help=f"comma-separated registry names (default {','.join(DEFAULT_ESTIMATORS)}; "
+                        f"known: {', '.join(estimator_names())})")
+    parser.add_argument("--max-samples", type=int, default=None, help=f"cap on the attack length (default {DEFAULT_CAP}; quick {QUICK_CAP})")
+    parser.add_argument("--points", type=int, default=None, help=f"grid points (default {DEFAULT_POINTS}; quick {QUICK_POINTS})")
+    parser.add_argument("--runs", action="append", default=[], help="training run directory or a parent of runs: its learned "
+                        "attackers join (repeatable; needs the [rl] extra)")
+    parser.add_argument("--which", choices=("best", "final"), default="best", help="learned model: best (default) or final")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run, write the CSVs, PNGs and ``summary.md`` under ``args.out``; print the summary."""
+    quick = bool(getattr(args, "quick", False))
+    systems_arg = getattr(args, "systems", None)
+    systems = tuple(x.strip() for x in systems_arg.split(",")) if systems_arg else (QUICK_SYSTEMS if quick else DEFAULT_SYSTEMS)
+    est_arg = getattr(args, "estimators", None)
+    estimators = tuple(x.strip() for x in est_arg.split(",")) if est_arg else DEFAULT_ESTIMATORS
+    episodes = getattr(args, "episodes", None) or (QUICK_EPISODES if quick else DEFAULT_EPISODES)
+    cap = getattr(args, "max_samples", None) or (QUICK_CAP if quick else DEFAULT_CAP)
+    points = getattr(args, "points", None) or (QUICK_POINTS if quick else DEFAULT_POINTS)
+    roots = getattr(args, "runs", None) or []
+    which = getattr(args, "which", "best")
+    out = ensure_out_dir(getattr(args, "out", "results/strategies"))
+    result = compute(systems, estimators=estimators, episodes=episodes, seed=args.seed, cap=cap, points=points,
+                     runs=find_runs(roots), which=which, progress=not getattr(args, "no_progress", True))
+    files = write_csvs(result, out)
+    plots = plot(result, out)
+    cmd = ["python -m experiments.identification_strategies", f"--seed {args.seed}", f"--episodes {episodes}",
+           f"--systems {','.join(systems)}", f"--estimators {','.join(estimators)}", f"--max-samples {cap}",
+           f"--points {points}"] + [f"--runs {r}" for r in roots] + (["--quick"] if quick else [])
+    md = summary_markdown(result, command=" ".join(cmd), plots=[Path(p.name) for p in plots])
+    (out / "summary.md").write_text(md)
+    print(md)
+    print("identification strategies: wrote " + ", ".join(str(p) for p in [*files, *plots, out / "summary.md"]))
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``python experiments/identification_strategies.py``."""
+    return script_main("identification_strategies", __doc__, add_arguments, run, argv)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
