@@ -9,7 +9,9 @@ Prints:
    the noise and catches up the Gram matrices while the main thread steps), with all the work
    on one thread (``helper_thread=False``), and with ``parallel=True``;
 3. the ElGamal backend's time per step at 712 bits against the crypto floor: the time of one
-   ``gmpy2.powmod`` with a full-size exponent at that size, measured in the same run.
+   ``gmpy2.powmod`` with a full-size exponent at that size, measured in the same run;
+4. the steps per second with each estimator other than least squares (``estimator`` key:
+   updated column by column, off the compiled path), single and vector, against least squares.
 
 Usage: ``python benchmarks/bench_env.py [--quick] [--record]`` (``--record`` writes
 ``benchmarks/results/bench_env.json`` for the README table, :mod:`benchmarks.record`).
@@ -129,6 +131,19 @@ def main(argv: list[str] | None = None) -> int:
     print(f"  parallel=True (all cores)         : {par_sps:12,.0f} env-steps/s")
     print(f"  ratio parallel vector / single    : {par_sps / our_sps:12.1f}")
 
+    est_rows = []
+    est_steps = max(n_vec // 4, 16)
+    for est in ("bayes", "forgetting", "iv"):
+        cfg = {**CONFIG, "estimator": est}
+        single = steps_per_second(gym.make(ENV_ID, config=cfg), our_acts[: n_single // 4])
+        vec = EncryptedLTIAttackVectorEnv(num_envs=num_envs, config=cfg)
+        vector_steps_per_second(vec, vec_acts[:4])
+        vsps = vector_steps_per_second(vec, vec_acts[:est_steps])
+        vec.close()
+        est_rows.append((est, single, vsps))
+        print(f"estimator {est:<10}: single {single:10,.0f} steps/s ({single / our_sps:.2f}x ls), "
+              f"vector {vsps:12,.0f} env-steps/s ({vsps / vec_sps:.2f}x ls)")
+
     floor = powmod_seconds(712)
     per_step = elgamal_seconds_per_step(5 if args.quick else 30)
     print(f"elgamal backend, 712 bits           : {per_step * 1e3:12.2f} ms/step")
@@ -145,6 +160,8 @@ def main(argv: list[str] | None = None) -> int:
              f"{vec_sps / our_sps:.1f}x as constructed (helper thread); {one_sps / our_sps:.1f}x with `helper_thread=False`; "
              f"{par_sps / our_sps:.1f}x with `parallel=True`"),
             ("environment step through real ElGamal at 712 bits", f"{per_step * 1e3:.2f} ms = {per_step / floor:.1f} powmod times"),
+            ("estimators other than least squares (single env / vector env, against least squares)",
+             "; ".join(f"`{e}` {s1 / our_sps:.2f}x / {v / vec_sps:.2f}x" for e, s1, v in est_rows)),
         ], argv)
     return 0
 

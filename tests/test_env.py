@@ -593,3 +593,46 @@ def test_a_users_plant_is_not_completed_from_the_default_preset():
 def test_a_quantisation_table_too_large_is_refused_with_its_size(x_bound):
     with pytest.raises(ResourceLimitError, match="x_bound"):
         EncryptedLTIAttackEnv(config={**SMALL, "x_bound": x_bound})
+
+
+# ------------------------------------------------------------------ estimators (issue 14)
+@pytest.mark.parametrize("estimator", ["bayes", "forgetting", "iv", {"name": "bayes", "prior_variance": 1.0, "noise_variance": 0.1}])
+def test_a_configured_estimator_gives_epsilon_and_reward_of_its_own_fit(estimator):
+    """info["epsilon"] is the error of the estimator's fit on the delivered data (its batch fit
+    computed here independently), the log_error return telescopes, and the vector environment
+    equals single environments copy for copy."""
+    from encctl_gym.ident import estimation_error
+    from encctl_gym.ident.registry import make_estimator
+
+    cfg = {**SMALL, "estimator": estimator}
+    K = 3
+    venv = EncryptedLTIAttackVectorEnv(num_envs=K, config=cfg)
+    singles = [EncryptedLTIAttackEnv(config=cfg) for _ in range(K)]
+    venv.reset(seed=20)
+    infos0 = [e.reset(seed=20 + i)[1] for i, e in enumerate(singles)]
+    rng, totals = np.random.default_rng(5), np.zeros(K)
+    for _ in range(venv.params.horizon):
+        acts = random_actions(rng, K, 2, scale=0.5)
+        obs_v, r_v, te, tr, info_v = venv.step(acts)
+        for i, e in enumerate(singles):
+            obs, r, _, _, info = e.step(acts[i])
+            assert np.array_equal(obs_v[i], obs) and r_v[i] == r and info_v["epsilon"][i] == info["epsilon"]
+            totals[i] += r
+        if te[0] or tr[0]:
+            break
+    p = venv.params
+    X, U = venv.episode.delivered_data()
+    for i in range(K):
+        theta = make_estimator(estimator).fit(X[i], U[i])
+        want = estimation_error(p.A, p.B, theta[:, : p.n], theta[:, p.n :])
+        assert info_v["epsilon"][i] == pytest.approx(want, rel=1e-9)
+        assert totals[i] == pytest.approx(math.log(infos0[i]["epsilon"]) - math.log(info_v["epsilon"][i]), rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "estimator,text",
+    [("ridge", "ridge"), ({"name": "forgetting", "forgetting_factor": 1.5}, "1.5"), ({"name": "forgetting", "factor": 0.9}, "factor"), ({"name": "bayes", "prior_variance": -1.0}, "variance"), (3, "3")],
+)
+def test_a_bad_estimator_is_refused_at_construction(estimator, text):
+    with pytest.raises(ParameterError, match=text):
+        EncryptedLTIAttackEnv(config={**SMALL, "estimator": estimator})

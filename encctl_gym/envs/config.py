@@ -24,6 +24,7 @@ from .._validation import (
     format_value,
 )
 from ..errors import BudgetError, ConfigError, ParameterError
+from ..ident.registry import make_estimator
 from ..presets import get_preset
 from ..security.complexity import sic_from_traces
 from ..security.cost_models import (
@@ -88,6 +89,11 @@ def default_config() -> dict[str, Any]:
                                   break reveals every sample (static; token vs server)
     ``decipher_delay``            0 (adaptive), an integer number of steps, or ``"end"``
     ``warmup_steps``              steps of normal encrypted LQR control before the attack
+    ``estimator``                 the attacker's identification method behind ``info["epsilon"]``
+                                  and the ``log_error`` reward: ``"ls"`` (least squares,
+                                  eq:estimate; compiled), ``"bayes"``, ``"forgetting"``,
+                                  ``"iv"``, or ``{"name": ..., **parameters}``
+                                  (:mod:`encctl_gym.ident`)
     ``reward``                    ``"log_error"``, ``"logdet"`` or ``"a_optimality"``
                                   (:mod:`encctl_gym.envs.rewards`)
     ``logdet_regularization``     delta of ``G + delta I`` in the Gram-matrix rewards
@@ -120,6 +126,7 @@ def default_config() -> dict[str, Any]:
         "max_samples": None,
         "decipher_delay": 0,
         "warmup_steps": 0,
+        "estimator": "ls",
         "reward": "log_error",
         "logdet_regularization": 1.0,
         "crypto": "ideal",
@@ -158,6 +165,7 @@ class AttackParams:
     budget_limited: bool  # the horizon is set by tau_c (terminated) rather than max_samples (truncated)
     decipher_delay: int | None  # None means "end"
     warmup_steps: int
+    estimator: Any  # the estimator specification (a name or a mapping), checked
     reward: str
     logdet_regularization: float
     crypto: str
@@ -296,6 +304,8 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     scheme = _choice("scheme", cfg["scheme"], SCHEMES)
     adversary = _choice("adversary", cfg["adversary"], ADVERSARIES)
     reward = _choice("reward", cfg["reward"], REWARDS)
+    estimator = cfg["estimator"]
+    make_estimator(estimator).check_dimensions(A.shape[0], B.shape[1])  # an unknown or impossible estimator fails here
     crypto = _choice("crypto backend", cfg["crypto"], BACKENDS)
 
     n, m = A.shape[0], B.shape[1]
@@ -373,7 +383,7 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         budget_samples=budget, horizon=horizon, independent_keys=independent_keys(scheme, adversary),
         budget_limited=budget_limited, decipher_delay=delay_v,
         warmup_steps=warmup,
-        reward=reward,
+        estimator=estimator, reward=reward,
         logdet_regularization=check_positive("logdet_regularization", cfg["logdet_regularization"]),
         crypto=crypto, delta=delta, x_bound=check_positive("x_bound", cfg["x_bound"]),
         u_max=action_scale * math.sqrt(sigma_u2),

@@ -41,6 +41,8 @@ import numpy as np
 
 from .._validation import as_finite_array, check_int, check_positive
 from ..errors import EncodingOverflowError, ParameterError, ShapeError
+from ..ident.ordinary import OrdinaryLeastSquares
+from ..ident.registry import make_estimator
 from ..loop import LoopBackend
 from ..resources import check_memory
 from . import _kernels as kern
@@ -241,6 +243,10 @@ class EpisodeCore:
         self.energy = np.zeros(K)
         self.eps = np.full(K, self._eps0)
         self.reward = REWARDS[p.reward](p, K)
+        # the attacker's estimator: least squares runs in the compiled kernels; any other is
+        # updated column by column (encctl_gym.ident)
+        est = make_estimator(p.estimator)
+        self.estimator = None if isinstance(est, OrdinaryLeastSquares) else est
         self.collected = 0  # samples collected and paid for
         self.delivered = 0  # samples delivered to the agent
         self.new = False
@@ -265,7 +271,7 @@ class EpisodeCore:
         # the ideal backend's steady-state step is one compiled call, on the loop's arithmetic
         q = loop.quantization
         self._quant = tuple(q) if q is not None else None
-        self._fused = self._quant is not None and self.reward.fused
+        self._fused = self._quant is not None and self.reward.fused and self.estimator is None
         C = sch.chunk
         self._noise_draws = np.zeros((K, C, n))  # each copy's chunk, as its generator draws it
         self._noise = np.zeros((C, K, n))  # period-major, like X: one period's noise is contiguous
@@ -405,6 +411,8 @@ class EpisodeCore:
         self.hist[:] = 0.0
         self.energy[:] = 0.0
         self.eps[:] = self._eps0
+        if self.estimator is not None:
+            self.estimator.start(self.K, self.n, self.m)
         self.reward.reset(self)
         self.collected = self.delivered = 0
         self.done = False
@@ -492,8 +500,10 @@ class EpisodeCore:
             kern.add_columns(self._dims, self.X, self.U, first, target, self._GC, self.Q, self.ready)
             self._gram_upto = target
         self.delivered = target
+        if self.estimator is not None:
+            self._estimate(first, target)
         self.reward.on_delivery(self)
-        if self.delivered - 1 >= self.d:
+        if self.estimator is None and self.delivered - 1 >= self.d:
             self._since_refresh += target - first
             if final or self._since_refresh >= self.schedule.refresh:  # exact solve: bounds drift; final = eq:estimate
                 stale = np.ones(self.K, dtype=bool)
@@ -508,6 +518,19 @@ class EpisodeCore:
             self._all_ready = bool(self.ready.all())
         self.history.append((self.delivered, float(self.eps[0])))
         return True
+
+    def _estimate(self, first: int, target: int) -> None:
+        """The configured (not least-squares) estimator takes the columns ``first <= j < target``;
+        epsilon is the error of its estimate once it has one (and where it is defined: the
+        instruments of ``iv`` can still be singular), that of the previous estimate before."""
+        est = self.estimator
+        assert est is not None
+        for j in range(first, target):
+            est.update(np.concatenate([self.X[j - 1], self.U[j - 1]], axis=1), self.X[j])
+        if est.ready:
+            err = est.error(self.p.A, self.p.B)
+            ok = np.isfinite(err)
+            self.eps[ok] = err[ok]
 
     def _refresh(self, rows: np.ndarray) -> np.ndarray:
         """Exact least squares (eq:estimate) for the copies ``rows`` from the running Gram matrices.
