@@ -12,7 +12,7 @@ import pytest
 from encctl_gym.envs import EncryptedLTIAttackEnv
 from encctl_gym.envs.config import REWARDS
 from encctl_gym.envs.helper import HelperThread
-from encctl_gym.envs.layout import INFO_FIELDS, OBSERVATION_MODES, ObservationLayout
+from encctl_gym.envs.layout import INFO_KEYS, OBSERVATION_MODES, ObservationLayout
 from encctl_gym.envs.rewards import REWARDS as REWARD_CLASSES
 from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
 from encctl_gym.errors import ParameterError
@@ -61,7 +61,9 @@ def test_single_and_vector_info_have_the_layout_keys_and_agree():
     venv = EncryptedLTIAttackVectorEnv(num_envs=2, config=SMALL)
     _, info = env.reset(seed=5)
     _, info_v = venv.reset(seed=5)
-    assert list(info) == list(info_v) == [name for name, _, _ in INFO_FIELDS]
+    assert list(info) == list(info_v) == list(INFO_KEYS)
+    assert all(isinstance(v, np.ndarray) and v.shape == (2,) for v in info_v.values())
+    assert info_v["samples_collected"].dtype == np.int64 and info_v["epsilon"].dtype == np.float64
     assert all(isinstance(v, (float, int)) and not isinstance(v, np.generic) for v in info.values())
     assert all(info_v[k][0] == info[k] for k in info)
     assert info["epsilon"] == pytest.approx(np.sum(np.hstack([env.params.A, env.params.B]) ** 2) / (2 * 4))

@@ -14,7 +14,7 @@ The small batched kernels (energy budget, plant update, regression columns, erro
 observation) are used one by one by the ElGamal backend, between calls into the crypto layer;
 :func:`step_fused` does a whole ideal-backend period (energy budget, forged input and collected
 state in the loop's exact fixed-point arithmetic, :mod:`encctl_gym.loop.quantize`, plant,
-delivery, recursive least squares, error, reward, observation, info) in one call. The batched
+delivery, recursive least squares, error, reward, observation) in one call. The batched
 kernels release the GIL, so the episode's helper thread (noise draws, Gram catch-up) runs
 while they do.
 
@@ -23,8 +23,7 @@ as fast as separate arguments): ``consts`` = ``(A, B, theta_true_T, c, u_max, bu
 ``arrays`` = ``(x, energy, X, U, hist, Q, eps, reward, a_buf, q_buf, qx_buf, sc)``, ``quant`` =
 the loop's :class:`~encctl_gym.loop.quantize.Quantization`, ``obs_at`` = the observation
 offsets of :class:`~encctl_gym.envs.layout.ObservationLayout`; each kernel unpacks them in
-that order. The observation and the info rows are written where
-:mod:`encctl_gym.envs.layout` says.
+that order. The observation is written where :mod:`encctl_gym.envs.layout` says.
 
 Data layout: ``X`` (N, K, n) and ``U`` (N, K, m) are time-major, so the copies' data of one
 period are contiguous. The running least squares are kept with the copies innermost: the
@@ -41,7 +40,6 @@ import numpy as np
 from numba import njit, prange
 
 from ..loop.quantize import OK, STATE_OVERFLOW, _collect, _forge
-from .layout import C_COLLECTED, C_DELIVERED, F_ENERGY, F_EPSILON, F_GAMMA, F_GAMMA_OPT, F_POWER, F_TIME
 
 __all__ = ["OK", "STATE_OVERFLOW", "PARALLEL_CHUNK", "dims"]
 
@@ -236,25 +234,6 @@ def _observation(k0, k1, n, m, H, obs, obs_at, X, U, j, new, hist, time_frac, en
 
 
 @njit(inline="always")
-def _info(k0, k1, f, counts, eps, energy, scalars):
-    """The info rows of :mod:`encctl_gym.envs.layout`: epsilon, gamma, deciphering time, input
-    energy, average power (energy / power_den) and, if ``f`` has the row, gamma_opt; the sample
-    counts. ``scalars`` = ``(gamma, time, power_den, gamma_opt, collected, delivered)``."""
-    gamma, time, power_den, gamma_opt, collected, delivered = scalars
-    for k in range(k0, k1):
-        f[F_EPSILON, k] = eps[k]
-        f[F_GAMMA, k] = gamma
-        f[F_TIME, k] = time
-        f[F_ENERGY, k] = energy[k]
-        f[F_POWER, k] = energy[k] / power_den
-        counts[C_COLLECTED, k] = collected
-        counts[C_DELIVERED, k] = delivered
-    if f.shape[0] > F_GAMMA_OPT:
-        for k in range(k0, k1):
-            f[F_GAMMA_OPT, k] = gamma_opt
-
-
-@njit(inline="always")
 def _period(k0, k1, n, m, H, consts, arrays, quant, act, w, u_at, collect_at, tmp):
     """One ideal-backend period of the copies ``k0 <= k < k1``, stage by stage: energy budget,
     forged input, plant update, own-input history and, if ``collect_at >= 0``, the collected
@@ -434,12 +413,6 @@ def load_actions(src, dst):
 
 
 @njit(cache=True, nogil=True)
-def fill_info(f, counts, eps, energy, scalars):
-    """The info of every copy (see :func:`_info`)."""
-    _info(0, f.shape[1], f, counts, eps, energy, scalars)
-
-
-@njit(cache=True, nogil=True)
 def log_ratio(before, after, out):
     """out = log(before / after): the reward, with the same log as the fused kernels."""
     for k in range(out.shape[0]):
@@ -454,40 +427,34 @@ def step_ideal(dims, consts, arrays, quant, act, w, u_at, collect_at):
 
 
 @njit(inline="always")
-def _steady(k0, k1, n, m, H, consts, arrays, obs, obs_at, first, target, j_obs, new, time_frac, info, scalars):
+def _steady(k0, k1, n, m, H, consts, arrays, obs, obs_at, first, target, j_obs, new, time_frac):
     """The stages after the period of a steady-state step: delivery by recursive least squares,
-    error and reward (:func:`_deliver`), observation and info, for the copies ``k0 <= k < k1``."""
+    error and reward (:func:`_deliver`) and the observation, for the copies ``k0 <= k < k1``."""
     A, B, theta_true_T, c, u_max, budget = consts
     x, energy, X, U, hist, Q, eps, reward, a_buf, q_buf, qx_buf, sc = arrays
     _deliver(k0, k1, n, m, X, U, first, target, Q, sc, theta_true_T, c, eps, reward)
     _observation(k0, k1, n, m, H, obs, obs_at, X, U, j_obs, new, hist, time_frac, energy, budget)
-    _info(k0, k1, info[0], info[1], eps, energy, scalars)
 
 
 @njit(cache=True, nogil=True)
-def step_fused(
-    dims, consts, arrays, quant, act, w, u_at, collect_at, first, target, obs, obs_at, j_obs, new, time_frac, info, scalars,
-):
+def step_fused(dims, consts, arrays, quant, act, w, u_at, collect_at, first, target, obs, obs_at, j_obs, new, time_frac):
     """A whole steady-state ideal-backend period for every copy in one call: the period, the
     delivery of the columns ``first <= j < target`` by recursive least squares, the error, the
-    reward, the observation and the info rows (``info`` = ``(f, counts)``, ``scalars`` as for
-    :func:`_info`). The Gram matrices are left behind; :func:`add_gram` catches them up when
-    they are needed. Stage by stage over the whole batch: measured faster here than chunk by
-    chunk.
+    reward and the observation. The Gram matrices are left behind; :func:`add_gram` catches them
+    up when they are needed. Stage by stage over the whole batch: measured faster here than
+    chunk by chunk.
     """
     K = act.shape[0]
     n, m, H = len(dims[0]), len(dims[1]), len(dims[2])
     status = _period(0, K, n, m, H, consts, arrays, quant, act, w, u_at, collect_at, np.empty(n))
     if status != OK:
         return status
-    _steady(0, K, n, m, H, consts, arrays, obs, obs_at, first, target, j_obs, new, time_frac, info, scalars)
+    _steady(0, K, n, m, H, consts, arrays, obs, obs_at, first, target, j_obs, new, time_frac)
     return OK
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def step_fused_parallel(
-    dims, consts, arrays, quant, act, w, u_at, collect_at, first, target, obs, obs_at, j_obs, new, time_frac, info, scalars,
-):
+def step_fused_parallel(dims, consts, arrays, quant, act, w, u_at, collect_at, first, target, obs, obs_at, j_obs, new, time_frac):
     """:func:`step_fused` with its chunks of :data:`PARALLEL_CHUNK` copies spread over the cores
     (``prange``): the same stages on the same chunks, which do not interact, so the numbers are
     identical."""
@@ -503,5 +470,5 @@ def step_fused_parallel(
         if s != OK:
             status[t] = s
         else:
-            _steady(k0, k1, n, m, H, consts, arrays, obs, obs_at, first, target, j_obs, new, time_frac, info, scalars)
+            _steady(k0, k1, n, m, H, consts, arrays, obs, obs_at, first, target, j_obs, new, time_frac)
     return status.max()

@@ -48,7 +48,7 @@ from ..resources import check_memory
 from . import _kernels as kern
 from .config import AttackParams
 from .helper import HelperThread
-from .layout import ObservationLayout, info_buffers, info_from_buffers
+from .layout import ObservationLayout, info_dict
 from .rewards import REWARDS
 
 __all__ = ["EpisodeCore", "EpisodeSchedule", "attack_design_for", "episode_bytes", "check_episode_memory"]
@@ -221,6 +221,9 @@ class EpisodeCore:
             self.gamma_opt_table[2:] = design.gamma(Ns[2:])
         self.time_table = np.asarray(p.deciphering_time(Ns), dtype=np.float64)  # Definition def:sdt, under the model
         self._time_frac = self.time_table / p.tau_c
+        # the same tables as Python floats, for the per-step info scalars
+        self._gamma_list, self._time_list = self.gamma_table.tolist(), self.time_table.tolist()
+        self._gamma_opt_list = self.gamma_opt_table.tolist()
         # per-copy data: collected (deciphered) states and applied inputs
         # time-major: the data of all copies for one period are contiguous
         self.X = np.zeros((N, K, n))  # collected (deciphered) states x_0 .. x_{N-1}
@@ -252,7 +255,6 @@ class EpisodeCore:
         self.new = False
         self.done = False
         self._obs_out: np.ndarray | None = None  # observation written by the fused step, not yet handed out
-        self._info_out: tuple[np.ndarray, np.ndarray] | None = None  # and its info buffers, likewise
         self._act = np.zeros((K, m))  # the actions of the current step, float64
         self._obs_shape = (K, self.layout.dim)
         self._obs_at = self.layout.offsets
@@ -391,7 +393,7 @@ class EpisodeCore:
         self.wait()  # the helper may still be drawing from the old generators or adding to G
         self._rngs = rngs
         self._given_noise = given
-        self._obs_out = self._info_out = None
+        self._obs_out = None
         for i, g in enumerate(rngs):
             draw = g.standard_normal(self.n) * self._sx
             self.x[i] = draw if x0_arr is None else x0_arr[i]
@@ -610,11 +612,9 @@ class EpisodeCore:
                 new = target > self.delivered
                 obs = np.empty(self._obs_shape, dtype=np.float32)
                 N, collected = (target if new else self.delivered), self.collected + 1
-                info = info_buffers(self.K, self.has_gamma_opt)
                 status = self._step_fused(
                     self._dims, self._consts, self._arrays, self._quant, act, w, self.collected - 1, self.collected,
                     first, target, obs, self._obs_at, N - 1, float(new), float(self._time_frac[collected]),
-                    info, self._info_scalars(collected, N),
                 )
                 if status == kern.STATE_OVERFLOW:
                     self._overflow()
@@ -627,9 +627,8 @@ class EpisodeCore:
                     if self.helper is not None and target - self._gram_upto >= self.schedule.gram_batch:
                         self._gram_behind(target)
                 self._obs_out = obs
-                self._info_out = info
                 return self._reward_out.copy(), False, False
-        self._obs_out = self._info_out = None
+        self._obs_out = None
         if self._quant is not None:  # ideal backend: the period in one compiled call
             status = kern.step_ideal(
                 self._dims, self._consts, self._arrays, self._quant, act, w, self.collected - 1, -1 if ended else self.collected
@@ -668,24 +667,17 @@ class EpisodeCore:
             )
         return obs
 
-    def _info_scalars(self, collected: int, N: int) -> tuple[float, float, float, float, int, int]:
-        """The info entries shared by all copies, as the kernels' ``_info`` stage takes them."""
+    def _shared_info(self) -> tuple[float, float, float, float, int, int]:
+        """The info entries all copies share (:func:`~encctl_gym.envs.layout.info_dict`)."""
+        collected, N = self.collected, self.delivered
         return (
-            float(self.gamma_table[N]), float(self.time_table[collected]), float(max(collected, 1) * self.m),
-            float(self.gamma_opt_table[N]), collected, N,
+            self._gamma_list[N], self._time_list[collected], float(max(collected, 1) * self.m),
+            self._gamma_opt_list[N], collected, N,
         )
 
-    def _info_filled(self) -> tuple[np.ndarray, np.ndarray]:
-        """The info buffers of this step: the fused step's, if not yet handed out, else filled now."""
-        bufs, self._info_out = self._info_out, None
-        if bufs is None:
-            bufs = info_buffers(self.K, self.has_gamma_opt)
-            kern.fill_info(*bufs, self.eps, self.energy, self._info_scalars(self.collected, self.delivered))
-        return bufs
-
     def info_arrays(self) -> dict[str, np.ndarray]:
-        """Info of every copy as new arrays of shape (K,) (keys: :data:`~encctl_gym.envs.layout.INFO_FIELDS`)."""
-        return info_from_buffers(*self._info_filled())
+        """Info of every copy as new arrays of shape (K,) (:func:`~encctl_gym.envs.layout.info_dict`)."""
+        return info_dict(self.eps.copy(), self.energy.copy(), self._shared_info(), self.has_gamma_opt, self.K)
 
     def info(self) -> dict[str, Any]:
         """Info of copy 0 as Python scalars (single environment).
@@ -693,4 +685,4 @@ class EpisodeCore:
         ``epsilon`` is the error (Definition def:error) of the attacker's current estimate: the
         least squares estimate once ``n + m`` columns are delivered, ``[A B] = 0`` before.
         """
-        return info_from_buffers(*self._info_filled(), copy=0)
+        return info_dict(float(self.eps[0]), float(self.energy[0]), self._shared_info(), self.has_gamma_opt)

@@ -3,9 +3,8 @@
 :class:`ObservationLayout` is the one definition of the flat observation vector: its slices
 (used by the attackers in :mod:`agents`), its bounds (the observation space), the offsets the
 compiled kernels write at (:mod:`encctl_gym.envs._kernels`), and the column subsets (*modes*)
-that learned attackers are trained on. :data:`INFO_FIELDS` is the one definition of the info
-entries: their names and order, and the rows of the two buffers (floats, counts) that the
-kernels fill for every copy.
+that learned attackers are trained on. :func:`info_dict` is the one definition of the info
+entries, for one copy (Python scalars) and for a batch (arrays).
 """
 
 from __future__ import annotations
@@ -20,20 +19,10 @@ from ..errors import ParameterError
 __all__ = [
     "ObservationLayout",
     "OBSERVATION_MODES",
-    "INFO_FIELDS",
-    "F_EPSILON",
-    "F_GAMMA",
-    "F_TIME",
-    "F_ENERGY",
-    "F_POWER",
-    "F_GAMMA_OPT",
-    "C_COLLECTED",
-    "C_DELIVERED",
-    "INFO_FLOAT_ROWS",
-    "INFO_COUNT_ROWS",
+    "INFO_KEYS",
+    "SHARED_INFO",
     "PRIVILEGED_INFO",
-    "info_buffers",
-    "info_from_buffers",
+    "info_dict",
 ]
 
 #: Column subsets of the observation for learned attackers (:meth:`ObservationLayout.columns`).
@@ -161,40 +150,51 @@ class ObservationLayout:
 
 
 # ----------------------------------------------------------------------------- info
-# Rows of the two info buffers (floats; counts), as the kernels' ``_info`` stage writes them.
-F_EPSILON, F_GAMMA, F_TIME, F_ENERGY, F_POWER, F_GAMMA_OPT = range(6)
-C_COLLECTED, C_DELIVERED = range(2)
+def info_dict(eps: Any, energy: Any, shared: tuple, with_gamma_opt: bool, num_envs: int | None = None) -> dict[str, Any]:
+    """The info of the attack environment, defined once for the single and the vector environment.
 
-#: The info entries, in the order of the info dict, each with its buffer ("f": floats, "c":
-#: counts) and row there.
-INFO_FIELDS: tuple[tuple[str, str, int], ...] = (
-    ("epsilon", "f", F_EPSILON),
-    ("gamma", "f", F_GAMMA),
-    ("samples_collected", "c", C_COLLECTED),
-    ("samples_delivered", "c", C_DELIVERED),
-    ("deciphering_time", "f", F_TIME),
-    ("input_energy", "f", F_ENERGY),
-    ("average_power", "f", F_POWER),
-    ("gamma_opt", "f", F_GAMMA_OPT),
-)
-INFO_FLOAT_ROWS = tuple(name for name, kind, _ in sorted(INFO_FIELDS, key=lambda f: f[2]) if kind == "f")
-INFO_COUNT_ROWS = tuple(name for name, kind, _ in sorted(INFO_FIELDS, key=lambda f: f[2]) if kind == "c")
+    Parameters
+    ----------
+    eps, energy : float or numpy.ndarray of shape (K,)
+        The error of the attacker's current estimate (Definition def:error) and the input
+        energy spent, of one copy (Python floats) or of every copy (arrays, handed out as they are).
+    shared : tuple
+        The entries all copies share: ``(gamma, deciphering_time, power_den, gamma_opt,
+        samples_collected, samples_delivered)``; ``average_power = energy / power_den``.
+    with_gamma_opt : bool
+        Include ``gamma_opt`` (computed only when the environment was asked to).
+    num_envs : int, optional
+        ``K`` for the vector environment: every shared entry becomes an array of shape (K,).
+
+    Returns
+    -------
+    dict
+        Keys in the order of :data:`INFO_KEYS`.
+    """
+    gamma, time, power_den, gamma_opt, collected, delivered = shared
+    info = {
+        "epsilon": eps,
+        "gamma": gamma,
+        "samples_collected": collected,
+        "samples_delivered": delivered,
+        "deciphering_time": time,
+        "input_energy": energy,
+        "average_power": energy / power_den,
+    }
+    if with_gamma_opt:
+        info["gamma_opt"] = gamma_opt
+    if num_envs is not None:
+        for key in SHARED_INFO:
+            if key in info:
+                info[key] = np.full(num_envs, info[key])
+    return info
+
+
+#: The info entries all copies share (arrays of one value in the vector environment).
+SHARED_INFO = ("gamma", "samples_collected", "samples_delivered", "deciphering_time", "gamma_opt")
+#: The keys of the info dict, in order (:func:`info_dict`).
+INFO_KEYS: tuple[str, ...] = tuple(info_dict(0.0, 0.0, (0.0, 0.0, 1.0, 0.0, 0, 0), True))
 
 #: Info entries that are functions of the true plant (A, B): for training and evaluation only,
 #: not something the attacker observes (see the environment's docstring, section Info).
 PRIVILEGED_INFO = ("epsilon", "gamma", "gamma_opt")
-
-
-def info_buffers(K: int, gamma_opt: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Empty float and count buffers for the info of ``K`` copies (``gamma_opt`` row only if computed)."""
-    rows = len(INFO_FLOAT_ROWS) if gamma_opt else len(INFO_FLOAT_ROWS) - 1
-    return np.empty((rows, K)), np.empty((len(INFO_COUNT_ROWS), K), dtype=np.int64)
-
-
-def info_from_buffers(f: np.ndarray, counts: np.ndarray, copy: int | None = None) -> dict[str, Any]:
-    """The info dict from filled buffers: arrays of shape (K,) per key, or with ``copy`` the
-    Python scalars of that copy (the single environment's info)."""
-    bufs: dict[str, Any] = {"f": f, "c": counts}
-    if copy is not None:
-        bufs = {"f": f[:, copy].tolist(), "c": counts[:, copy].tolist()}
-    return {name: bufs[kind][row] for name, kind, row in INFO_FIELDS if row < len(bufs[kind])}
