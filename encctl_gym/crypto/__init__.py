@@ -31,71 +31,22 @@ steps raises :class:`~encctl_gym.errors.KeyMismatchError`.
 
 from __future__ import annotations
 
-from .arith import RandomSource, as_random_source, as_random_stream, secure_random, seeded_random
-from .controller import EncryptedLinearController, PlantCryptoSide
-from .plant_side import ModifiedPlant, PlantParty, StaticPlant, TokenPlant
-from .quantized import QuantizedLinearController
-from .schemes import SCHEMES, Scheme, get_scheme
-from .servers import ControllerServer, StaticControllerServer, TokenControllerServer
-from .dyn_elgamal import UpdateToken, ciphertext_update, key_update, recover_next_secret_key
-from .elgamal import Ciphertext, PublicKey, SecretKey, decrypt, encrypt, keygen, mult
-from .encoding import Encoder, decode_int, encode_int
-from .group import (
-    DEFAULT_MAX_GENERATION_SECONDS,
-    MAX_GROUP_BITS,
-    MIN_GENERATE_BITS,
-    SHIPPED_BITS,
-    GroupParams,
-    estimate_generation_seconds,
-    generate_safe_prime_group,
-    get_group,
-    shipped_group,
-)
-from .modified import ModifiedCiphertext, modified_decrypt, modified_eval
+import sys
 
-__all__ = [
-    "RandomSource",
-    "secure_random",
-    "seeded_random",
-    "as_random_source",
-    "as_random_stream",
-    "GroupParams",
-    "MIN_GENERATE_BITS",
-    "MAX_GROUP_BITS",
-    "SHIPPED_BITS",
-    "DEFAULT_MAX_GENERATION_SECONDS",
-    "estimate_generation_seconds",
-    "generate_safe_prime_group",
-    "shipped_group",
-    "get_group",
-    "Encoder",
-    "encode_int",
-    "decode_int",
-    "PublicKey",
-    "SecretKey",
-    "Ciphertext",
-    "keygen",
-    "encrypt",
-    "decrypt",
-    "mult",
-    "UpdateToken",
-    "key_update",
-    "ciphertext_update",
-    "recover_next_secret_key",
-    "ModifiedCiphertext",
-    "modified_eval",
-    "modified_decrypt",
-    "ControllerServer",
-    "StaticControllerServer",
-    "TokenControllerServer",
-    "PlantParty",
-    "ModifiedPlant",
-    "TokenPlant",
-    "StaticPlant",
-    "PlantCryptoSide",
-    "Scheme",
-    "SCHEMES",
-    "get_scheme",
-    "EncryptedLinearController",
-    "QuantizedLinearController",
-]
+from .arith import *  # noqa: F403
+from .group import *  # noqa: F403
+from .checks import *  # noqa: F403
+from .encoding import *  # noqa: F403
+from .elgamal import *  # noqa: F403
+from .dyn_elgamal import *  # noqa: F403
+from .modified import *  # noqa: F403
+from .quantized import *  # noqa: F403
+from .servers import *  # noqa: F403
+from .plant_side import *  # noqa: F403
+from .schemes import *  # noqa: F403
+from .controller import *  # noqa: F403
+
+#: The public names of the modules above, in their order (each module's ``__all__``).
+__all__ = list(dict.fromkeys(
+    name for module in ("arith", "group", "checks", "encoding", "elgamal", "dyn_elgamal", "modified", "quantized", "servers", "plant_side", "schemes", "controller") for name in sys.modules[f"{__name__}.{module}"].__all__
+))

@@ -33,6 +33,7 @@ __all__ = [
     "check_group_of",
     "check_component",
     "check_ciphertext_matrix",
+    "check_ciphertext_of",
 ]
 
 _MPZ = type(arith.mpz(0))
@@ -139,3 +140,24 @@ def check_ciphertext_matrix(name: str, mat: Any, cls: type, shape: tuple[int, in
             if not isinstance(c, cls):
                 raise CiphertextError(f"{name} must contain {cls.__name__} entries, got {type(c).__name__}")
     return rows
+
+
+def check_ciphertext_of(group: GroupParams, ct: Any, cls: type, components: tuple[str, ...], description: str) -> Any:
+    """``ct`` after checking it is a ``cls`` of ``group`` whose ``components`` all lie in G.
+
+    The check of every ciphertext type (:func:`~.elgamal.check_ciphertext`,
+    :func:`~.modified.check_modified_ciphertext`).
+
+    Raises
+    ------
+    CiphertextError
+        For another type (named by ``description``) or a component outside G.
+    KeyMismatchError
+        If ``ct`` belongs to another group.
+    """
+    if not isinstance(ct, cls):
+        raise CiphertextError(f"expected {description}, got {ct!r}")
+    check_group_of(ct, group)
+    for name in components:
+        check_component(group, getattr(ct, name), name)
+    return ct

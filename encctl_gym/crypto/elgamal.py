@@ -30,15 +30,7 @@ from ..errors import CiphertextError, KeyMismatchError, ParameterError, Plaintex
 from . import arith
 from .arith import RngLike
 from .arith import format_int as fmt
-from .checks import (
-    check_component,
-    check_group_of,
-    check_instance,
-    check_same_group,
-    group_field,
-    integer_field,
-    step_field,
-)
+from .checks import check_ciphertext_of, check_instance, check_same_group, group_field, integer_field, step_field
 from .group import GroupParams, as_group
 
 __all__ = [
@@ -196,12 +188,7 @@ def check_ciphertext(group: GroupParams, ct: Any) -> "Ciphertext":
     KeyMismatchError
         If ``ct`` belongs to another group.
     """
-    if not isinstance(ct, Ciphertext):
-        raise CiphertextError(f"expected an ElGamal Ciphertext (c1, c2), got {ct!r}")
-    check_group_of(ct, group)
-    check_component(group, ct.c1, "c1")
-    check_component(group, ct.c2, "c2")
-    return ct
+    return check_ciphertext_of(group, ct, Ciphertext, ("c1", "c2"), "an ElGamal Ciphertext (c1, c2)")
 
 
 # ---------------------------------------------------------------------- algorithms

@@ -17,15 +17,7 @@ from typing import Any, Optional
 
 from ..errors import CiphertextError, KeyMismatchError
 from . import arith
-from .checks import (
-    check_component,
-    check_group_of,
-    check_instance,
-    check_same_group,
-    group_field,
-    integer_field,
-    step_field,
-)
+from .checks import check_ciphertext_of, check_instance, check_same_group, group_field, integer_field, step_field
 from .elgamal import Ciphertext, PublicKey, SecretKey, check_ciphertext, decrypt_components
 from .group import GroupParams
 
@@ -102,13 +94,7 @@ def check_modified_ciphertext(grp: GroupParams, ct: Any) -> ModifiedCiphertext:
     KeyMismatchError
         If ``ct`` belongs to another group.
     """
-    if not isinstance(ct, ModifiedCiphertext):
-        raise CiphertextError(f"expected a ModifiedCiphertext (c1, c2, c3), got {ct!r}")
-    check_group_of(ct, grp)
-    check_component(grp, ct.c1, "c1")
-    check_component(grp, ct.c2, "c2")
-    check_component(grp, ct.c3, "c3")
-    return ct
+    return check_ciphertext_of(grp, ct, ModifiedCiphertext, ("c1", "c2", "c3"), "a ModifiedCiphertext (c1, c2, c3)")
 
 
 def modified_decrypt(sk1: SecretKey, sk2: SecretKey, ct: ModifiedCiphertext) -> int:

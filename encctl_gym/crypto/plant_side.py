@@ -100,7 +100,22 @@ class PlantParty:
         return check_ciphertext_matrix("server output", out, self.output_type, shape)
 
     def decrypt_products(self, out: Sequence[Sequence[Any]]) -> list[list[int]]:
-        """Decrypt the server's alpha x beta output; every product lifted to a signed integer."""
+        """Decrypt the server's alpha x beta output; every product lifted to a signed integer.
+
+        Raises
+        ------
+        CiphertextError
+            If the output has the wrong shape or malformed entries.
+        KeyMismatchError
+            If an entry belongs to another group or records other steps than the keys it needs.
+        """
+        rows = self._output(out)
+        cache: dict[tuple[str, int], Any] = {}  # the parts c^(-s) computed this step, by key and component
+        grp = self.group
+        return [[lift(grp, self._decrypt_entry(c, cache)) for c in row] for row in rows]
+
+    def _decrypt_entry(self, c: Any, cache: dict[tuple[str, int], Any]) -> int:
+        """The plaintext of one entry of the output (the scheme's decryption), checks included."""
         raise NotImplementedError
 
     def decrypt_output(self, out: Sequence[Sequence[Any]]) -> np.ndarray:
@@ -139,85 +154,52 @@ class ModifiedPlant(PlantParty):
                 self._mask0[c.c1] = arith.powmod(c.c1, q - s0, p)
         return ct
 
-    def decrypt_products(self, out: Sequence[Sequence[Any]]) -> list[list[int]]:
-        """``Dec_bar(sk_0, sk_t, .)`` of every entry, lifted to signed integers.
-
-        Raises
-        ------
-        CiphertextError
-            If the output has the wrong shape or malformed entries.
-        KeyMismatchError
-            If an entry belongs to another group or records steps other than (0, t).
-        """
+    def _decrypt_entry(self, c: Any, cache: dict[tuple[str, int], Any]) -> int:
+        """``Dec_bar(sk_0, sk_t, c)``: ``c1^(-s_0)`` from the set-up (Phi's entries) or computed once
+        per distinct c1 (e.g. injected ones), ``c2^(-s_t)`` once per distinct c2 (per column)."""
         grp = self.group
         p, q = grp.p, grp.q
-        rows = self._output(out)
-        s0, st, t = self._sk0.s, self._sk.s, self._sk.t
-        col: dict[int, Any] = {}
-        other: dict[int, Any] = {}  # c1 parts of ciphertexts that are not Phi's (e.g. injected)
-        res = []
-        for row in rows:
-            lifted = []
-            for c in row:
-                check_group_of(c, grp)
-                if not (0 < c.c1 < p and 0 < c.c2 < p and grp.contains(c.c3)):
-                    check_modified_ciphertext(grp, c)  # raises, naming the component
-                if (c.t1 is not None and c.t1 != self._sk0.t) or (c.t2 is not None and c.t2 != t):
-                    raise KeyMismatchError(
-                        f"output ciphertext records steps (t1, t2) = ({c.t1}, {c.t2}), "
-                        f"the plant decrypts with the keys of steps ({self._sk0.t}, {t})"
-                    )
-                # c1 and c2 are checked for membership when first seen (the cached c1 of Phi's
-                # ciphertexts were made by the plant itself).
-                a = self._mask0.get(c.c1)
-                if a is None:
-                    a = other.get(c.c1)
-                if a is None:  # not one of Phi's ciphertexts (e.g. an injected one)
-                    if not grp.contains(c.c1):
-                        check_modified_ciphertext(grp, c)  # raises, naming c1
-                    a = other[c.c1] = arith.powmod(c.c1, q - s0, p)
-                b = col.get(c.c2)
-                if b is None:
-                    if not grp.contains(c.c2):
-                        check_modified_ciphertext(grp, c)  # raises, naming c2
-                    b = col[c.c2] = arith.powmod(c.c2, q - st, p)
-                lifted.append(lift(grp, int(arith.mulmod(arith.mulmod(a, b, p), c.c3, p))))
-            res.append(lifted)
-        return res
+        check_group_of(c, grp)
+        if not (0 < c.c1 < p and 0 < c.c2 < p and grp.contains(c.c3)):
+            check_modified_ciphertext(grp, c)  # raises, naming the component
+        t0, t = self._sk0.t, self._sk.t
+        if (c.t1 is not None and c.t1 != t0) or (c.t2 is not None and c.t2 != t):
+            raise KeyMismatchError(
+                f"output ciphertext records steps (t1, t2) = ({c.t1}, {c.t2}), "
+                f"the plant decrypts with the keys of steps ({t0}, {t})"
+            )
+        # c1 and c2 are checked for membership when first seen (the cached c1 of Phi's ciphertexts
+        # were made by the plant itself).
+        a = self._mask0.get(c.c1)
+        if a is None:
+            a = cache.get(("c1", c.c1))
+        if a is None:  # not one of Phi's ciphertexts (e.g. an injected one)
+            if not grp.contains(c.c1):
+                check_modified_ciphertext(grp, c)  # raises, naming c1
+            a = cache["c1", c.c1] = arith.powmod(c.c1, q - self._sk0.s, p)
+        b = cache.get(("c2", c.c2))
+        if b is None:
+            if not grp.contains(c.c2):
+                check_modified_ciphertext(grp, c)  # raises, naming c2
+            b = cache["c2", c.c2] = arith.powmod(c.c2, q - self._sk.s, p)
+        return int(arith.mulmod(arith.mulmod(a, b, p), c.c3, p))
 
 
 class TokenPlant(PlantParty):
     """The plant of the conventional dynamic key: ``Dec(sk_t, .)`` of the server's ``Eval``
     output; each key update returns the token the server needs (Definition def:ec)."""
 
-    def decrypt_products(self, out: Sequence[Sequence[Any]]) -> list[list[int]]:
-        """``Dec(sk_t, .)`` of every entry, lifted to signed integers (one ``c1^(-s_t)`` per distinct c1).
-
-        Raises
-        ------
-        CiphertextError
-            If the output has the wrong shape or malformed entries.
-        KeyMismatchError
-            If an entry belongs to another group or records another step than ``t``.
-        """
+    def _decrypt_entry(self, c: Any, cache: dict[tuple[str, int], Any]) -> int:
+        """``Dec(sk_t, c)`` with one ``c1^(-s_t)`` per distinct c1."""
         grp = self.group
-        p, q = grp.p, grp.q
-        rows = self._output(out)
-        st, t = self._sk.s, self._sk.t
-        masks: dict[int, Any] = {}
-        res = []
-        for row in rows:
-            lifted = []
-            for c in row:
-                check_ciphertext(grp, c)
-                if c.t is not None and c.t != t:
-                    raise KeyMismatchError(f"output ciphertext is of step t = {c.t}, the plant's key of step t = {t}")
-                a = masks.get(c.c1)
-                if a is None:
-                    a = masks[c.c1] = arith.powmod(c.c1, q - st, p)
-                lifted.append(lift(grp, int(arith.mulmod(a, c.c2, p))))
-            res.append(lifted)
-        return res
+        check_ciphertext(grp, c)
+        t = self._sk.t
+        if c.t is not None and c.t != t:
+            raise KeyMismatchError(f"output ciphertext is of step t = {c.t}, the plant's key of step t = {t}")
+        a = cache.get(("c1", c.c1))
+        if a is None:
+            a = cache["c1", c.c1] = arith.powmod(c.c1, grp.q - self._sk.s, grp.p)
+        return int(arith.mulmod(a, c.c2, grp.p))
 
 
 class StaticPlant(TokenPlant):

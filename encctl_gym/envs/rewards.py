@@ -20,7 +20,7 @@ import numpy as np
 
 from . import _kernels as kern
 
-__all__ = ["Reward", "LogErrorReward", "LogDetReward", "AOptimalityReward", "REWARDS"]
+__all__ = ["Reward", "GramReward", "LogErrorReward", "LogDetReward", "AOptimalityReward", "REWARDS"]
 
 
 class Reward:
@@ -65,40 +65,62 @@ class LogErrorReward(Reward):
         return out
 
 
-class LogDetReward(Reward):
-    """The increase of ``log det(G + delta I)`` of the regressor Gram matrix ``G`` of the delivered
-    data (D-optimality; an attacker can compute it without knowing ``(A, B)``);
-    ``delta = logdet_regularization``."""
+class GramReward(Reward):
+    """A reward that is the change, at each delivery, of a function of the Gram matrix ``G`` of the
+    delivered regressors (``needs_gram``): a subclass gives the value before any delivery
+    (:meth:`initial`) and after one (:meth:`measure`), and ``sign`` (+1: an increase is
+    rewarded, -1: a decrease)."""
 
-    name = "logdet"
     needs_gram = True
+    sign = 1.0
 
     def __init__(self, params: Any, num_envs: int) -> None:
         super().__init__(params, num_envs)
-        d = params.n + params.m
-        self._reg = params.logdet_regularization * np.eye(d)
-        self._value0 = d * math.log(params.logdet_regularization)
-        self.value = np.full(num_envs, self._value0)
+        self._d = params.n + params.m
+        self._delta = params.logdet_regularization
+        self.value = np.full(num_envs, self.initial())
+
+    def initial(self) -> float:
+        """The value of every copy before its first delivery."""
+        raise NotImplementedError
+
+    def measure(self, G: np.ndarray) -> np.ndarray:
+        """The value for the Gram matrices ``G`` (K, d, d) of the copies."""
+        raise NotImplementedError
 
     def reset(self, core: Any) -> None:
-        self.value = np.full(self.K, self._value0)
+        self.value = np.full(self.K, self.initial())
 
     def begin(self, core: Any) -> None:
         self._before = self.value.copy()
 
     def on_delivery(self, core: Any) -> None:
-        sign, value = np.linalg.slogdet(core.G + self._reg)
-        bad = ~((sign > 0) & np.isfinite(value))
-        if bad.any():  # delta I lost to rounding next to a singular G: log det from the clipped eigenvalues
-            lam = np.clip(np.linalg.eigvalsh(core.G[bad]), 0.0, None)
-            value[bad] = np.log(lam + self._reg[0, 0]).sum(axis=-1)
-        self.value = value
+        self.value = self.measure(core.G)
 
     def end(self, core: Any) -> np.ndarray:
-        return self.value - self._before
+        return self.sign * (self.value - self._before)
 
 
-class AOptimalityReward(Reward):
+class LogDetReward(GramReward):
+    """The increase of ``log det(G + delta I)`` of the regressor Gram matrix ``G`` of the delivered
+    data (D-optimality; an attacker can compute it without knowing ``(A, B)``);
+    ``delta = logdet_regularization``."""
+
+    name = "logdet"
+
+    def initial(self) -> float:
+        return self._d * math.log(self._delta)
+
+    def measure(self, G: np.ndarray) -> np.ndarray:
+        sign, value = np.linalg.slogdet(G + self._delta * np.eye(self._d))
+        bad = ~((sign > 0) & np.isfinite(value))
+        if bad.any():  # delta I lost to rounding next to a singular G: log det from the clipped eigenvalues
+            lam = np.clip(np.linalg.eigvalsh(G[bad]), 0.0, None)
+            value[bad] = np.log(lam + self._delta).sum(axis=-1)
+        return value
+
+
+class AOptimalityReward(GramReward):
     """The decrease of ``log tr((G + delta I)^-1)``: A-optimality of the delivered regressors.
 
     For least squares with white noise, the error of Definition def:error given the regressors is
@@ -111,27 +133,14 @@ class AOptimalityReward(Reward):
     """
 
     name = "a_optimality"
-    needs_gram = True
+    sign = -1.0
 
-    def __init__(self, params: Any, num_envs: int) -> None:
-        super().__init__(params, num_envs)
-        self._d = params.n + params.m
-        self._delta = params.logdet_regularization
-        self._value0 = math.log(self._d / self._delta)
-        self.value = np.full(num_envs, self._value0)
+    def initial(self) -> float:
+        return math.log(self._d / self._delta)
 
-    def reset(self, core: Any) -> None:
-        self.value = np.full(self.K, self._value0)
-
-    def begin(self, core: Any) -> None:
-        self._before = self.value.copy()
-
-    def on_delivery(self, core: Any) -> None:
-        lam = np.clip(np.linalg.eigvalsh(core.G), 0.0, None)  # G is PSD; clip rounding below 0
-        self.value = np.log((1.0 / (lam + self._delta)).sum(axis=-1))
-
-    def end(self, core: Any) -> np.ndarray:
-        return self._before - self.value
+    def measure(self, G: np.ndarray) -> np.ndarray:
+        lam = np.clip(np.linalg.eigvalsh(G), 0.0, None)  # G is PSD; clip rounding below 0
+        return np.log((1.0 / (lam + self._delta)).sum(axis=-1))
 
 
 #: Rewards by the name the ``reward`` configuration key gives.

@@ -17,44 +17,18 @@ estimates; the Monte Carlo engine (:mod:`encctl_gym.sim`) and the environment us
 
 from __future__ import annotations
 
-from .bayes import BayesianLeastSquares
-from .error import estimation_error
-from .estimator import Estimator, MomentEstimator, estimate_errors
-from .forgetting import ForgettingLeastSquares
-from .instrumental import InstrumentalVariables
-from .least_squares import (
-    GRAM_COND_LIMIT,
-    RecursiveLeastSquares,
-    check_sample_sizes,
-    data_matrices,
-    identification_errors,
-    least_squares,
-    prefix_estimates,
-    solve_normal_equations,
-)
-from .ordinary import OrdinaryLeastSquares
-from .registry import DEFAULT_ESTIMATOR, ESTIMATORS, estimator_names, estimator_spec, make_estimator
+import sys
 
-__all__ = [
-    "estimation_error",
-    "data_matrices",
-    "least_squares",
-    "RecursiveLeastSquares",
-    "check_sample_sizes",
-    "prefix_estimates",
-    "identification_errors",
-    "solve_normal_equations",
-    "GRAM_COND_LIMIT",
-    "Estimator",
-    "MomentEstimator",
-    "estimate_errors",
-    "OrdinaryLeastSquares",
-    "BayesianLeastSquares",
-    "ForgettingLeastSquares",
-    "InstrumentalVariables",
-    "ESTIMATORS",
-    "DEFAULT_ESTIMATOR",
-    "estimator_names",
-    "estimator_spec",
-    "make_estimator",
-]
+from .error import *  # noqa: F403
+from .least_squares import *  # noqa: F403
+from .estimator import *  # noqa: F403
+from .ordinary import *  # noqa: F403
+from .bayes import *  # noqa: F403
+from .forgetting import *  # noqa: F403
+from .instrumental import *  # noqa: F403
+from .registry import *  # noqa: F403
+
+#: The public names of the modules above, in their order (each module's ``__all__``).
+__all__ = list(dict.fromkeys(
+    name for module in ("error", "least_squares", "estimator", "ordinary", "bayes", "forgetting", "instrumental", "registry") for name in sys.modules[f"{__name__}.{module}"].__all__
+))

@@ -36,7 +36,7 @@ import numpy as np
 from .._validation import check_int, check_system
 from ..errors import ParameterError, ShapeError
 from .error import estimation_error
-from .least_squares import _trajectory, check_sample_sizes
+from .least_squares import check_runs, check_sample_sizes, check_trajectory
 
 __all__ = ["Estimator", "MomentEstimator", "estimate_errors", "check_grid"]
 
@@ -211,7 +211,7 @@ class MomentEstimator(ABC):
         return out
 
     def _prepare(self, x: Any, u: Any) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
-        x, u = _trajectory(x, u)
+        x, u = check_trajectory(x, u)
         lead = x.shape[:-2]
         x = x.reshape(-1, *x.shape[-2:])
         u = u.reshape(-1, *u.shape[-2:])
@@ -266,12 +266,7 @@ class MomentEstimator(ABC):
         -------
         numpy.ndarray, shape (runs, K, n, n + m) (or (K, n, n + m) for 2-D input)
         """
-        x, u = _trajectory(x, u)
-        squeeze = x.ndim == 2
-        if squeeze:
-            x, u = x[None], u[None]
-        if x.ndim != 3:
-            raise ShapeError(f"x must have shape (runs, N, n) or (N, n), got {x.shape}")
+        x, u, squeeze = check_runs(x, u)
         runs, N_max, n = x.shape
         m = u.shape[-1]
         self.check_dimensions(n, m)

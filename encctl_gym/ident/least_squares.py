@@ -38,6 +38,8 @@ __all__ = [
     "prefix_estimates",
     "GRAM_COND_LIMIT",
     "solve_normal_equations",
+    "check_trajectory",
+    "check_runs",
 ]
 
 _EPS = np.finfo(np.float64).eps
@@ -55,8 +57,14 @@ def _check_N(N: int, n: int, m: int, what: str = "N") -> None:
         )
 
 
-def _trajectory(x: Any, u: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Validate a trajectory pair: x (..., N, n), u (..., N, m) or (..., N-1, m); returns u cut to N-1."""
+def check_trajectory(x: Any, u: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Validate a trajectory pair: x (..., N, n), u (..., N, m) or (..., N-1, m); returns u cut to N-1.
+
+    Raises
+    ------
+    ShapeError, ParameterError
+        On mismatched shapes, non-finite or non-real entries, or ``N < 2``.
+    """
     x = as_finite_array("x", x)
     u = as_finite_array("u", u)
     if x.ndim < 2:
@@ -71,6 +79,18 @@ def _trajectory(x: Any, u: Any) -> tuple[np.ndarray, np.ndarray]:
             f"u must have shape (..., N or N-1, m) matching x of shape {x.shape} (N={N}), got {u.shape}"
         )
     return x, u[..., : N - 1, :]
+
+
+def check_runs(x: Any, u: Any) -> tuple[np.ndarray, np.ndarray, bool]:
+    """:func:`check_trajectory` in the layout of a batch of runs: ``x`` (runs, N, n), ``u``
+    (runs, N - 1, m), and whether the input was one trajectory (then ``runs = 1``)."""
+    x, u = check_trajectory(x, u)
+    single = x.ndim == 2
+    if single:
+        x, u = x[None], u[None]
+    if x.ndim != 3:
+        raise ShapeError(f"x must have shape (runs, N, n) or (N, n), got {x.shape}")
+    return x, u, single
 
 
 def data_matrices(x: Any, u: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -97,7 +117,7 @@ def data_matrices(x: Any, u: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     ShapeError, ParameterError
         On mismatched shapes, non-finite entries or ``N < 2``.
     """
-    x, u = _trajectory(x, u)
+    x, u = check_trajectory(x, u)
     X_f = np.swapaxes(x[..., 1:, :], -1, -2).copy()
     X_p = np.swapaxes(x[..., :-1, :], -1, -2).copy()
     U_p = np.swapaxes(u, -1, -2).copy()
@@ -469,12 +489,7 @@ def prefix_estimates(
     ParameterError, ShapeError
         On bad data or grid (see :func:`check_sample_sizes`).
     """
-    x, u = _trajectory(x, u)
-    squeeze = x.ndim == 2
-    if squeeze:
-        x, u = x[None], u[None]
-    if x.ndim != 3:
-        raise ShapeError(f"x must have shape (runs, N, n) or (N, n), got {x.shape}")
+    x, u, squeeze = check_runs(x, u)
     runs, N_max, n = x.shape
     m = u.shape[-1]
     d = n + m

@@ -37,79 +37,21 @@ design_cli
 
 from __future__ import annotations
 
-from .complexity import (
-    estimation_error,
-    input_upper_bound,
-    noise_upper_bound,
-    sample_identifying_complexity,
-    sample_identifying_complexity_asymptotic,
-    sic_asymptotic_from_traces,
-    sic_from_traces,
-)
-from .cost_models import (
-    DECIPHERING_MODELS,
-    GUILLEVIC_CORRECTION,
-    DecipheringModel,
-    GenericModel,
-    KeyBreakCost,
-    PaperModel,
-    PrecomputationModel,
-    deciphering_model,
-    pollard_rho_log2_operations,
-)
-from .deciphering import break_cost, max_affordable_samples, per_sample_cost, sample_deciphering_time
-from .design import (
-    SecurityDesign,
-    bit_security_of_key_length,
-    design_from_traces,
-    design_security_parameter,
-    gnfs_complexity,
-    gnfs_log2_complexity,
-    is_secure,
-    minimum_key_length,
-    optimal_sample_size,
-    optimal_security_parameter,
-    paper_design_example,
-)
-from .gramians import controllability_gramian, noise_gramian
-from .key_length import KeyLengthDesign, KeyValue, design_key_length, key_length_value
+import sys
 
-__all__ = [
-    "controllability_gramian",
-    "noise_gramian",
-    "estimation_error",
-    "sample_identifying_complexity",
-    "sample_identifying_complexity_asymptotic",
-    "sic_from_traces",
-    "sic_asymptotic_from_traces",
-    "input_upper_bound",
-    "noise_upper_bound",
-    "sample_deciphering_time",
-    "per_sample_cost",
-    "max_affordable_samples",
-    "break_cost",
-    "KeyBreakCost",
-    "DecipheringModel",
-    "PaperModel",
-    "PrecomputationModel",
-    "GenericModel",
-    "DECIPHERING_MODELS",
-    "deciphering_model",
-    "GUILLEVIC_CORRECTION",
-    "pollard_rho_log2_operations",
-    "KeyLengthDesign",
-    "KeyValue",
-    "design_key_length",
-    "key_length_value",
-    "SecurityDesign",
-    "is_secure",
-    "optimal_sample_size",
-    "optimal_security_parameter",
-    "design_from_traces",
-    "design_security_parameter",
-    "paper_design_example",
-    "gnfs_complexity",
-    "gnfs_log2_complexity",
-    "bit_security_of_key_length",
-    "minimum_key_length",
-]
+from .gramians import *  # noqa: F403
+from .exact import *  # noqa: F403
+from .complexity import *  # noqa: F403
+from .bayes_complexity import *  # noqa: F403
+from .sample_size import *  # noqa: F403
+from .records import *  # noqa: F403
+from .cost_models import *  # noqa: F403
+from .deciphering import *  # noqa: F403
+from .design import *  # noqa: F403
+from .key_length import *  # noqa: F403
+from .attack_design import *  # noqa: F403
+
+#: The public names of the modules above, in their order (each module's ``__all__``).
+__all__ = list(dict.fromkeys(
+    name for module in ("gramians", "exact", "complexity", "bayes_complexity", "sample_size", "records", "cost_models", "deciphering", "design", "key_length", "attack_design") for name in sys.modules[f"{__name__}.{module}"].__all__
+))

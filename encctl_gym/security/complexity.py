@@ -36,7 +36,7 @@ from .._validation import (
     check_system,
     format_value,
 )
-from ..errors import ParameterError, ShapeError
+from ..errors import ParameterError
 from ..ident.error import estimation_error  # Definition def:error; its home is the identification layer
 from .gramians import controllability_gramian, noise_gramian
 

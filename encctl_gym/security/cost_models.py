@@ -640,19 +640,8 @@ def deciphering_model(name: Any = "paper", **options: Any) -> CostModel:
 
 # --------------------------------------------------------------------------- eq:opt_key under the paper model
 def bit_security_of_key_length(k: Any, gnfs_correction: Any = 0.0) -> float | np.ndarray:
-    """Bit security (Definition def:bit_sec) of a ``k``-bit key under the GNFS: ``log2 Omega(k) - c``.
-
-    Parameters
-    ----------
-    k : int or array_like of int
-        Key bit length in ``[40, 65536]``.
-    gnfs_correction : float, default 0.0
-        o(1) correction in bits.
-
-    Returns
-    -------
-    float or ndarray
-    """
+    """Bit security (Definition def:bit_sec) of a ``k``-bit key under the GNFS, ``log2 Omega(k) - c``:
+    :func:`gnfs_log2_complexity` under the name of the paper's question (eq:opt_key read backwards)."""
     return gnfs_log2_complexity(k, gnfs_correction)
 
 

@@ -9,22 +9,17 @@ version (their home is :mod:`encctl_gym.ident`).
 
 from __future__ import annotations
 
-from ..ident.least_squares import (
-    RecursiveLeastSquares,
-    data_matrices,
-    identification_errors,
-    least_squares,
-    prefix_estimates,
-)
-from .montecarlo import AttackSpec, gaussian_attack_errors, log_grid, sweep_gaussian_attack
+from . import montecarlo, plant
+from .montecarlo import *  # noqa: F403
+from .plant import *  # noqa: F403
+
+# the least-squares and task names this package gave before they had homes of their own
+from ..ident.least_squares import RecursiveLeastSquares, data_matrices, identification_errors, least_squares, prefix_estimates  # noqa: E501
 from ..parallel import child_seeds, run_tasks
-from .plant import LinearPlant, SimulationResult, simulate, simulate_gaussian_attack
 
 __all__ = [
-    "LinearPlant",
-    "SimulationResult",
-    "simulate",
-    "simulate_gaussian_attack",
+    *plant.__all__,
+    *montecarlo.__all__,
     "data_matrices",
     "least_squares",
     "RecursiveLeastSquares",
@@ -32,8 +27,4 @@ __all__ = [
     "identification_errors",
     "child_seeds",
     "run_tasks",
-    "AttackSpec",
-    "log_grid",
-    "gaussian_attack_errors",
-    "sweep_gaussian_attack",
 ]

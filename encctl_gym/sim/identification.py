@@ -5,22 +5,7 @@ Kept as an import path for one version; import from :mod:`encctl_gym.ident` inst
 
 from __future__ import annotations
 
-from ..ident.least_squares import (
-    GRAM_COND_LIMIT,
-    RecursiveLeastSquares,
-    check_sample_sizes,
-    data_matrices,
-    identification_errors,
-    least_squares,
-    prefix_estimates,
-)
+from ..ident import least_squares
+from ..ident.least_squares import *  # noqa: F403
 
-__all__ = [
-    "data_matrices",
-    "least_squares",
-    "RecursiveLeastSquares",
-    "check_sample_sizes",
-    "identification_errors",
-    "prefix_estimates",
-    "GRAM_COND_LIMIT",
-]
+__all__ = list(least_squares.__all__)

@@ -5,6 +5,8 @@ Kept as an import path for one version; import from :mod:`encctl_gym.parallel` i
 
 from __future__ import annotations
 
-from ..parallel import CONNECT_TIMEOUT, child_seeds, run_tasks
+from .. import parallel
+from ..parallel import *  # noqa: F403
+from ..parallel import CONNECT_TIMEOUT  # noqa: F401  (a constant tests set)
 
-__all__ = ["child_seeds", "run_tasks", "CONNECT_TIMEOUT"]
+__all__ = list(parallel.__all__)

@@ -21,7 +21,7 @@ state, the noise and the input, so
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Union
+from typing import Any
 
 import numpy as np
 
@@ -100,35 +100,11 @@ class LinearPlant:
         )
 
     def initial_state(self, rng: np.random.Generator, size: Size = None) -> np.ndarray:
-        """Draw ``x_0 ~ N(0, sigma_x2 I)`` (eq:system).
-
-        Parameters
-        ----------
-        rng
-            The generator to draw from.
-        size
-            Leading batch shape; ``None`` gives one state of shape ``(n,)``.
-
-        Returns
-        -------
-        numpy.ndarray, shape (*size, n)
-        """
+        """Draw ``x_0 ~ N(0, sigma_x2 I)`` (eq:system): shape ``(*size, n)``, one state for ``size=None``."""
         return self._sx * rng.standard_normal((*_size_tuple(size), self.n))
 
     def noise(self, rng: np.random.Generator, size: Size = None) -> np.ndarray:
-        """Draw process noise ``w_t ~ N(0, sigma_w2 I)`` (eq:system).
-
-        Parameters
-        ----------
-        rng
-            The generator to draw from.
-        size
-            Leading batch shape; ``None`` gives one vector of shape ``(n,)``.
-
-        Returns
-        -------
-        numpy.ndarray, shape (*size, n)
-        """
+        """Draw process noise ``w_t ~ N(0, sigma_w2 I)`` (eq:system): shape ``(*size, n)``, as :meth:`initial_state`."""
         return self._sw * rng.standard_normal((*_size_tuple(size), self.n))
 
     def next_state(self, x: np.ndarray, u: np.ndarray, w: np.ndarray) -> np.ndarray:
