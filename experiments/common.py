@@ -144,6 +144,7 @@ class Table:
         err = t.columns["error"][order].reshape(runs.size, grid.size)
         first = order[: grid.size]
         return {
+            "panel": label,
             "N": grid,
             "errors": err,
             "mean": err.mean(axis=0),
@@ -224,6 +225,53 @@ def plot_panel(ax: Any, s: dict[str, Any], title: str, *, bound: bool = False) -
         ax.loglog(N, s["bound"], ":", color="k", lw=1.6, label=r"$\bar\gamma(N)$ (eq:bound)")
     ax.set_title(title, fontsize=9)
     ax.grid(True, which="major", alpha=0.3)
+
+
+def panel_table(figure: str, panel: str, spec: Any, grid: np.ndarray, errors: np.ndarray, *, bound: bool = False) -> "Table":
+    """The rows of one panel of Figure 1 or 2: the errors of its runs with ``gamma(N)`` of eq:sic2,
+    ``psi_u`` (the scalar of ``Psi_u = psi_u I`` computed from ``(A, B)``) and, with ``bound``,
+    the upper bound eq:bound ``(m+n) / ((N-1) m R_sigma)``."""
+    from encctl_gym.security.complexity import input_upper_bound, sample_identifying_complexity_asymptotic
+    from encctl_gym.security.gramians import controllability_gramian
+
+    n, m = spec.B.shape
+    r_sigma = spec.sigma_u2 / spec.sigma_w2
+    gamma = sample_identifying_complexity_asymptotic(grid, spec.A, spec.B, r_sigma=r_sigma)
+    psi_u = float(np.trace(controllability_gramian(spec.A, spec.B))) / n
+    extra = {"bound": input_upper_bound(grid, m, n, r_sigma)} if bound else {}
+    return Table.from_errors(
+        figure=figure, panel=panel, grid=grid, errors=errors, gamma=gamma,
+        sigma_w2=spec.sigma_w2, sigma_u2=spec.sigma_u2, psi_u=psi_u, **extra,
+    )
+
+
+def panel_figure(
+    table: "Table", panels: Sequence[str], shape: tuple[int, int], figsize: tuple[float, float], title: Callable[[dict[str, Any]], str],
+    suptitle: str, path: str | Path, *, bound: bool = False, rect: tuple[float, float, float, float] = (0, 0.05, 1, 0.95),
+) -> Path:
+    """A grid of :func:`plot_panel` panels, one per label of ``panels`` (``title(summary)`` each),
+    with a shared legend below and ``suptitle`` above, saved as a PNG at ``path``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(*shape, figsize=figsize, sharex=True, sharey=True)
+    for ax, letter in zip(axes.ravel(), panels):
+        s = table.summary(letter)
+        plot_panel(ax, s, title(s), bound=bound)
+    for ax in axes[-1]:
+        ax.set_xlabel("sample size $N$")
+    for ax in axes[:, 0]:
+        ax.set_ylabel(r"estimation error $\epsilon(N)$")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(labels), frameon=False)
+    fig.suptitle(suptitle, fontsize=10)
+    fig.tight_layout(rect=rect)
+    path = Path(path)
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    return path
 
 
 def run_figure(args: argparse.Namespace, compute: Callable[..., "Table"], plot: Callable[..., Path], stem: str, label: str) -> int:

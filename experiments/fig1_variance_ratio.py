@@ -25,11 +25,8 @@ from typing import Any, Sequence
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import numpy as np
 
 from encctl_gym.presets import get_preset
-from encctl_gym.security.complexity import sample_identifying_complexity_asymptotic
-from encctl_gym.security.gramians import controllability_gramian
 from encctl_gym.sim.montecarlo import AttackSpec, sweep_gaussian_attack
 from experiments.common import (
     FULL,
@@ -37,7 +34,8 @@ from experiments.common import (
     Table,
     add_common_arguments,
     figure_seed,
-    plot_panel,
+    panel_figure,
+    panel_table,
     run_figure,
     script_main,
 )
@@ -94,16 +92,7 @@ def compute(
         [spec for _, spec in systems], sample_sizes=grid, runs=config.runs, seed=figure_seed(seed, 1),
         n_jobs=n_jobs, scheduler=scheduler, progress=progress, desc="Figure 1",
     )
-    parts = []
-    for (letter, spec), errors in zip(systems, errors_all):
-        r_sigma = spec.sigma_u2 / spec.sigma_w2
-        gamma = sample_identifying_complexity_asymptotic(grid, spec.A, spec.B, r_sigma=r_sigma)
-        psi_u = float(np.trace(controllability_gramian(spec.A, spec.B))) / spec.A.shape[0]
-        parts.append(Table.from_errors(
-            figure=FIGURE, panel=letter, grid=grid, errors=errors, gamma=gamma,
-            sigma_w2=spec.sigma_w2, sigma_u2=spec.sigma_u2, psi_u=psi_u,
-        ))
-    return Table.concat(parts)
+    return Table.concat([panel_table(FIGURE, letter, spec, grid, errors) for (letter, spec), errors in zip(systems, errors_all)])
 
 
 def plot(table: Table, path: str | Path) -> Path:
@@ -120,33 +109,14 @@ def plot(table: Table, path: str | Path) -> Path:
     -------
     pathlib.Path
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(3, 3, figsize=(11, 9.5), sharex=True, sharey=True)
-    for ax, letter in zip(axes.ravel(), PANELS):
-        s = table.summary(letter)
-        plot_panel(ax, s, f"({letter}) $R_\\sigma={s['r_sigma']:g}$, $\\sigma_w^2={s['sigma_w2']:g}$, "
-                          f"$\\sigma_u^2={s['sigma_u2']:g}$")
-    for ax in axes[-1]:
-        ax.set_xlabel("sample size $N$")
-    for ax in axes[:, 0]:
-        ax.set_ylabel(r"estimation error $\epsilon(N)$")
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=3, frameon=False)
     runs = int(table.columns["run"].max()) + 1
-    fig.suptitle(
+    return panel_figure(
+        table, PANELS, (3, 3), (11, 9.5),
+        lambda s: f"({s['panel']}) $R_\\sigma={s['r_sigma']:g}$, $\\sigma_w^2={s['sigma_w2']:g}$, $\\sigma_u^2={s['sigma_u2']:g}$",
         "Figure 1: estimation error vs. sample identifying complexity "
         f"($A=0.7071I$, $B=I$, $\\Psi_w\\approx\\Psi_u\\approx 2I$, $n=m=4$, $\\sigma_x^2=1$, {runs} runs per $N$)",
-        fontsize=10,
+        path, rect=(0, 0.04, 1, 0.97),
     )
-    fig.tight_layout(rect=(0, 0.04, 1, 0.97))
-    path = Path(path)
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    return path
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

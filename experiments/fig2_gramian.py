@@ -25,11 +25,8 @@ from typing import Any, Sequence
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import numpy as np
 
 from encctl_gym.presets import get_preset
-from encctl_gym.security.complexity import input_upper_bound, sample_identifying_complexity_asymptotic
-from encctl_gym.security.gramians import controllability_gramian
 from encctl_gym.sim.montecarlo import AttackSpec, sweep_gaussian_attack
 from experiments.common import (
     FULL,
@@ -37,7 +34,8 @@ from experiments.common import (
     Table,
     add_common_arguments,
     figure_seed,
-    plot_panel,
+    panel_figure,
+    panel_table,
     run_figure,
     script_main,
 )
@@ -97,18 +95,9 @@ def compute(
         [spec for _, _, spec in systems], sample_sizes=grid, runs=config.runs, seed=figure_seed(seed, 2),
         n_jobs=n_jobs, scheduler=scheduler, progress=progress, desc="Figure 2",
     )
-    parts = []
-    for (letter, _, spec), errors in zip(systems, errors_all):
-        n, m = spec.B.shape
-        r_sigma = spec.sigma_u2 / spec.sigma_w2
-        gamma = sample_identifying_complexity_asymptotic(grid, spec.A, spec.B, r_sigma=r_sigma)
-        bound = input_upper_bound(grid, m, n, r_sigma)
-        psi_u = float(np.trace(controllability_gramian(spec.A, spec.B))) / n
-        parts.append(Table.from_errors(
-            figure=FIGURE, panel=letter, grid=grid, errors=errors, gamma=gamma, bound=bound,
-            sigma_w2=spec.sigma_w2, sigma_u2=spec.sigma_u2, psi_u=psi_u,
-        ))
-    return Table.concat(parts)
+    return Table.concat(
+        [panel_table(FIGURE, letter, spec, grid, errors, bound=True) for (letter, _, spec), errors in zip(systems, errors_all)]
+    )
 
 
 def plot(table: Table, path: str | Path) -> Path:
@@ -125,35 +114,16 @@ def plot(table: Table, path: str | Path) -> Path:
     -------
     pathlib.Path
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(2, 3, figsize=(11, 7), sharex=True, sharey=True)
-    for ax, letter in zip(axes.ravel(), PANELS):
-        s = table.summary(letter)
-        plot_panel(ax, s, f"({letter}) $\\Psi_u = {s['psi_u']:.3g}I$", bound=True)
-    for ax in axes[-1]:
-        ax.set_xlabel("sample size $N$")
-    for ax in axes[:, 0]:
-        ax.set_ylabel(r"estimation error $\epsilon(N)$")
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=4, frameon=False)
     s0 = table.summary(PANELS[0])
     runs = s0["errors"].shape[0]
-    fig.suptitle(
+    return panel_figure(
+        table, PANELS, (2, 3), (11, 7), lambda s: f"({s['panel']}) $\\Psi_u = {s['psi_u']:.3g}I$",
         "Figure 2: varying $\\Psi_u$ with $\\Psi_w = 2I$, $R_\\sigma = 100$ "
         f"($\\sigma_w^2={s0['sigma_w2']:g}$, $\\sigma_u^2={s0['sigma_u2']:g}$, {runs} runs per $N$)\n"
         "realised by $A = I/\\sqrt{2}$, $B = bI$, $b = \\sqrt{\\psi_u(1-1/2)}$, "
         "i.e. $\\Psi_u = b^2/(1-a^2)\\,I$",
-        fontsize=10,
+        path, bound=True,
     )
-    fig.tight_layout(rect=(0, 0.05, 1, 0.95))
-    path = Path(path)
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    return path
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
