@@ -227,11 +227,45 @@ def plot_panel(ax: Any, s: dict[str, Any], title: str, *, bound: bool = False) -
     ax.grid(True, which="major", alpha=0.3)
 
 
+def preset_spec(name: str) -> Any:
+    """The :class:`~encctl_gym.sim.montecarlo.AttackSpec` of a preset of :mod:`encctl_gym.presets`."""
+    from encctl_gym.presets import get_preset
+    from encctl_gym.sim.montecarlo import AttackSpec
+
+    p = get_preset(name)
+    return AttackSpec(p.A, p.B, sigma_w2=p.sigma_w2, sigma_u2=p.sigma_u2, sigma_x2=p.sigma_x2)
+
+
+def figure_table(
+    figure: str, number: int, panels: Sequence[tuple[str, Any]], config: GridConfig, *, seed: int, n_jobs: int,
+    scheduler: Any, progress: bool, bound: bool = False,
+) -> "Table":
+    """The data of one of the paper's figures: for each ``(letter, spec)`` of ``panels``,
+    ``config.runs`` Gaussian attacks identified on the grid of N (Definition def:error), with
+    ``gamma(N)`` of eq:sic2 and, with ``bound``, eq:bound (:func:`panel_table`).
+
+    The figure uses child ``number`` of ``SeedSequence(seed)`` (:func:`figure_seed`) and panel
+    ``k`` its child ``k``, so a panel depends neither on the others nor on the workers
+    (``n_jobs``, ``scheduler``: :func:`encctl_gym.parallel.run_tasks`).
+    """
+    from encctl_gym.sim.montecarlo import sweep_gaussian_attack
+
+    grid = config.grid(4, 4)
+    errors_all = sweep_gaussian_attack(
+        [spec for _, spec in panels], sample_sizes=grid, runs=config.runs, seed=figure_seed(seed, number),
+        n_jobs=n_jobs, scheduler=scheduler, progress=progress, desc=f"Figure {number}",
+    )
+    return Table.concat([panel_table(figure, letter, spec, grid, errors, bound=bound) for (letter, spec), errors in zip(panels, errors_all)])
+
+
 def panel_table(figure: str, panel: str, spec: Any, grid: np.ndarray, errors: np.ndarray, *, bound: bool = False) -> "Table":
     """The rows of one panel of Figure 1 or 2: the errors of its runs with ``gamma(N)`` of eq:sic2,
     ``psi_u`` (the scalar of ``Psi_u = psi_u I`` computed from ``(A, B)``) and, with ``bound``,
     the upper bound eq:bound ``(m+n) / ((N-1) m R_sigma)``."""
-    from encctl_gym.security.complexity import input_upper_bound, sample_identifying_complexity_asymptotic
+    from encctl_gym.security.complexity import (
+        input_upper_bound,
+        sample_identifying_complexity_asymptotic,
+    )
     from encctl_gym.security.gramians import controllability_gramian
 
     n, m = spec.B.shape

@@ -26,16 +26,15 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 
-from encctl_gym.presets import get_preset
-from encctl_gym.sim.montecarlo import AttackSpec, sweep_gaussian_attack
+from encctl_gym.sim.montecarlo import AttackSpec
 from experiments.common import (
     FULL,
     GridConfig,
     Table,
     add_common_arguments,
-    figure_seed,
+    figure_table,
     panel_figure,
-    panel_table,
+    preset_spec,
     run_figure,
     script_main,
 )
@@ -48,51 +47,18 @@ PANELS = tuple("abcdefghi")
 
 
 def panel_systems() -> list[tuple[str, AttackSpec]]:
-    """The nine systems of Figure 1, ``(letter, spec)`` in the paper's panel order.
-
-    Returns
-    -------
-    list of (str, AttackSpec)
-        From the presets ``fig1-a`` ... ``fig1-i`` of :mod:`encctl_gym.presets`.
-    """
-    out = []
-    for letter in PANELS:
-        p = get_preset(f"fig1-{letter}")
-        out.append((letter, AttackSpec(p.A, p.B, sigma_w2=p.sigma_w2, sigma_u2=p.sigma_u2, sigma_x2=p.sigma_x2)))
-    return out
+    """The nine systems of Figure 1, ``(letter, spec)`` in the paper's panel order (the presets
+    ``fig1-a`` ... ``fig1-i`` of :mod:`encctl_gym.presets`)."""
+    return [(letter, preset_spec(f"fig1-{letter}")) for letter in PANELS]
 
 
 def compute(
-    config: GridConfig = FULL,
-    *,
-    seed: int = 0,
-    n_jobs: int = -1,
-    scheduler: Any = None,
-    progress: bool = False,
+    config: GridConfig = FULL, *, seed: int = 0, n_jobs: int = -1, scheduler: Any = None, progress: bool = False
 ) -> Table:
-    """The data of Figure 1: errors (Definition def:error) and ``gamma(N)`` (eq:sic2).
-
-    Parameters
-    ----------
-    config
-        Grid of sample sizes and number of runs (:data:`experiments.common.FULL` is the paper's).
-    seed
-        Master seed; the figure uses child 1 of ``SeedSequence(seed)`` and panel ``k`` its child
-        ``k``, so a panel does not depend on the others or on the workers.
-    n_jobs, scheduler, progress
-        Parallel execution (see :func:`encctl_gym.parallel.run_tasks`).
-    Returns
-    -------
-    Table
-        One row per (panel, N, run), ``bound`` empty.
-    """
-    systems = panel_systems()
-    grid = config.grid(4, 4)
-    errors_all = sweep_gaussian_attack(
-        [spec for _, spec in systems], sample_sizes=grid, runs=config.runs, seed=figure_seed(seed, 1),
-        n_jobs=n_jobs, scheduler=scheduler, progress=progress, desc="Figure 1",
-    )
-    return Table.concat([panel_table(FIGURE, letter, spec, grid, errors) for (letter, spec), errors in zip(systems, errors_all)])
+    """The data of Figure 1: errors (Definition def:error) and ``gamma(N)`` (eq:sic2), one row per
+    (panel, N, run), ``bound`` empty; child 1 of ``SeedSequence(seed)`` (see
+    :func:`experiments.common.figure_table`)."""
+    return figure_table(FIGURE, 1, panel_systems(), config, seed=seed, n_jobs=n_jobs, scheduler=scheduler, progress=progress)
 
 
 def plot(table: Table, path: str | Path) -> Path:

@@ -26,16 +26,15 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 
-from encctl_gym.presets import get_preset
-from encctl_gym.sim.montecarlo import AttackSpec, sweep_gaussian_attack
+from encctl_gym.sim.montecarlo import AttackSpec
 from experiments.common import (
     FULL,
     GridConfig,
     Table,
     add_common_arguments,
-    figure_seed,
+    figure_table,
     panel_figure,
-    panel_table,
+    preset_spec,
     run_figure,
     script_main,
 )
@@ -49,55 +48,20 @@ PANELS = tuple("abcdef")
 
 
 def panel_systems() -> list[tuple[str, float, AttackSpec]]:
-    """The six systems of Figure 2: ``(letter, psi_u, spec)``.
-
-    Returns
-    -------
-    list of (str, float, AttackSpec)
-        ``A = I / sqrt(2)``, ``B = sqrt(psi_u / 2) I``, ``sigma_w2 = 0.1``, ``sigma_u2 = 10``
-        (presets ``fig2-psi<v>`` of :mod:`encctl_gym.presets`).
-    """
-    out = []
-    for letter, psi in zip(PANELS, PSI_U):
-        p = get_preset(f"fig2-psi{psi:g}")
-        out.append((letter, psi, AttackSpec(p.A, p.B, sigma_w2=p.sigma_w2, sigma_u2=p.sigma_u2, sigma_x2=p.sigma_x2)))
-    return out
+    """The six systems of Figure 2, ``(letter, psi_u, spec)``: ``A = I / sqrt(2)``,
+    ``B = sqrt(psi_u / 2) I``, ``sigma_w2 = 0.1``, ``sigma_u2 = 10`` (the presets ``fig2-psi<v>``
+    of :mod:`encctl_gym.presets`)."""
+    return [(letter, psi, preset_spec(f"fig2-psi{psi:g}")) for letter, psi in zip(PANELS, PSI_U)]
 
 
 def compute(
-    config: GridConfig = FULL,
-    *,
-    seed: int = 0,
-    n_jobs: int = -1,
-    scheduler: Any = None,
-    progress: bool = False,
+    config: GridConfig = FULL, *, seed: int = 0, n_jobs: int = -1, scheduler: Any = None, progress: bool = False
 ) -> Table:
-    """The data of Figure 2: errors (Definition def:error), ``gamma(N)`` (eq:sic2), bound (eq:bound).
-
-    Parameters
-    ----------
-    config
-        Grid of sample sizes and number of runs (:data:`experiments.common.FULL` is the paper's).
-    seed
-        Master seed; the figure uses child 2 of ``SeedSequence(seed)``, panel ``k`` its child ``k``.
-    n_jobs, scheduler, progress
-        Parallel execution (see :func:`encctl_gym.parallel.run_tasks`).
-
-    Returns
-    -------
-    Table
-        One row per (panel, N, run); ``psi_u`` is the scalar of ``Psi_u = psi_u I`` computed
-        from ``(A, B)`` by :func:`encctl_gym.security.gramians.controllability_gramian`.
-    """
-    systems = panel_systems()
-    grid = config.grid(4, 4)
-    errors_all = sweep_gaussian_attack(
-        [spec for _, _, spec in systems], sample_sizes=grid, runs=config.runs, seed=figure_seed(seed, 2),
-        n_jobs=n_jobs, scheduler=scheduler, progress=progress, desc="Figure 2",
-    )
-    return Table.concat(
-        [panel_table(FIGURE, letter, spec, grid, errors, bound=True) for (letter, _, spec), errors in zip(systems, errors_all)]
-    )
+    """The data of Figure 2: errors (Definition def:error), ``gamma(N)`` (eq:sic2) and the bound
+    (eq:bound), one row per (panel, N, run); ``psi_u`` is computed from ``(A, B)``. Child 2 of
+    ``SeedSequence(seed)`` (see :func:`experiments.common.figure_table`)."""
+    panels = [(letter, spec) for letter, _, spec in panel_systems()]
+    return figure_table(FIGURE, 2, panels, config, seed=seed, n_jobs=n_jobs, scheduler=scheduler, progress=progress, bound=True)
 
 
 def plot(table: Table, path: str | Path) -> Path:
