@@ -14,6 +14,9 @@ Systems Against Eavesdropper and Malicious Server" (arXiv 2303.13059).
 from __future__ import annotations
 
 from .errors import (
+    BreakerError,
+    BreakerLimitError,
+    BreakerTimeoutError,
     BudgetError,
     CiphertextError,
     ConfigError,
@@ -21,6 +24,7 @@ from .errors import (
     EncodingOverflowError,
     GroupError,
     KeyMismatchError,
+    OptionalDependencyError,
     ParameterError,
     PlaintextError,
     ShapeError,
@@ -44,6 +48,10 @@ __all__ = [
     "SolverError",
     "BudgetError",
     "ConfigError",
+    "BreakerError",
+    "BreakerLimitError",
+    "BreakerTimeoutError",
+    "OptionalDependencyError",
 ]
 
 

@@ -21,6 +21,10 @@ __all__ = [
     "SolverError",
     "BudgetError",
     "ConfigError",
+    "BreakerError",
+    "BreakerLimitError",
+    "BreakerTimeoutError",
+    "OptionalDependencyError",
 ]
 
 
@@ -70,3 +74,21 @@ class BudgetError(ParameterError):
 
 class ConfigError(ParameterError):
     """A configuration or system file cannot be read or has invalid content."""
+
+
+class BreakerError(SolverError):
+    """A key breaker (:mod:`encctl_gym.cryptanalysis`) failed: no logarithm found, or a recovered
+    exponent failed the check g^s = h (a breaker never returns an unchecked key)."""
+
+
+class BreakerLimitError(ParameterError):
+    """A group is too large for a breaker; refused before any work, naming the limit and the
+    expected time."""
+
+
+class BreakerTimeoutError(BreakerError, TimeoutError):
+    """A breaker call ran past its time limit and was stopped."""
+
+
+class OptionalDependencyError(ConfigError, ImportError):
+    """An optional dependency is not installed; the message names the extra that provides it."""
