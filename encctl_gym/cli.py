@@ -33,6 +33,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "experiments.attackers_vs_bounds",
         "the headline experiment: every attacker against gamma(N) and gamma_opt(N)",
     ),
+    "crack": (
+        "encctl_gym.cryptanalysis.cli",
+        "break N keys of one dynamic-key sequence with a real discrete-logarithm attack and time each key",
+    ),
 }
 
 

@@ -27,6 +27,7 @@ STEPS = (
     ("fig1", "experiments.fig1_variance_ratio"),
     ("fig2", "experiments.fig2_gramian"),
     ("design", "experiments.design_example"),
+    ("deciphering", "experiments.deciphering_time"),
 )
 
 

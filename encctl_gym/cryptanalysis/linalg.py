@@ -72,7 +72,8 @@ def solve_mod_prime(
     for i, (row, r) in enumerate(zip(rows, rhs)):
         base = i * width
         for j, c in row.items():
-            entries[base + pos[j]] = c % q
+            if c % q:
+                entries[base + pos[j]] = c % q
         entries[base + width - 1] = r % q
     if q < _WORD:
         mat = flint.nmod_mat(len(rows), width, entries, q)
