@@ -79,8 +79,8 @@ def bench(sizes: list[int], keys: int) -> None:
             report = break_sequence(get_breaker(name, rng=2, **kwargs), grp, hs,
                                     tokens=tokens if name == "token-chain" else None)
             assert report.secrets == secrets
-            t = report.key_seconds
-            first, later = report.precomputation.seconds + t[0], float(t[1:].mean())
+            t = report.key_seconds("cpu")
+            first, later = report.precomputation.cpu_seconds + t[0], float(t[1:].mean())
             if ref is None:
                 ref = (first, later)
             print(f"{bits:>5} {name:<15} {first:12.4g} {later:12.4g} {first / ref[0]:12.3g} {later / ref[1]:10.3g}")

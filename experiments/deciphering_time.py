@@ -16,7 +16,7 @@ The sizes run (:data:`FULL_PLAN`) go from 32 bits to where each breaker's cost o
 (2 cores, about ten minutes in all) stops it: the generic breakers (bsgs, rho, rho-multi) near
 48 bits, PARI and the index calculus at 96 bits. Each (breaker, size) is one task of
 :func:`encctl_gym.parallel.run_tasks` (joblib processes; PARI needs a process's main thread, so
-not Dask). Wall times are of this machine and are not reproducible elsewhere; the keys are
+not Dask). Times are of this machine and are not reproducible elsewhere; the keys are
 (seeded groups and sequences, every key checked g^s = h and against the true secret).
 
 CSV ``deciphering_time.csv``, one row per measurement, columns:
@@ -29,16 +29,23 @@ kind          ``sequence`` (N keys of one dynamic-key sequence) or ``fresh`` (on
               group: a T_first sample)
 group         0 for the sequence's group, 1, 2, ... for the fresh groups
 N             number of keys broken so far (1 for ``fresh``)
-tau           seconds to break those N keys, precomputation included: ``T_pre + t_1 + ... + t_N``
-precompute    seconds of the precomputation (once per group)
-key_seconds   seconds of the N-th key alone
+tau           CPU seconds to break those N keys, precomputation included:
+              ``T_pre + t_1 + ... + t_N``
+precompute    CPU seconds of the precomputation (once per group)
+key_seconds   CPU seconds of the N-th key alone
+tau_wall      ``tau`` in wall-clock seconds (``precompute_wall``, ``key_wall`` likewise)
 operations    the N-th key's operation counts, ``name=value`` separated by ``;``
 p             the group's p in hexadecimal
 ============  ==============================================================================
 
-CSV ``deciphering_time_fit.csv``, one row per (breaker, bits): ``T_first`` (mean over the fresh
-groups), ``T_0``, ``T_1`` (the fit), ``ratio`` (``T_1 / T_first``), ``N_max``, ``precompute``
-(the sequence group's), ``fresh`` (number of fresh groups).
+Times are the CPU time of the process that breaks the keys (``time.process_time``), because
+the machine is shared with other jobs whose load inflates wall-clock times; the wall-clock
+columns are kept beside them (they agree on an idle machine).
+
+CSV ``deciphering_time_fit.csv``, one row per (breaker, bits), from the CPU times: ``T_first``
+(mean over the fresh groups), ``T_0``, ``T_1`` (the fit), ``ratio`` (``T_1 / T_first``),
+``N_max``, ``precompute`` (the sequence group's), ``fresh`` (number of fresh groups), and
+``T_first_wall``, ``T_1_wall``, ``ratio_wall`` from the wall-clock times.
 
 Usage: ``python experiments/deciphering_time.py [--quick] [--out DIR] [--seed S] [--n-jobs J]``
 (also ``encctl-gym reproduce --only deciphering``).
@@ -87,9 +94,11 @@ __all__ = [
 ]
 
 #: Columns of ``deciphering_time.csv`` (see the module docstring).
-COLUMNS = ("breaker", "bits", "kind", "group", "N", "tau", "precompute", "key_seconds", "operations", "p")
+COLUMNS = ("breaker", "bits", "kind", "group", "N", "tau", "precompute", "key_seconds",
+           "tau_wall", "precompute_wall", "key_wall", "operations", "p")
 #: Columns of ``deciphering_time_fit.csv``.
-FIT_COLUMNS = ("breaker", "bits", "T_first", "T_0", "T_1", "ratio", "N_max", "precompute", "fresh")
+FIT_COLUMNS = ("breaker", "bits", "T_first", "T_0", "T_1", "ratio", "N_max", "precompute", "fresh",
+               "T_first_wall", "T_1_wall", "ratio_wall")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -145,6 +154,19 @@ def _breaker(name: str, rng: arith.RandomSource) -> Any:
     return get_breaker(name, inner="index-calculus", rng=rng) if name == "token-chain" else get_breaker(name, rng=rng)
 
 
+def _rows(plan: Plan, kind: str, index: int, report: Any, grid: Sequence[int]) -> list[dict[str, Any]]:
+    tau, tau_wall = report.tau("cpu"), report.tau("wall")
+    pre = report.precomputation
+    rows = []
+    for n in grid:
+        cost = report.keys[n - 1].cost
+        rows.append({"breaker": plan.breaker, "bits": plan.bits, "kind": kind, "group": index, "N": n,
+                     "tau": float(tau[n - 1]), "precompute": pre.cpu_seconds, "key_seconds": cost.cpu_seconds,
+                     "tau_wall": float(tau_wall[n - 1]), "precompute_wall": pre.seconds, "key_wall": cost.seconds,
+                     "operations": _ops(cost.operations), "p": hex(report.group.p)})
+    return rows
+
+
 def measure(plan: Plan, seed: np.random.SeedSequence) -> list[dict[str, Any]]:
     """Run one plan: break ``plan.keys`` keys of one sequence, and one key on each fresh group.
 
@@ -159,23 +181,14 @@ def measure(plan: Plan, seed: np.random.SeedSequence) -> list[dict[str, Any]]:
     report = break_sequence(breaker, group, hs, tokens=tokens if plan.breaker == "token-chain" else None)
     if report.secrets != secrets:  # never expected: every key is checked g^s = h
         raise BreakerError(f"{plan.breaker}: a recovered key differs from the sequence's secret key")
-    tau = report.tau()
-    rows = []
-    for n in n_grid(plan.keys):
-        key = report.keys[n - 1]
-        rows.append({"breaker": plan.breaker, "bits": plan.bits, "kind": "sequence", "group": 0, "N": n,
-                     "tau": float(tau[n - 1]), "precompute": report.precomputation.seconds,
-                     "key_seconds": key.cost.seconds, "operations": _ops(key.cost.operations), "p": hex(group.p)})
+    rows = _rows(plan, "sequence", 0, report, n_grid(plan.keys))
     for i in range(1, plan.fresh + 1):
         fresh = generate_safe_prime_group(plan.bits, rng=_rng(seed, 10 * i))
         (h,), (s,), _ = key_sequence(fresh, 1, _rng(seed, 10 * i + 1))
         one = break_sequence(_breaker(plan.breaker, _rng(seed, 10 * i + 2)), fresh, [h])
         if one.secrets != [s]:
             raise BreakerError(f"{plan.breaker}: a recovered key differs from the fresh group's secret key")
-        key = one.keys[0]
-        rows.append({"breaker": plan.breaker, "bits": plan.bits, "kind": "fresh", "group": i, "N": 1,
-                     "tau": float(one.tau()[0]), "precompute": one.precomputation.seconds,
-                     "key_seconds": key.cost.seconds, "operations": _ops(key.cost.operations), "p": hex(fresh.p)})
+        rows += _rows(plan, "fresh", i, one, [1])
     return rows
 
 
@@ -223,9 +236,21 @@ def _measure_task(task: tuple[Plan, np.random.SeedSequence], _: np.random.SeedSe
     return measure(*task)
 
 
+def _fit_one(seq: Sequence[dict[str, Any]], fresh: Sequence[dict[str, Any]], column: str) -> tuple[float, float, float]:
+    n = np.array([int(r["N"]) for r in seq], dtype=float)
+    tau = np.array([float(r[column]) for r in seq])
+    if n.size >= 2:
+        t1, t0 = np.polyfit(n, tau, 1)
+    else:
+        t0, t1 = (float(tau[0]) if tau.size else float("nan")), float("nan")
+    t_first = float(np.mean([float(r[column]) for r in fresh])) if fresh else (float(tau[0]) if tau.size else float("nan"))
+    return t_first, float(t0), float(t1)
+
+
 def fit(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     """Per (breaker, bits): ``T_first`` (mean of the fresh groups), the least-squares fit
-    ``tau(N) = T_0 + N T_1`` of the sequence, and ``T_1 / T_first``.
+    ``tau(N) = T_0 + N T_1`` of the sequence, and ``T_1 / T_first``; from the CPU times, and
+    (``*_wall``) from the wall-clock times.
 
     Returns
     -------
@@ -237,18 +262,15 @@ def fit(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     for breaker, bits in keys:
         mine = [r for r in rows if r["breaker"] == breaker and int(r["bits"]) == bits]
         seq = sorted((r for r in mine if r["kind"] == "sequence"), key=lambda r: int(r["N"]))
-        fresh = [float(r["tau"]) for r in mine if r["kind"] == "fresh"]
-        n = np.array([int(r["N"]) for r in seq], dtype=float)
-        tau = np.array([float(r["tau"]) for r in seq])
-        if n.size >= 2:
-            t1, t0 = np.polyfit(n, tau, 1)
-        else:
-            t0, t1 = float(tau[0]) if tau.size else float("nan"), float("nan")
-        t_first = float(np.mean(fresh)) if fresh else (float(tau[0]) if tau.size else float("nan"))
-        out.append({"breaker": breaker, "bits": bits, "T_first": t_first, "T_0": float(t0), "T_1": float(t1),
-                    "ratio": float(t1) / t_first if t_first > 0 else float("nan"),
-                    "N_max": int(n.max()) if n.size else 0,
-                    "precompute": float(seq[0]["precompute"]) if seq else float("nan"), "fresh": len(fresh)})
+        fresh = [r for r in mine if r["kind"] == "fresh"]
+        t_first, t0, t1 = _fit_one(seq, fresh, "tau")
+        w_first, _, w1 = _fit_one(seq, fresh, "tau_wall")
+        out.append({"breaker": breaker, "bits": bits, "T_first": t_first, "T_0": t0, "T_1": t1,
+                    "ratio": t1 / t_first if t_first > 0 else float("nan"),
+                    "N_max": max((int(r["N"]) for r in seq), default=0),
+                    "precompute": float(seq[0]["precompute"]) if seq else float("nan"), "fresh": len(fresh),
+                    "T_first_wall": w_first, "T_1_wall": w1,
+                    "ratio_wall": w1 / w_first if w_first > 0 else float("nan")})
     return out
 
 
@@ -268,7 +290,8 @@ def read_csv(path: str | Path) -> list[dict[str, Any]]:
     with Path(path).open(newline="") as fh:
         rows = list(csv.DictReader(fh))
     ints = {"bits", "group", "N", "N_max", "fresh"}
-    floats = {"tau", "precompute", "key_seconds", "T_first", "T_0", "T_1", "ratio"}
+    floats = {"tau", "precompute", "key_seconds", "tau_wall", "precompute_wall", "key_wall", "T_first", "T_0",
+              "T_1", "ratio", "T_first_wall", "T_1_wall", "ratio_wall"}
     for r in rows:
         for k in list(r):
             if k in ints:
@@ -306,7 +329,7 @@ def plot(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
             ax.loglog(n, n * t_first, "--", color=color, lw=0.9)
         ax.set_title(f"{breaker}: measured $\\tau(N)$ (solid) vs $N\\,T_{{first}}$ (dashed)", fontsize=9)
         ax.set_xlabel("keys broken $N$")
-        ax.set_ylabel("seconds")
+        ax.set_ylabel("CPU seconds")
         ax.grid(True, which="major", alpha=0.3)
         ax.legend(fontsize=7, ncol=2, frameon=False)
     ax = fig.add_subplot(grid[nrows - 1, :])

@@ -55,7 +55,7 @@ __all__ = [
 
 @dataclasses.dataclass(frozen=True)
 class Cost:
-    """Cost of one phase of an attack: wall time and operation counts.
+    """Cost of one phase of an attack: wall time, CPU time and operation counts.
 
     Attributes
     ----------
@@ -64,14 +64,19 @@ class Cost:
     operations : Mapping[str, int]
         Counts the algorithm defines, e.g. ``group_operations`` (multiplications in G),
         ``smoothness_tests``, ``relations``; empty where the algorithm reports none (PARI).
+    cpu_seconds : float
+        CPU time of this process during the phase (``time.process_time``): on a machine shared
+        with other jobs, the measure of the work that their load does not inflate.
     """
 
     seconds: float
     operations: Mapping[str, int] = dataclasses.field(default_factory=dict)
+    cpu_seconds: float = 0.0
 
     def to_dict(self) -> dict[str, Any]:
-        """A JSON-ready dict ``{"seconds": ..., "operations": {...}}``."""
-        return {"seconds": float(self.seconds), "operations": {k: int(v) for k, v in self.operations.items()}}
+        """A JSON-ready dict ``{"seconds": ..., "cpu_seconds": ..., "operations": {...}}``."""
+        return {"seconds": float(self.seconds), "cpu_seconds": float(self.cpu_seconds),
+                "operations": {k: int(v) for k, v in self.operations.items()}}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -122,11 +127,12 @@ class Deadline:
         Named in the error message (``"index-calculus precomputation"``).
     """
 
-    __slots__ = ("limit", "what", "start", "_end")
+    __slots__ = ("limit", "what", "start", "cpu_start", "_end")
 
     def __init__(self, time_limit: Optional[float], what: str) -> None:
         self.limit = None if time_limit is None else check_positive("time_limit", time_limit)
         self.what = what
+        self.cpu_start = time.process_time()
         self.start = time.perf_counter()
         self._end = math.inf if self.limit is None else self.start + self.limit
 
@@ -134,6 +140,10 @@ class Deadline:
     def remaining(self) -> float:
         """Seconds left (``inf`` without a limit)."""
         return self._end - time.perf_counter()
+
+    def cost(self, operations: Mapping[str, int]) -> Cost:
+        """The :class:`Cost` of the call so far: wall and CPU time since the start, ``operations``."""
+        return Cost(time.perf_counter() - self.start, dict(operations), time.process_time() - self.cpu_start)
 
     def check(self) -> None:
         """Raise :class:`~encctl_gym.errors.BreakerTimeoutError` if the limit has passed."""
@@ -249,9 +259,9 @@ class Precomputation:
         deadline = Deadline(_check_time_limit(time_limit), f"{self.breaker}: breaking h = {h:#x}")
         s, ops, method = self._solve(h, deadline, src)
         s = verify_exponent(self.group, h, s, self.breaker)
-        seconds = time.perf_counter() - deadline.start
+        cost = deadline.cost(ops)
         self.keys_broken += 1
-        return RecoveredKey(h, s, Cost(seconds, dict(ops)), method or self.breaker)
+        return RecoveredKey(h, s, cost, method or self.breaker)
 
     @abc.abstractmethod
     def _solve(self, h: int, deadline: Deadline, src: RandomSource) -> tuple[int, Mapping[str, int], str]:
@@ -345,7 +355,7 @@ class Breaker(abc.ABC):
         self._check_thread()
         deadline = Deadline(_check_time_limit(time_limit), f"{self.name} precomputation")
         pre, ops = self._precompute(group, deadline)
-        pre.cost = Cost(time.perf_counter() - deadline.start, dict(ops))
+        pre.cost = deadline.cost(ops)
         return pre
 
     @abc.abstractmethod

@@ -11,8 +11,8 @@ shipped, or ``shipped``) or a fresh one from ``generate_safe_prime_group(bits, r
 (``fresh``, or ``auto`` for sizes not shipped). The keys are one dynamic-key sequence of
 Example ex:dyn_elgamal: KeyGen, then KeyUpd N - 1 times (seeded, so reproducible and unsafe for
 deployment; the tokens go to the ``token-chain`` breaker only). The breaker's precomputation
-runs once; the table lists each key's wall time and operation counts, then ``T_first``
-(precomputation + first key), the mean time of a later key and their ratio. Every recovered key
+runs once; the table lists each key's wall time, CPU time and operation counts, then
+``T_first`` (precomputation + first key), the mean wall time of a later key and their ratio. Every recovered key
 is checked (g^s = h) and compared with the sequence's secret key.
 
 With ``--scheduler`` (``local`` starts a Dask ``LocalCluster``; needs ``encctl-gym[dask]``) the
@@ -114,7 +114,7 @@ def _ops(ops: dict[str, int]) -> str:
 
 def summary(report: BreakReport) -> dict[str, float]:
     """``T_first`` (precomputation + first key), the mean later key, their ratio, the total."""
-    t = report.key_seconds
+    t = report.key_seconds()
     first = report.precomputation.seconds + float(t[0])
     later = float(t[1:].mean()) if t.size > 1 else float("nan")
     return {"T_first": first, "mean_later_key": later, "ratio": later / first if first > 0 else float("nan"),
@@ -153,9 +153,10 @@ def run(args: argparse.Namespace) -> int:
           f"{n} keys of one dynamic-key sequence")
     pre = report.precomputation
     print(f"precomputation: {format_seconds(pre.seconds)}  ({_ops(dict(pre.operations))})")
-    print(f"{'t':>5}  {'seconds':>12}  {'method':<15} operations")
+    print(f"{'t':>5}  {'seconds':>12}  {'cpu seconds':>12}  {'method':<15} operations")
     for i, key in enumerate(report.keys):
-        print(f"{i:>5}  {key.cost.seconds:12.6f}  {key.method:<15} {_ops(dict(key.cost.operations))}")
+        print(f"{i:>5}  {key.cost.seconds:12.6f}  {key.cost.cpu_seconds:12.6f}  {key.method:<15} "
+              f"{_ops(dict(key.cost.operations))}")
     later = "n/a" if n == 1 else format_seconds(stats["mean_later_key"])
     print(f"T_first = {format_seconds(stats['T_first'])} (precomputation + key 0), mean later key = {later}, "
           f"T_1 / T_first = {stats['ratio']:.3g}, total = {format_seconds(stats['total'])}")

@@ -57,15 +57,16 @@ class BreakReport:
         """The recovered exponents s_1, ..., s_N."""
         return [k.s for k in self.keys]
 
-    @property
-    def key_seconds(self) -> np.ndarray:
-        """Per-key wall times t_1, ..., t_N (precomputation excluded)."""
-        return np.array([k.cost.seconds for k in self.keys], dtype=float)
+    def key_seconds(self, clock: str = "wall") -> np.ndarray:
+        """Per-key times t_1, ..., t_N (precomputation excluded): ``clock="wall"`` (default) or
+        ``"cpu"`` (this process's CPU time, see :class:`~.base.Cost`)."""
+        attr = _clock(clock)
+        return np.array([getattr(k.cost, attr) for k in self.keys], dtype=float)
 
-    def tau(self) -> np.ndarray:
+    def tau(self, clock: str = "wall") -> np.ndarray:
         """The measured deciphering time of the first N keys, ``T_pre + t_1 + ... + t_N``, for
-        N = 1, ..., len(keys)."""
-        return self.precomputation.seconds + np.cumsum(self.key_seconds)
+        N = 1, ..., len(keys) (``clock`` as in :meth:`key_seconds`)."""
+        return getattr(self.precomputation, _clock(clock)) + np.cumsum(self.key_seconds(clock))
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: group, breaker, precomputation cost and per-key records (exponents in hex)."""
@@ -79,6 +80,12 @@ class BreakReport:
             ],
             "total_seconds": float(self.tau()[-1]) if self.keys else self.precomputation.seconds,
         }
+
+
+def _clock(clock: str) -> str:
+    if clock not in ("wall", "cpu"):
+        raise ParameterError(f"clock must be 'wall' or 'cpu', got {clock!r}")
+    return "seconds" if clock == "wall" else "cpu_seconds"
 
 
 def _break_chunk(task: tuple[Precomputation, list[int], Optional[float]], seed: np.random.SeedSequence) -> list[RecoveredKey]:
