@@ -115,12 +115,12 @@ def _plans(breaker: str, sizes: Sequence[tuple[int, int, int]]) -> tuple[Plan, .
     return tuple(Plan(breaker, b, k, f) for b, k, f in sizes)
 
 
-_GENERIC = ((32, 64, 3), (36, 64, 3), (40, 64, 3), (44, 64, 3), (48, 8, 2))
 #: The full run: (bits, N_max, fresh groups) per breaker, up to about ten minutes on 2 cores.
+#: The generic breakers get more fresh groups: a rho walk's length varies a lot from key to key.
 FULL_PLAN: tuple[Plan, ...] = (
-    _plans("bsgs", _GENERIC)
-    + _plans("rho", _GENERIC)
-    + _plans("rho-multi", ((32, 64, 3), (36, 64, 3), (40, 64, 3), (44, 64, 3), (48, 64, 2)))
+    _plans("bsgs", ((32, 64, 8), (36, 64, 8), (40, 64, 8), (44, 64, 8), (48, 8, 2)))
+    + _plans("rho", ((32, 64, 8), (36, 64, 8), (40, 64, 8), (44, 64, 8), (48, 8, 6)))
+    + _plans("rho-multi", ((32, 64, 8), (36, 64, 8), (40, 64, 8), (44, 64, 8), (48, 64, 4)))
     + _plans("pari", ((32, 64, 3), (40, 64, 3), (48, 64, 3), (56, 64, 3), (64, 64, 3), (72, 64, 3),
                       (80, 64, 3), (88, 32, 2), (96, 8, 2)))
     + _plans("index-calculus", ((32, 64, 3), (40, 64, 3), (48, 64, 3), (56, 64, 3), (64, 64, 3),

@@ -77,7 +77,7 @@ TRIAL_PER_BIT = 2.0e-8
 TRIAL_PER_BOUND = 7.0e-11
 #: ... and seconds per k^3 of the dense elimination (k unknowns), for word-size q and larger q.
 LINALG_WORD = 2.5e-10
-LINALG_MULTI = 1.1e-9
+LINALG_MULTI = 1.5e-9
 #: Seconds per entry of building the dense matrix (Python lists into FLINT).
 MATRIX_ENTRY = 5.0e-7
 
