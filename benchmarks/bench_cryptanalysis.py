@@ -2,8 +2,9 @@
 
 For each size it breaks the same dynamic-key sequence with every breaker and prints the
 first-key time ``T_first`` (precomputation + first key) and the mean time of a later key
-``T_1``, each as a ratio to PARI's at the same size, measured in this one run. It also prints
-the calibration constants of the breakers' cost models as measured now (seconds per walk step,
+``T_1``, each as a ratio to PARI's at the same size, measured in this one run (CPU time of this
+process, which other jobs on a shared machine do not inflate). It also prints the calibration
+constants of the breakers' cost models as measured now (seconds per walk step,
 per baby step, per index-calculus smoothness trial), beside the documented values in the
 modules, so the constants can be checked on another machine.
 
@@ -16,7 +17,6 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 import time
 from pathlib import Path
@@ -39,10 +39,10 @@ def calibrate() -> None:
     hs, _, _ = key_sequence(grp, 2, 1)
     pre = get_breaker("rho", rng=1).precompute(grp)
     key = pre.break_key(hs[0])
-    step = key.cost.seconds / key.cost.operations["group_operations"]
+    step = key.cost.cpu_seconds / key.cost.operations["group_operations"]
     print(f"rho: {step * 1e9:.0f} ns per walk step (documented rho.SECONDS_PER_STEP = {rho.SECONDS_PER_STEP * 1e9:.0f} ns)")
     table = get_breaker("bsgs").precompute(grp)
-    per_baby = table.cost.seconds / table.m
+    per_baby = table.cost.cpu_seconds / table.m
     print(f"bsgs: {per_baby * 1e9:.0f} ns per baby step (documented bsgs.SECONDS_PER_STEP = "
           f"{bsgs.SECONDS_PER_STEP * 1e9:.0f} ns)")
     for bits in (64, 80):
@@ -51,11 +51,12 @@ def calibrate() -> None:
         pre = ic.precompute(grp)
         bound = pre.bound
         model = index_calculus.cost_model(bits, bound)
-        trial = pre.phase_seconds["relations"] / pre.cost.operations["smoothness_tests"]
+        phases = pre.phase_cpu_seconds
+        trial = phases["relations"] / pre.cost.operations["smoothness_tests"]
         documented = index_calculus.TRIAL_BASE + index_calculus.TRIAL_PER_BIT * bits + index_calculus.TRIAL_PER_BOUND * bound
         print(f"index-calculus {bits} bits (B = {bound}): {trial * 1e6:.2f} us per smoothness trial (model "
-              f"{documented * 1e6:.2f} us); relations {pre.phase_seconds['relations']:.2f} s (model "
-              f"{model['relations']:.2f} s), linear algebra {pre.phase_seconds['linear_algebra']:.2f} s (model "
+              f"{documented * 1e6:.2f} us); relations {phases['relations']:.2f} s (model "
+              f"{model['relations']:.2f} s), linear algebra {phases['linear_algebra']:.2f} s (model "
               f"{model['linear_algebra']:.2f} s)")
 
 

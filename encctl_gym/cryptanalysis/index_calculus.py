@@ -54,7 +54,7 @@ from .._validation import check_int, check_positive
 from ..crypto import arith
 from ..crypto.arith import RandomSource, RngLike
 from ..crypto.group import GroupParams
-from ..errors import BreakerError, BreakerLimitError, GroupError
+from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, GroupError
 from .base import Breaker, Deadline, Precomputation
 from .linalg import flint_backend, solve_mod_prime
 from .smoothness import FactorBase, dickman_rho, rational_reconstruction
@@ -138,6 +138,26 @@ def choose_bound(bits: int) -> int:
     return max(2, int(2 ** (best / 8)))
 
 
+class _PhaseClock:
+    """Wall and CPU seconds per named phase (``with clock("relations"): ...``), accumulated."""
+
+    def __init__(self) -> None:
+        self.wall: dict[str, float] = {"factor_base": 0.0, "relations": 0.0, "linear_algebra": 0.0}
+        self.cpu = dict(self.wall)
+        self._name = ""
+
+    def __call__(self, name: str) -> "_PhaseClock":
+        self._name = name
+        return self
+
+    def __enter__(self) -> None:
+        self._t0, self._c0 = time.perf_counter(), time.process_time()
+
+    def __exit__(self, *exc: object) -> None:
+        self.wall[self._name] += time.perf_counter() - self._t0
+        self.cpu[self._name] += time.process_time() - self._c0
+
+
 class Relation(tuple):
     """One relation ``(row, rhs)``: ``sum_j row[j] lambda_j = rhs (mod q)``."""
 
@@ -209,8 +229,8 @@ class FactorBaseLogs(Precomputation):
         The factor-base bound B.
     logs : list of int or None
         ``lambda(l)`` per prime of the factor base (``None``: not determined by the relations).
-    phase_seconds : dict
-        Wall time of the phases of the precomputation: ``factor_base``, ``relations``,
+    phase_seconds, phase_cpu_seconds : dict
+        Wall and CPU time of the phases of the precomputation: ``factor_base``, ``relations``,
         ``linear_algebra``.
     backend : str
         The FLINT matrix type of the linear algebra (``nmod_mat`` or ``fmpz_mod_mat``).
@@ -222,6 +242,7 @@ class FactorBaseLogs(Precomputation):
         self.bound = bound
         self.logs = logs
         self.phase_seconds: dict[str, float] = {}
+        self.phase_cpu_seconds: dict[str, float] = {}
         self.backend = flint_backend(group.q)
         self._fb: Optional[FactorBase] = None
 
@@ -280,13 +301,14 @@ class IndexCalculus(Breaker):
     bound : int, optional
         The factor-base bound B (default: :func:`choose_bound` for the group's size).
     max_bits : int, optional
-        Size limit (default 128: the halves a and b then fit in 64 bits).
+        Size limit (default 112 bits: about six minutes and a dense matrix of about 3500 x 3500
+        on this machine; at most 128, where the halves a and b still fit in 64 bits).
     rng
         See :class:`~encctl_gym.cryptanalysis.base.Breaker`.
     """
 
     name: ClassVar[str] = "index-calculus"
-    DEFAULT_MAX_BITS: ClassVar[int] = 128
+    DEFAULT_MAX_BITS: ClassVar[int] = 112
     #: Rounds of extra relations collected when the system leaves too many unknowns free.
     MAX_ROUNDS: ClassVar[int] = 6
 
@@ -316,12 +338,11 @@ class IndexCalculus(Breaker):
 
     def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[FactorBaseLogs, Mapping[str, int]]:
         src = self.rng or arith.secure_random()
-        seconds = {"factor_base": 0.0, "relations": 0.0, "linear_algebra": 0.0}
-        t0 = time.perf_counter()
+        clock = _PhaseClock()
         # Phase 1: the factor base.
-        fb = FactorBase(self.factor_base_bound(group))
+        with clock("factor_base"):
+            fb = FactorBase(self.factor_base_bound(group))
         k = len(fb)
-        seconds["factor_base"] = time.perf_counter() - t0
         # Phase 2: relations; phase 3: linear algebra. More relations while a prime below
         # sqrt(B) (and sqrt(p), for toy groups) is undetermined, or more than SOLVED_FRACTION of
         # the primes that occur in the relations are: the descent needs those.
@@ -332,14 +353,20 @@ class IndexCalculus(Breaker):
         logs: list[Optional[int]] = [None] * k
         small = sum(1 for ell in fb.primes if ell <= max(2, math.isqrt(min(fb.bound, group.p))))
         for _ in range(self.MAX_ROUNDS):
-            t0 = time.perf_counter()
-            more, t = collect_relations(group, fb, need - len(relations), src, deadline)
+            with clock("relations"):
+                more, t = collect_relations(group, fb, need - len(relations), src, deadline)
             relations += more
             trials += t
-            t1 = time.perf_counter()
-            logs, rank = solve_mod_prime([r.row for r in relations], [r.rhs for r in relations], k, group.q)
-            seconds["relations"] += t1 - t0
-            seconds["linear_algebra"] += time.perf_counter() - t1
+            # The elimination runs inside FLINT and cannot be interrupted: refuse it up front
+            # when the cost model says it would overrun the time limit.
+            expected = cost_model(group.bits, fb.bound)["linear_algebra"]
+            if expected > deadline.remaining:
+                raise BreakerTimeoutError(
+                    f"{deadline.what} stopped before its linear algebra: expected {expected:.3g} s, but only "
+                    f"{max(deadline.remaining, 0.0):.3g} s of its time limit of {deadline.limit:g} s remain"
+                )
+            with clock("linear_algebra"):
+                logs, rank = solve_mod_prime([r.row for r in relations], [r.rhs for r in relations], k, group.q)
             occurring = len({j for r in relations for j in r.row})
             solved = sum(v is not None for v in logs)
             if all(v is not None for v in logs[:small]) and solved >= SOLVED_FRACTION * occurring:
@@ -353,7 +380,7 @@ class IndexCalculus(Breaker):
             )
         pre = FactorBaseLogs(group, fb.bound, logs, self.rng)
         pre._fb = fb
-        pre.phase_seconds = seconds
+        pre.phase_seconds, pre.phase_cpu_seconds = clock.wall, clock.cpu
         ops = {
             "factor_base": k,
             "smoothness_tests": trials,
