@@ -20,6 +20,7 @@ import gmpy2
 import numpy as np
 
 from .._validation import check_int, check_positive
+from ..crypto.group import _small_primes
 from ..errors import ParameterError
 
 __all__ = [
@@ -31,18 +32,9 @@ __all__ = [
 ]
 
 
-@lru_cache(maxsize=8)
-def _sieve(limit: int) -> tuple[int, ...]:
-    flags = np.ones(limit + 1, dtype=bool)
-    flags[:2] = False
-    for i in range(2, math.isqrt(limit) + 1):
-        if flags[i]:
-            flags[i * i :: i] = False
-    return tuple(int(x) for x in np.flatnonzero(flags))
-
-
 def primes_up_to(bound: int) -> tuple[int, ...]:
-    """The primes ``2, 3, 5, ... <= bound`` (sieve of Eratosthenes).
+    """The primes ``2, 3, 5, ... <= bound`` (the sieve of :mod:`encctl_gym.crypto.group`, which
+    the safe-prime generation uses for its candidates).
 
     Raises
     ------
@@ -50,7 +42,7 @@ def primes_up_to(bound: int) -> tuple[int, ...]:
         If ``bound < 2``.
     """
     bound = check_int("bound", bound, minimum=2)
-    return _sieve(bound)
+    return (2, *_small_primes(bound + 1))
 
 
 class FactorBase:
