@@ -12,26 +12,23 @@ takes one observation ``(obs_dim,)`` or a batch ``(K, obs_dim)`` from the native
 environment and returns actions of the matching shape, always inside ``[-1, 1]``; stateful
 attackers keep one state per copy, created on the first ``act`` after ``reset``.
 
-Observation layout (see the environment's docstring): :class:`ObsLayout` names the slices, and
-:func:`observation_indices` gives the columns of the observation *modes* learned attackers
-are trained on (``"full"``, ``"no_budget"``, ``"blind"``).
+Observation layout: :class:`encctl_gym.envs.layout.ObservationLayout` (``self.layout``) names
+the slices, and :func:`observation_indices` gives the columns of the observation *modes* learned
+attackers are trained on (``"full"``, ``"no_budget"``, ``"blind"``).
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from encctl_gym.envs.config import AttackParams
+from encctl_gym.envs.layout import OBSERVATION_MODES, ObservationLayout
 from encctl_gym.errors import ParameterError
 
 __all__ = ["Attacker", "ObsLayout", "OBSERVATION_MODES", "observation_indices", "params_of"]
-
-#: Observation modes for learned attackers (:func:`observation_indices`).
-OBSERVATION_MODES = ("full", "no_budget", "blind")
 
 
 def params_of(env: Any) -> AttackParams:
@@ -43,78 +40,15 @@ def params_of(env: Any) -> AttackParams:
     raise ParameterError(f"{type(env).__name__} carries no AttackParams (is it an EncryptedLTIAttack environment?)")
 
 
-@dataclass(frozen=True)
-class ObsLayout:
-    """Slices of the flat observation of ``EncryptedLTIAttack-v0`` for ``n`` states, ``m``
-    inputs and an input history of ``H`` steps."""
-
-    n: int
-    m: int
-    H: int
-
-    @classmethod
-    def of(cls, params: AttackParams) -> "ObsLayout":
-        return cls(params.n, params.m, params.input_history)
-
-    @property
-    def dim(self) -> int:
-        return self.n + self.m + 1 + self.H * self.m + 2
-
-    @property
-    def state(self) -> slice:
-        """Latest delivered decrypted state ``x_j``."""
-        return slice(0, self.n)
-
-    @property
-    def input(self) -> slice:
-        """Delivered input ``u_{j-1}``."""
-        return slice(self.n, self.n + self.m)
-
-    @property
-    def flag(self) -> int:
-        """1.0 when a sample was delivered at this step."""
-        return self.n + self.m
-
-    @property
-    def history(self) -> slice:
-        """Own last ``H`` actions, newest first (action units)."""
-        start = self.n + self.m + 1
-        return slice(start, start + self.H * self.m)
-
-    @property
-    def time_fraction(self) -> int:
-        return self.dim - 2
-
-    @property
-    def energy_fraction(self) -> int:
-        return self.dim - 1
+#: The environment's observation layout (:class:`encctl_gym.envs.layout.ObservationLayout`),
+#: under the name this module gave it before it had one home.
+ObsLayout = ObservationLayout
 
 
 def observation_indices(params: AttackParams, mode: str) -> np.ndarray:
-    """Columns of the observation a learned attacker sees in ``mode``.
-
-    * ``"full"``: everything.
-    * ``"no_budget"``: without the two budget fractions. Their scale depends on the episode
-      length (``max_samples``, ``tau_c``), so a stationary policy trained on short episodes
-      transfers to the full attack only if it does not see them.
-    * ``"blind"``: the attacker's own past actions and the two budget fractions, i.e. what the
-      paper's attacker knows before the attack ends (``decipher_delay="end"``); no delivered
-      data. Use with a recurrent policy.
-
-    The budget fractions let a policy pace its input energy. They mean "fraction of the attack
-    elapsed" only when the horizon is set by ``tau_c`` (see :func:`agents.evaluate.budget_config`),
-    not by ``max_samples``.
-    """
-    lay = ObsLayout.of(params)
-    if mode == "full":
-        return np.arange(lay.dim)
-    if mode == "no_budget":
-        return np.arange(lay.dim - 2)
-    if mode == "blind":
-        if lay.H == 0:
-            raise ParameterError("observation mode 'blind' needs input_history >= 1")
-        return np.concatenate([np.arange(lay.history.start, lay.history.stop), [lay.time_fraction, lay.energy_fraction]])
-    raise ParameterError(f"unknown observation mode {mode!r}; choose one of {', '.join(OBSERVATION_MODES)}")
+    """Columns of the observation a learned attacker sees in ``mode`` (``"full"``,
+    ``"no_budget"``, ``"blind"``): :meth:`ObservationLayout.columns` of the environment's layout."""
+    return ObservationLayout.of(params).columns(mode)
 
 
 class Attacker(ABC):
@@ -145,7 +79,7 @@ class Attacker(ABC):
         if not isinstance(params, AttackParams):
             raise ParameterError(f"params must be AttackParams, got {type(params).__name__}")
         self.params = params
-        self.layout = ObsLayout.of(params)
+        self.layout = ObservationLayout.of(params)
         self.rng = np.random.default_rng()
         self._batch: int | None = None
 

@@ -1,7 +1,7 @@
 """stable-baselines3 glue: a VecEnv over the native vector environment, and learned attackers.
 
 * :class:`SB3VecEnv` adapts :class:`~encctl_gym.envs.vector.EncryptedLTIAttackVectorEnv` (K
-  copies stepped at once in numpy) to stable-baselines3's ``VecEnv`` API: same-step autoreset
+  copies stepped at once) to stable-baselines3's ``VecEnv`` API: same-step autoreset
   with ``info["terminal_observation"]`` and ``info["TimeLimit.truncated"]``, seeding through
   ``VecEnv.seed``, and an observation *mode* (:func:`agents.base.observation_indices`) that
   selects the columns the policy sees. It is several times faster than a ``DummyVecEnv`` over
@@ -9,54 +9,53 @@
 * :class:`SB3Attacker` wraps a trained model (PPO, SAC, RecurrentPPO; with its
   ``VecNormalize`` statistics) as an :class:`~agents.base.Attacker`.
 * :func:`load_attacker` loads a training run written by :mod:`agents.train`.
+* :data:`ALGORITHMS`: the learning algorithms by name (one table for training, loading and the
+  command line).
 """
 
 from __future__ import annotations
 
-import json
+import pickle
+import zipfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from gymnasium import spaces
+from sb3_contrib import RecurrentPPO
+from stable_baselines3 import PPO, SAC
+from stable_baselines3.common.base_class import BaseAlgorithm
+from stable_baselines3.common.vec_env import VecEnv
 
 from encctl_gym.envs.config import AttackParams, resolve_params
-from encctl_gym.errors import ParameterError
+from encctl_gym.errors import ConfigError, ParameterError
 
 from .base import Attacker, observation_indices
 
-try:  # stable-baselines3 is the optional [rl] extra
-    from stable_baselines3.common.vec_env import VecEnv
-except ModuleNotFoundError:  # pragma: no cover
-    VecEnv = object  # type: ignore[misc,assignment]
-
 __all__ = ["SB3VecEnv", "SB3Attacker", "load_attacker", "ALGORITHMS", "algorithm_class", "INFO_KEYS"]
 
-#: Algorithm names accepted by :func:`algorithm_class` and the ``train`` command.
-ALGORITHMS = ("ppo", "sac", "recurrent_ppo")
+#: The learning algorithms by name: ``train``, :func:`load_attacker` and the command line's
+#: choices all read this one table (a new algorithm is a row here and a default config in
+#: ``agents/configs/defaults/{name}.yaml``).
+ALGORITHMS: dict[str, type[BaseAlgorithm]] = {
+    "ppo": PPO,
+    "sac": SAC,
+    "recurrent_ppo": RecurrentPPO,
+}
 
 #: Info keys copied into the SB3 info dicts at the end of an episode.
 INFO_KEYS = ("epsilon", "gamma", "samples_delivered", "input_energy", "average_power")
 
 
-def algorithm_class(algo: str) -> Any:
-    """The stable-baselines3 (or sb3-contrib) class of ``algo``."""
-    if algo == "ppo":
-        from stable_baselines3 import PPO
-
-        return PPO
-    if algo == "sac":
-        from stable_baselines3 import SAC
-
-        return SAC
-    if algo == "recurrent_ppo":
-        from sb3_contrib import RecurrentPPO
-
-        return RecurrentPPO
-    raise ParameterError(f"unknown algorithm {algo!r}; choose one of {', '.join(ALGORITHMS)}")
+def algorithm_class(algo: str) -> type[BaseAlgorithm]:
+    """The stable-baselines3 (or sb3-contrib) class registered as ``algo`` in :data:`ALGORITHMS`."""
+    try:
+        return ALGORITHMS[algo]
+    except (KeyError, TypeError):
+        raise ConfigError(f"unknown algorithm {algo!r}; choose one of {', '.join(ALGORITHMS)}") from None
 
 
-class SB3VecEnv(VecEnv):  # type: ignore[misc]
+class SB3VecEnv(VecEnv):
     """``num_envs`` copies of the attack environment as a stable-baselines3 ``VecEnv``.
 
     Parameters
@@ -263,14 +262,16 @@ def load_attacker(
     params: AttackParams | None = None,
     deterministic: bool = False,
     name: str | None = None,
+    torch_threads: int | None = 1,
 ) -> SB3Attacker:
     """Load a training run written by :mod:`agents.train` as an attacker.
 
     Parameters
     ----------
     run_dir : path
-        The run's directory (holds ``run.json``, ``model.zip``, ``best_model.zip`` and, when the
-        observations were normalised, ``vecnormalize.pkl``).
+        The run's directory (:mod:`agents.runs`: ``run.json``, ``model.zip``,
+        ``best_model.zip`` and, when the observations were normalised, ``vecnormalize.pkl``).
+        Loading unpickles these files: load only runs you trust.
     which : {"final", "best"}
         The model at the end of training or the best one of the evaluation callback.
     params : AttackParams, optional
@@ -279,30 +280,48 @@ def load_attacker(
         See :class:`SB3Attacker`.
     name : str, optional
         Label (default: the run's algorithm name).
+    torch_threads : int, optional
+        Sets torch's (process-wide) number of threads, 1 by default: the policies are small,
+        and on a shared 2-core machine a second thread made one RecurrentPPO step 4 to 40 times
+        slower (1.1 ms on one thread). ``None`` leaves it as it is.
+
+    Raises
+    ------
+    ConfigError
+        A broken ``run.json``, an unknown algorithm, a missing, corrupt or incompatible model
+        or normalisation file.
     """
-    run_dir = Path(run_dir)
-    meta_path = run_dir / "run.json"
-    if not meta_path.exists():
-        raise ParameterError(f"{run_dir} is not a training run (no run.json)")
-    meta = json.loads(meta_path.read_text())
-    files = {"final": "model.zip", "best": "best_model.zip"}
-    if which not in files:
-        raise ParameterError(f"which must be 'final' or 'best', got {which!r}")
-    model_path = run_dir / files[which]
-    if not model_path.exists():
-        raise ParameterError(f"no {files[which]} in {run_dir}")
-    cls = algorithm_class(meta["algo"])
-    model = cls.load(str(model_path), device="cpu")
-    env_cfg = dict(meta["env"])
+    from .runs import read_run
+
+    run = read_run(run_dir)
+    cls = algorithm_class(run.algo)
+    if torch_threads is not None:
+        import torch
+
+        torch.set_num_threads(int(torch_threads))
+    model_path = run.model_path(which)
+    try:
+        model = cls.load(str(model_path), device="cpu")
+    except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError, RuntimeError, pickle.UnpicklingError) as exc:
+        raise ConfigError(f"cannot load {model_path} as a {run.algo} model: {type(exc).__name__}: {_first_line(exc)}") from exc
+    env_cfg = dict(run.env)
     env_cfg["gamma_opt"] = False
     if params is None:
         params = resolve_params(env_cfg)
     vecnorm = None
-    vn_path = run_dir / "vecnormalize.pkl"
+    vn_path = run.path / "vecnormalize.pkl"
     if vn_path.exists():
         from stable_baselines3.common.vec_env import VecNormalize
 
-        vecnorm = VecNormalize.load(str(vn_path), SB3VecEnv(env_cfg, 1, meta["observation"]))
+        try:
+            vecnorm = VecNormalize.load(str(vn_path), SB3VecEnv(env_cfg, 1, run.observation))
+        except (EOFError, OSError, ValueError, KeyError, AttributeError, pickle.UnpicklingError) as exc:
+            raise ConfigError(f"cannot load {vn_path}: {type(exc).__name__}: {_first_line(exc)}") from exc
     return SB3Attacker(
-        model, vecnorm, deterministic, params=params, observation=meta["observation"], name=name or meta["algo"],
+        model, vecnorm, deterministic, params=params, observation=run.observation, name=name or run.algo,
     )
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else ""

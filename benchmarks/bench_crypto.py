@@ -1,10 +1,16 @@
 """Benchmark of the cryptographic core (encctl_gym.crypto).
 
 For each key length it prints the time of: safe-prime group generation + KeyGen (fresh) and
-KeyGen with the shipped group, Enc, Dec, Eval, Eval_bar/Dec_bar, KeyUpd, CtUpd, and one
-full encrypted control step of each scheme (n = m = 4), with the step time divided by the
-time of one gmpy2.powmod at that size (full-size exponent) measured in the same run, and
-the number of modular exponentiations per step (counted by crypto.arith.powmod).
+KeyGen with the shipped group, the verification of the shipped group from scratch, Enc, Dec,
+Eval, Eval_bar/Dec_bar, KeyUpd, CtUpd, and one full encrypted control step of each scheme
+(n = m = 4), with the step time divided by the time of one gmpy2.powmod at that size
+(full-size exponent) measured in the same run, and the number of modular exponentiations per
+step (counted by crypto.arith.powmod).
+
+Then the mean time of repeated safe-prime searches against
+crypto.group.estimate_generation_seconds (the estimate that decides, before a search starts,
+whether it is refused), and the build time and peak memory (tracemalloc) of the residue table
+of the environment's default range against crypto.residue_table.residue_table_bytes.
 
 Usage::
 
@@ -19,6 +25,7 @@ import multiprocessing as mp
 import statistics
 import sys
 import time
+import tracemalloc
 from typing import Callable
 
 import gmpy2
@@ -28,8 +35,9 @@ from encctl_gym.crypto import arith
 from encctl_gym.crypto.controller import EncryptedLinearController
 from encctl_gym.crypto.dyn_elgamal import ciphertext_update, key_update
 from encctl_gym.crypto.elgamal import decrypt, encrypt, keygen, mult
-from encctl_gym.crypto.group import generate_safe_prime_group, shipped_group
+from encctl_gym.crypto.group import estimate_generation_seconds, generate_safe_prime_group, shipped_group
 from encctl_gym.crypto.modified import modified_decrypt, modified_eval
+from encctl_gym.crypto.residue_table import ResidueTable, residue_table_bytes
 
 PHI = np.array(
     [[0.5, -1.2, 0.3, 0.0], [1.0, 2.0, -3.0, 0.25], [0.1, 0.2, 0.3, 0.4], [-1.0, -1.0, -1.0, -1.0]]
@@ -94,6 +102,7 @@ def bench_size(bits: int, reps: int, fresh_samples: int, fresh_timeout: float, s
 
     fresh = "skipped" if skip_fresh else fresh_keygen(bits, fresh_samples, fresh_timeout)
     ops = {
+        "verify shipped group from scratch": timeit(lambda: grp.verify(recheck=True), max(1, reps // 4)),
         "keygen, shipped group": timeit(lambda: keygen(grp), reps),
         "encrypt": timeit(lambda: encrypt(pk, m1), reps),
         "decrypt": timeit(lambda: decrypt(sk, ct1), reps),
@@ -129,6 +138,42 @@ def bench_size(bits: int, reps: int, fresh_samples: int, fresh_timeout: float, s
         )
 
 
+def bench_generation(sizes: list[tuple[int, int]]) -> None:
+    """Mean time of ``samples`` searches per size against estimate_generation_seconds.
+
+    Wall time and the process's CPU time: on a machine shared with other jobs the wall time
+    grows with the load, the CPU time is what the estimate models.
+    """
+    print("\n== safe-prime generation: mean of n searches (seeded streams 0..n-1) vs the estimate ==")
+    print(f"  {'bits':>5s} {'n':>3s} {'estimate':>9s} {'wall mean':>10s} {'ratio':>6s} {'cpu mean':>9s} "
+          f"{'ratio':>6s} {'sem':>5s}")
+    for bits, samples in sizes:
+        wall, cpu = [], []
+        for i in range(samples):
+            t0, c0 = time.perf_counter(), time.process_time()
+            generate_safe_prime_group(bits, rng=arith.seeded_random(i, "bench"))
+            wall.append(time.perf_counter() - t0)
+            cpu.append(time.process_time() - c0)
+        est, w, c = estimate_generation_seconds(bits), statistics.mean(wall), statistics.mean(cpu)
+        sem = statistics.stdev(cpu) / samples**0.5 / c if samples > 1 else float("nan")
+        print(f"  {bits:5d} {samples:3d} {est:8.3f}s {w:9.3f}s {w / est:6.2f} {c:8.3f}s {c / est:6.2f} {sem:5.2f}")
+
+
+def bench_residue_table(limit: int) -> None:
+    """Build time and tracemalloc peak of a residue table against residue_table_bytes."""
+    grp = shipped_group(712)
+    tracemalloc.start()
+    t0 = time.perf_counter()
+    ResidueTable(grp, limit)
+    dt = time.perf_counter() - t0
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    est = residue_table_bytes(limit)
+    print(f"\n== residue table, limit {limit} (712-bit group) ==")
+    print(f"  build {dt:.2f} s (under tracemalloc); peak {peak / 2**20:.1f} MiB; "
+          f"estimate {est / 2**20:.1f} MiB ({est / peak:.2f}x the peak)")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--bits", type=int, nargs="+", default=[256, 712, 1024, 2048])
@@ -143,6 +188,12 @@ def main(argv: list[str] | None = None) -> int:
     for bits in args.bits:
         skip = bits >= 2048 and (args.quick or args.skip_fresh_2048)
         bench_size(bits, reps, 1 if bits >= 2048 else fresh_samples, args.fresh_timeout, skip)
+    if args.quick:
+        bench_generation([(256, 20), (512, 10), (712, 8), (1024, 4)])
+    else:
+        bench_generation([(256, 80), (512, 40), (712, 30), (1024, 16), (1536, 6), (2048, 3)])
+    # The environment's default range: Delta = 4096 times x_bound = 256 (plus one).
+    bench_residue_table(4096 * 256 + 1)
     return 0
 
 

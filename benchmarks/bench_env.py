@@ -11,7 +11,8 @@ Prints:
 3. the ElGamal backend's time per step at 712 bits against the crypto floor: the time of one
    ``gmpy2.powmod`` with a full-size exponent at that size, measured in the same run.
 
-Usage: ``python benchmarks/bench_env.py [--quick]``.
+Usage: ``python benchmarks/bench_env.py [--quick] [--record]`` (``--record`` writes
+``benchmarks/results/bench_env.json`` for the README table, :mod:`benchmarks.record`).
 """
 
 from __future__ import annotations
@@ -55,7 +56,7 @@ def vector_steps_per_second(venv: EncryptedLTIAttackVectorEnv, actions: np.ndarr
     t0 = time.perf_counter()
     for a in actions:
         venv.step(a)
-    venv._core.wait()
+    venv.episode.wait()
     return venv.num_envs * len(actions) / (time.perf_counter() - t0)
 
 
@@ -84,6 +85,7 @@ def elgamal_seconds_per_step(steps: int) -> float:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer steps (a smoke test)")
+    parser.add_argument("--record", action="store_true", help="record the figures for the README table")
     args = parser.parse_args(argv)
     n_single = 2000 if args.quick else 20000
     n_vec = 64 if args.quick else 2 * 1024
@@ -132,6 +134,18 @@ def main(argv: list[str] | None = None) -> int:
     print(f"elgamal backend, 712 bits           : {per_step * 1e3:12.2f} ms/step")
     print(f"one gmpy2.powmod at 712 bits        : {floor * 1e6:12.1f} us")
     print(f"step / powmod (crypto floor)        : {per_step / floor:12.1f}")
+    if args.record:
+        from record import write
+
+        figures = {"single_sps": our_sps, "pendulum_sps": pend_sps, "vector_sps": vec_sps, "one_thread_sps": one_sps,
+                   "parallel_sps": par_sps, "elgamal_step_s": per_step, "powmod_s": floor}
+        write("bench_env", figures, [
+            ("environment (ideal backend) vs `Pendulum-v1`, both through `gymnasium.make`", f"{our_sps / pend_sps:.2f}x the steps per second ({our_sps:,.0f} steps/s)"),
+            (f"native vector environment, {num_envs} copies, vs the single environment ({n_vec}-step passes)",
+             f"{vec_sps / our_sps:.1f}x as constructed (helper thread); {one_sps / our_sps:.1f}x with `helper_thread=False`; "
+             f"{par_sps / our_sps:.1f}x with `parallel=True`"),
+            ("environment step through real ElGamal at 712 bits", f"{per_step * 1e3:.2f} ms = {per_step / floor:.1f} powmod times"),
+        ], argv)
     return 0
 
 

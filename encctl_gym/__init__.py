@@ -1,11 +1,6 @@
 """encctl-gym: adversarial experiments on encrypted control systems.
 
-Layers, importing downward only::
-
-    crypto (arith -> group -> encoding -> elgamal -> dyn_elgamal -> modified -> controller)
-    sim (plant, identification, parallel)
-    security (pure math, beside the others)
-    envs (the Gymnasium environment)
+Layers import downward only; ``docs/architecture.md`` draws them module by module.
 
 Implements K. Teranishi and K. Kogiso, "Optimal Security Parameter for Encrypted Control
 Systems Against Eavesdropper and Malicious Server" (arXiv 2303.13059).
@@ -24,9 +19,11 @@ from .errors import (
     EncodingOverflowError,
     GroupError,
     KeyMismatchError,
+    ModelRangeError,
     OptionalDependencyError,
     ParameterError,
     PlaintextError,
+    ResourceLimitError,
     ShapeError,
     SolverError,
     UnstableSystemError,
@@ -48,6 +45,8 @@ __all__ = [
     "SolverError",
     "BudgetError",
     "ConfigError",
+    "ModelRangeError",
+    "ResourceLimitError",
     "BreakerError",
     "BreakerLimitError",
     "BreakerTimeoutError",
@@ -55,18 +54,8 @@ __all__ = [
 ]
 
 
-def _register() -> None:
-    # Register the Gymnasium environment on import, without importing the environment module
-    # (and its dependencies) until gymnasium.make asks for it.
-    import gymnasium as gym
+from .registration import register_when_gymnasium_loads
 
-    env_id = "encctl_gym/EncryptedLTIAttack-v0"
-    if env_id not in gym.registry:
-        gym.register(
-            id=env_id,
-            entry_point="encctl_gym.envs.encrypted_lti_attack:EncryptedLTIAttackEnv",
-            vector_entry_point="encctl_gym.envs.vector:EncryptedLTIAttackVectorEnv",
-        )
-
-
-_register()
+# gymnasium.make finds encctl_gym/EncryptedLTIAttack-v0 after `import encctl_gym`, whichever
+# of the two is imported first; importing this package does not import gymnasium.
+register_when_gymnasium_loads()

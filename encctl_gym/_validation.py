@@ -1,11 +1,22 @@
 """Shared input checks. Every public function validates through these, so that a bad value
 always raises an error of :mod:`encctl_gym.errors` that names the value.
+
+:func:`format_value` is the one way a value goes into an error message: it never fails and
+never grows without bound (an integer of ten thousand digits, a string of a megabyte, an
+array of a million entries are all shown in a few dozen characters), so a message can always
+be built, whatever the input.
+
+Real numbers are finite float64 values: a Python integer beyond the float range
+(``10**400``) or a complex number is refused with its name, never silently truncated to its
+real part or turned into ``inf``.
 """
 
 from __future__ import annotations
 
 import math
 import numbers
+import sys
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -13,30 +24,119 @@ import numpy as np
 from .errors import ParameterError, ShapeError, UnstableSystemError
 
 __all__ = [
+    "format_value",
     "check_positive",
     "check_nonnegative",
+    "check_real",
     "check_int",
+    "check_bool",
+    "parse_number",
     "as_finite_array",
     "check_system",
     "spectral_radius",
     "check_schur_stable",
+    "FLOAT_MAX",
 ]
+
+#: Largest finite float64; every real input must lie within +-FLOAT_MAX.
+FLOAT_MAX: float = sys.float_info.max
+
+_MAX_INT_DIGITS_SHOWN = 40  # integers up to this many digits are printed in full
+_MAX_ITEMS_SHOWN = 4
+
+
+def _format_int(v: int) -> str:
+    bits = abs(v).bit_length()
+    if bits <= _MAX_INT_DIGITS_SHOWN * 3:  # at most ~36 digits: safe and short
+        return repr(v)
+    digits = int(bits * math.log10(2)) + 1  # exact to within one digit, without str(v)
+    sign = "-" if v < 0 else ""
+    return f"{sign}<integer of {bits} bits, about {digits} digits>"
+
+
+def format_value(value: Any, limit: int = 120) -> str:
+    """A short, always-computable text for ``value`` in an error message.
+
+    Integers of more than about 36 digits are shown by their size (``<integer of 1329 bits,
+    about 401 digits>``: Python refuses ``str`` of integers over 4300 digits, and a message
+    must never fail); strings and reprs are cut at ``limit`` characters; arrays and sequences
+    show their shape or length and a few entries.
+
+    Parameters
+    ----------
+    value : object
+        Anything.
+    limit : int, default 120
+        Largest number of characters taken from a string or a repr.
+
+    Returns
+    -------
+    str
+    """
+    try:
+        if isinstance(value, bool) or value is None:
+            return repr(value)
+        if isinstance(value, (int, np.integer)):
+            return _format_int(int(value))
+        if isinstance(value, Fraction):
+            if max(abs(value.numerator).bit_length(), value.denominator.bit_length()) <= 100:
+                return f"Fraction({value.numerator}, {value.denominator})"
+            return f"<fraction {_format_int(value.numerator)} / {_format_int(value.denominator)}>"
+        if isinstance(value, (float, complex, np.floating, np.complexfloating)):
+            return repr(value.item() if isinstance(value, np.generic) else value)
+        if isinstance(value, str):
+            return repr(value) if len(value) <= limit else repr(value[:limit]) + f"... ({len(value)} characters)"
+        if isinstance(value, (bytes, bytearray)):
+            return repr(bytes(value[:limit])) + (f"... ({len(value)} bytes)" if len(value) > limit else "")
+        if isinstance(value, np.ndarray):
+            if value.dtype.kind in "biufc" and value.size <= 6:
+                return f"array({np.array2string(value, threshold=6, edgeitems=2, separator=', ')}, dtype={value.dtype})"
+            if value.dtype.kind in "biufc":
+                body = np.array2string(value.ravel()[:_MAX_ITEMS_SHOWN], separator=", ")
+                return f"<array of shape {value.shape}, dtype {value.dtype}, first entries {body[:limit]}>"
+            return f"<array of shape {value.shape}, dtype {value.dtype}>"
+        if isinstance(value, (list, tuple)):
+            items = ", ".join(format_value(v, limit=limit // 2) for v in value[:_MAX_ITEMS_SHOWN])
+            more = f", ... ({len(value)} items)" if len(value) > _MAX_ITEMS_SHOWN else ""
+            text = ("[" if isinstance(value, list) else "(") + items + more + ("]" if isinstance(value, list) else ")")
+            return text if len(text) <= 2 * limit else text[: 2 * limit] + "...]"
+        if isinstance(value, dict):
+            keys = list(value)[:_MAX_ITEMS_SHOWN]
+            items = ", ".join(f"{format_value(k, limit // 4)}: {format_value(value[k], limit // 2)}" for k in keys)
+            more = f", ... ({len(value)} keys)" if len(value) > _MAX_ITEMS_SHOWN else ""
+            return "{" + items + more + "}"
+        text = repr(value)
+    except Exception:  # noqa: BLE001 - a repr that fails must not hide the real error
+        return f"<{type(value).__name__} object>"
+    return text if len(text) <= limit else text[:limit] + f"... ({len(text)} characters)"
 
 
 def _as_float(name: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (numbers.Real, np.floating, np.integer)):
-        raise ParameterError(f"{name} must be a real number, got {value!r}")
-    v = float(value)
+        raise ParameterError(f"{name} must be a real number, got {format_value(value)}")
+    try:
+        v = float(value)
+    except OverflowError:
+        raise ParameterError(
+            f"{name} must be a finite real number within the float64 range (|x| <= {FLOAT_MAX:.4g}), "
+            f"got {format_value(value)}"
+        ) from None
     if not math.isfinite(v):
-        raise ParameterError(f"{name} must be finite, got {value!r}")
+        raise ParameterError(f"{name} must be finite, got {format_value(value)}")
     return v
+
+
+def check_real(name: str, value: Any) -> float:
+    """Return ``value`` as a float, raising :class:`ParameterError` unless it is a finite real
+    number (not a bool, not complex, within the float64 range)."""
+    return _as_float(name, value)
 
 
 def check_positive(name: str, value: Any) -> float:
     """Return ``value`` as a float, raising :class:`ParameterError` unless it is finite and > 0."""
     v = _as_float(name, value)
     if v <= 0:
-        raise ParameterError(f"{name} must be > 0, got {value!r}")
+        raise ParameterError(f"{name} must be > 0, got {format_value(value)}")
     return v
 
 
@@ -44,40 +144,98 @@ def check_nonnegative(name: str, value: Any) -> float:
     """Return ``value`` as a float, raising :class:`ParameterError` unless it is finite and >= 0."""
     v = _as_float(name, value)
     if v < 0:
-        raise ParameterError(f"{name} must be >= 0, got {value!r}")
+        raise ParameterError(f"{name} must be >= 0, got {format_value(value)}")
     return v
 
 
-def check_int(name: str, value: Any, minimum: int | None = None) -> int:
-    """Return ``value`` as an int, raising :class:`ParameterError` for non-integers or values below ``minimum``."""
+def check_int(name: str, value: Any, minimum: int | None = None, maximum: int | None = None) -> int:
+    """Return ``value`` as an int, raising :class:`ParameterError` for non-integers or values
+    outside ``[minimum, maximum]`` (integral floats such as ``3.0`` are accepted)."""
     if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)):
         if isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer():
             value = int(value)
         else:
-            raise ParameterError(f"{name} must be an integer, got {value!r}")
+            raise ParameterError(f"{name} must be an integer, got {format_value(value)}")
     v = int(value)
     if minimum is not None and v < minimum:
-        raise ParameterError(f"{name} must be >= {minimum}, got {v}")
+        raise ParameterError(f"{name} must be >= {minimum}, got {format_value(v)}")
+    if maximum is not None and v > maximum:
+        raise ParameterError(f"{name} must be <= {maximum}, got {format_value(v)}")
+    return v
+
+
+def check_bool(name: str, value: Any) -> bool:
+    """Return ``value`` if it is a bool (or ``numpy.bool_``); anything else, including the
+    strings ``'no'`` and ``'false'`` and the integers 0 and 1, raises :class:`ParameterError`."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise ParameterError(f"{name} must be True or False, got {format_value(value)}")
+
+
+def parse_number(name: str, text: Any) -> float:
+    """A finite real number from a command-line string (``"1e-6"``, ``"442e15"``) or a number.
+
+    Raises
+    ------
+    ParameterError
+        For text that is not a number, or a number that is not finite in float64.
+    """
+    if isinstance(text, (numbers.Real, np.floating, np.integer)) and not isinstance(text, bool):
+        return _as_float(name, text)
+    if not isinstance(text, str):
+        raise ParameterError(f"{name} must be a number, got {format_value(text)}")
+    try:
+        v = float(text.strip())
+    except ValueError:
+        raise ParameterError(f"{name} must be a number, got {format_value(text)}") from None
+    if not math.isfinite(v):
+        raise ParameterError(f"{name} must be a finite number within the float64 range, got {format_value(text)}")
     return v
 
 
 def as_finite_array(name: str, value: Any, ndim: int | None = None) -> np.ndarray:
-    """Convert ``value`` to a float64 array with finite entries (and ``ndim`` dimensions if given)."""
+    """Convert ``value`` to a float64 array with finite real entries (and ``ndim`` dimensions if
+    given).
+
+    Complex, boolean and string data are refused (never truncated to the real part or read as
+    0/1), as are integers beyond the float64 range.
+    """
     try:
-        arr = np.asarray(value, dtype=np.float64)
+        raw = value if isinstance(value, np.ndarray) else np.asarray(value)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise ParameterError(f"{name} must be a numeric array, got {format_value(value)}") from exc
+    kind = raw.dtype.kind
+    if kind == "c":
+        raise ParameterError(f"{name} must be real, got a complex array {format_value(raw)}")
+    if kind == "b":
+        raise ParameterError(f"{name} must be numeric, got a boolean array {format_value(raw)}")
+    if kind in "USV" or kind == "M" or kind == "m":
+        raise ParameterError(f"{name} must be a numeric array, got {format_value(value)}")
+    if kind == "O":
+        for v in raw.ravel():
+            if isinstance(v, (complex, np.complexfloating)):
+                raise ParameterError(f"{name} must be real, got complex entries in {format_value(value)}")
+            if v is None or isinstance(v, (bool, np.bool_, str, bytes)):
+                raise ParameterError(f"{name} must be a numeric array, got the entry {format_value(v)} in {format_value(value)}")
+    try:
+        arr = np.asarray(raw, dtype=np.float64)
+    except OverflowError as exc:
+        raise ParameterError(
+            f"{name} must have entries within the float64 range, got {format_value(value)}"
+        ) from exc
     except (TypeError, ValueError) as exc:
-        raise ParameterError(f"{name} must be a numeric array, got {value!r}") from exc
+        raise ParameterError(f"{name} must be a numeric array, got {format_value(value)}") from exc
     if ndim is not None and arr.ndim != ndim:
         raise ShapeError(f"{name} must have {ndim} dimension(s), got shape {arr.shape}")
     if arr.size == 0:
         raise ShapeError(f"{name} must not be empty, got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
-        raise ParameterError(f"{name} must have finite entries, got {arr!r}")
+        raise ParameterError(f"{name} must have finite entries, got {format_value(arr)}")
     return arr
 
 
 def check_system(A: Any, B: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Validate the plant matrices of eq:system: A is n x n, B is n x m, all entries finite."""
+    """Validate the plant matrices of eq:system: A is n x n, B is n x m, all entries finite and real."""
     A = as_finite_array("A", A)
     B = as_finite_array("B", B)
     if A.ndim != 2 or A.shape[0] != A.shape[1]:

@@ -30,8 +30,12 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "train a learned attacker with stable-baselines3 (needs the [rl] extra)",
     ),
     "compare": (
-        "experiments.attackers_vs_bounds",
+        "experiments.compare.cli",
         "the headline experiment: every attacker against gamma(N) and gamma_opt(N)",
+    ),
+    "evaluate": (
+        "experiments.compare.evaluate_run",
+        "a training run against the Gaussian, AR(1) and oracle attackers on paired seeds (needs the [rl] extra)",
     ),
     "crack": (
         "encctl_gym.cryptanalysis.cli",

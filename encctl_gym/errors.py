@@ -21,6 +21,8 @@ __all__ = [
     "SolverError",
     "BudgetError",
     "ConfigError",
+    "ModelRangeError",
+    "ResourceLimitError",
     "BreakerError",
     "BreakerLimitError",
     "BreakerTimeoutError",
@@ -76,12 +78,23 @@ class ConfigError(ParameterError):
     """A configuration or system file cannot be read or has invalid content."""
 
 
+class ModelRangeError(ParameterError):
+    """A value lies outside the range where a formula or cost model holds (a key length below
+    the GNFS crossover, a security parameter above the supported bound, ...); the message names
+    the value and the range."""
+
+
+class ResourceLimitError(ParameterError):
+    """An input would need more time or memory than the package allows (a file above the size
+    bound, YAML aliases expanding past the node bound, an SDP too large to solve, a safe prime
+    too slow to generate, an episode or table too large to allocate); the message names the
+    estimate and the bound."""
 class BreakerError(SolverError):
     """A key breaker (:mod:`encctl_gym.cryptanalysis`) failed: no logarithm found, or a recovered
     exponent failed the check g^s = h (a breaker never returns an unchecked key)."""
 
 
-class BreakerLimitError(ParameterError):
+class BreakerLimitError(ResourceLimitError):
     """A group is too large for a breaker; refused before any work, naming the limit and the
     expected time."""
 

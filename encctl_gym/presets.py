@@ -26,14 +26,44 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._validation import format_value
 from .errors import ParameterError
+from .units import SECONDS_PER_YEAR
 
-__all__ = ["SystemPreset", "PRESETS", "get_preset", "preset_names", "SECONDS_PER_YEAR"]
+__all__ = [
+    "SystemPreset",
+    "PRESETS",
+    "get_preset",
+    "preset_names",
+    "SECONDS_PER_YEAR",
+    "FUGAKU_FLOPS",
+    "PAPER_DESIGN_PARAMETERS",
+    "PAPER_VARIANCES",
+    "PAPER_DESIGN_EXAMPLE",
+    "PAPER_REPORTED",
+    "DESIGN_FIELDS",
+    "design_defaults",
+]
 
-#: The paper's year: tau_c = 31536e4 s is 10 years of 365 days.
-SECONDS_PER_YEAR = 365 * 24 * 3600
+# --------------------------------------------------------------------------- the paper's constants
+# One home for every number the paper states (Section "Numerical Simulation"); the presets, the
+# ``design`` command, the security module and the experiments all read them from here.
+
 #: Supercomputer Fugaku, the paper's adversary computer (FLOPS).
 FUGAKU_FLOPS = 442e15
+#: The design parameters of the design example: gamma_c, tau_c = 10 years (s), Upsilon (FLOPS).
+PAPER_DESIGN_PARAMETERS: dict[str, float] = {"gamma_c": 1e-6, "tau_c": 31536e4, "upsilon": FUGAKU_FLOPS}
+#: Variances: the design example fixes only R_sigma = 100; these are Figure 1 (c)'s (same ratio),
+#: and sigma_x2 = 1 as in all of the paper's simulations.
+PAPER_VARIANCES: dict[str, float] = {"sigma_u2": 10.0, "sigma_w2": 0.1, "sigma_x2": 1.0}
+#: The design example from its Gramian traces (Psi_w = 2I, Psi_u = 0.5I, n = m = 4).
+PAPER_DESIGN_EXAMPLE: dict[str, float | int] = {
+    "tr_psi_u": 2, "tr_psi_w": 8, "m": 4, "n": 4, **PAPER_VARIANCES, **PAPER_DESIGN_PARAMETERS,
+}
+#: What the paper reports for its design example: shown beside computed values, never used to compute them.
+PAPER_REPORTED: dict[str, int] = {"N_star": 13159, "lam_star": 74, "k_star": 712}
+#: The design parameters a plant needs besides A and B.
+DESIGN_FIELDS: tuple[str, ...] = ("sigma_u2", "sigma_w2", "sigma_x2", "gamma_c", "tau_c", "upsilon")
 
 
 @dataclass(frozen=True)
@@ -46,10 +76,10 @@ class SystemPreset:
     B: np.ndarray
     sigma_w2: float
     sigma_u2: float
-    sigma_x2: float = 1.0
-    gamma_c: float = 1e-6
-    tau_c: float = 10 * SECONDS_PER_YEAR
-    upsilon: float = FUGAKU_FLOPS
+    sigma_x2: float = PAPER_VARIANCES["sigma_x2"]
+    gamma_c: float = PAPER_DESIGN_PARAMETERS["gamma_c"]
+    tau_c: float = PAPER_DESIGN_PARAMETERS["tau_c"]
+    upsilon: float = PAPER_DESIGN_PARAMETERS["upsilon"]
     extra: dict = field(default_factory=dict)
 
     @property
@@ -76,7 +106,7 @@ def _build() -> dict[str, SystemPreset]:
     presets["paper-example"] = SystemPreset(
         "paper-example",
         "design example of Section 'Numerical Simulation': Psi_w = 2I, Psi_u = 0.5I, R_sigma = 100",
-        A, B, sigma_w2=0.1, sigma_u2=10.0,
+        A, B, sigma_w2=PAPER_VARIANCES["sigma_w2"], sigma_u2=PAPER_VARIANCES["sigma_u2"],
     )
     variances = [0.1, 1.0, 10.0]
     letters = "abcdefghi"
@@ -118,8 +148,14 @@ def preset_names() -> list[str]:
 
 
 def get_preset(name: str) -> SystemPreset:
-    """Return the preset ``name``, raising :class:`ParameterError` for an unknown name."""
-    try:
-        return PRESETS[name]
-    except KeyError:
-        raise ParameterError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}") from None
+    """Return the preset ``name``, raising :class:`ParameterError` for an unknown name (or a non-string)."""
+    if not isinstance(name, str) or name not in PRESETS:
+        raise ParameterError(f"unknown preset {format_value(name)}; choose one of {', '.join(PRESETS)}")
+    return PRESETS[name]
+
+
+def design_defaults() -> dict[str, float]:
+    """The design parameters of the paper's design example (preset ``paper-example``), by
+    :data:`DESIGN_FIELDS`: the defaults of ``encctl-gym design`` and of plant files."""
+    p = PRESETS["paper-example"]
+    return {key: getattr(p, key) for key in DESIGN_FIELDS}

@@ -1,7 +1,9 @@
-"""Training with stable-baselines3: the VecEnv adapter, configs, train --quick, save/load/evaluate."""
+"""Training with stable-baselines3: the VecEnv adapter, train --quick end to end, what a run
+directory holds, save/load, the learning curve, the progress bar, evaluate RUN_DIR."""
 
 from __future__ import annotations
 
+import csv
 import json
 from pathlib import Path
 
@@ -10,16 +12,18 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from agents import GaussianAttacker, rollout
+from agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker, rollout
+from agents.curves import load_learning_curve, plot_learning_curves, reference_designs
 from agents.evaluate import budget_config
+from agents.runs import read_run
 from agents.sb3 import SB3Attacker, SB3VecEnv, load_attacker
-from agents.train import CONFIG_DIR, apply_override, load_config
 from encctl_gym import cli
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
-from encctl_gym.errors import ParameterError
+from encctl_gym.errors import ConfigError, ParameterError
 
 SMALL = {"preset": "small", "gamma_opt": False}
+PLANT = {"A": [[0.6, 0.2], [0.0, 0.5]], "B": [[1.0, 0.0], [0.3, 1.0]]}
 
 
 # ------------------------------------------------------------------ the VecEnv adapter
@@ -52,113 +56,186 @@ def test_sb3_vecenv_observation_modes_and_reward_scaling():
     full = SB3VecEnv(SMALL, 2, "full")
     blind = SB3VecEnv(SMALL, 2, "blind")
     scaled = SB3VecEnv(SMALL, 2, "full", reward_scaling="samples")
+    native = EncryptedLTIAttackVectorEnv(2, config=SMALL)
     p = full.params
     assert blind.observation_space.shape == (p.input_history * p.m + 2,)
     for v in (full, blind, scaled):
         v.seed(1)
         v.reset()
+    native.reset(seed=[1, 2])
     a = np.full((2, p.m), 0.2, dtype=np.float32)
     for _ in range(p.n + p.m + 3):
         o_full, r_full, _, _ = full.step(a)
         o_blind, _, _, _ = blind.step(a)
         _, r_scaled, _, _ = scaled.step(a)
+        *_, info = native.step(a)
     assert np.array_equal(o_blind, o_full[:, blind.obs_idx])
-    N = full.venv._core.delivered
-    assert np.allclose(r_scaled, r_full * N, rtol=1e-6)
+    assert np.allclose(r_scaled, r_full * info["samples_delivered"], rtol=1e-6)
     with pytest.raises(ParameterError):
         SB3VecEnv(SMALL, 2, "full", reward_scaling="bogus")
 
 
-# ------------------------------------------------------------------ configs
-@pytest.mark.parametrize("path", sorted(CONFIG_DIR.glob("*.yaml")), ids=lambda p: p.stem)
-def test_every_shipped_config_loads_and_builds_its_environment(path):
-    algo = path.stem.split("_")[0] if not path.stem.startswith("recurrent_ppo") else "recurrent_ppo"
-    for quick in (False, True):
-        cfg = load_config(algo, path=path, quick=quick)
-        assert cfg["n_timesteps"] > 0 and cfg["n_envs"] >= 1
-        venv = SB3VecEnv(dict(cfg["env"], gamma_opt=False), 1, cfg["observation"])
-        assert venv.observation_space.shape[0] >= 1
-    if cfg.get("horizon"):
-        from agents.train import _env_cfg
-
-        assert resolve_params(_env_cfg(cfg)).horizon == cfg["horizon"]
-
-
-def test_config_errors_and_overrides():
-    with pytest.raises(ParameterError):
-        load_config("dqn", "paper-example")
-    with pytest.raises(ParameterError):
-        load_config("ppo", "no-such-preset")
-    cfg = load_config("ppo", "paper-example")
-    apply_override(cfg, "hyperparams.learning_rate=1e-3")
-    apply_override(cfg, "hyperparams.policy_kwargs.net_arch={pi: [], vf: [8]}")
-    assert cfg["hyperparams"]["learning_rate"] == 1e-3
-    assert cfg["hyperparams"]["policy_kwargs"]["net_arch"] == {"pi": [], "vf": [8]}
-    with pytest.raises(ParameterError):
-        apply_override(cfg, "env.preset=nope")
-    with pytest.raises(ParameterError):
-        apply_override(cfg, "no_equals_sign")
-
-
-def test_cli_reports_a_bad_config_in_one_line(capsys, tmp_path):
-    assert cli.main(["train", "--algo", "ppo", "--preset", "no-such-preset", "--out", str(tmp_path)]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "no config" in err[0]
-
-
-# ------------------------------------------------------------------ train --quick
-def _check_run(run_dir: Path, algo: str, capsys) -> None:
-    for f in ("model.zip", "best_model.zip", "vecnormalize.pkl", "evaluations.npz", "run.json"):
-        assert (run_dir / f).exists(), f
-    assert any((run_dir / "tb").rglob("events.out.tfevents.*"))
-    meta = json.loads((run_dir / "run.json").read_text())
-    assert meta["algo"] == algo and meta["n_timesteps"] > 0 and meta["train_seconds"] > 0
-    ev = meta["final_evaluation"]
-    for which in ("gaussian", "final", "best"):
-        assert np.isfinite(ev[which]["mean_epsilon"]) and ev[which]["mean_epsilon"] > 0
-    # the learned policy ran through real ElGamal ciphertexts
-    assert "unavailable" not in ev["elgamal"], ev["elgamal"]
-    assert np.isfinite(ev["elgamal"]["mean_epsilon"]) and ev["elgamal"]["key_length"] <= 128
-    assert "ratio to gaussian" in capsys.readouterr().out
-
-    att = load_attacker(run_dir)
-    assert isinstance(att, SB3Attacker) and att.vecnormalize is not None and not att.vecnormalize.training
-    cfg = dict(meta["env"])
-    params = resolve_params(cfg)
-    r1 = rollout(att, cfg, episodes=3, seed=4, record=True)
-    r2 = rollout(load_attacker(run_dir), cfg, episodes=3, seed=4, record=True)
-    assert np.array_equal(r1.epsilon, r2.epsilon)  # loading and seeding reproduce the policy exactly
-    assert r1.epsilon.shape == (3, params.horizon) and np.all(np.isfinite(r1.final_epsilon))
-    # through a single environment too, inside the action space
-    import gymnasium as gym
-
-    from encctl_gym.envs import ENV_ID
-
-    env = gym.make(ENV_ID, config=cfg)
-    obs, _ = env.reset(seed=0)
-    att.reset(seed=0)
-    for _ in range(10):
-        a = att.act(obs)
-        assert env.action_space.contains(a)
-        obs, *_ = env.step(a)
-
-
-def test_train_quick_ppo_saves_loads_and_evaluates(tmp_path, capsys):
-    rc = cli.main(["train", "--algo", "ppo", "--preset", "paper-example", "--quick", "--out", str(tmp_path), "--no-progress"])
+# ------------------------------------------------------------------ train --quick on a plant file
+@pytest.fixture(scope="module")
+def ppo_run(tmp_path_factory) -> Path:
+    tmp = tmp_path_factory.mktemp("train")
+    plant = tmp / "plant2.json"
+    plant.write_text(json.dumps(PLANT))
+    rc = cli.main(["train", "--algo", "ppo", "--system", str(plant), "--quick", "--out", str(tmp / "runs"), "--no-progress",
+                   "--set", "env.sigma_w2=0.2", "--set", "horizon=64", "--n-timesteps", "1500"])
     assert rc == 0
-    run_dir = tmp_path / "ppo_paper-example_d0_full_s0-quick"
-    _check_run(run_dir, "ppo", capsys)
+    return tmp / "runs" / "ppo_plant2_d0_full_s0-quick"
 
 
-@pytest.mark.parametrize("algo", ["sac", "recurrent_ppo"])  # ~10 s each
-def test_train_quick_sac_and_recurrent_ppo(tmp_path, capsys, algo):
-    rc = cli.main(["train", "--algo", algo, "--preset", "paper-example", "--quick", "--out", str(tmp_path), "--no-progress"])
+def test_train_quick_writes_a_complete_run(ppo_run, capsys):
+    for f in ("model.zip", "best_model.zip", "vecnormalize.pkl", "evaluations.npz", "run.json", "learning_curve.npz",
+              "learning_curve.png"):
+        assert (ppo_run / f).exists(), f
+    assert (ppo_run / "learning_curve.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert any((ppo_run / "tb").rglob("events.out.tfevents.*"))
+    run = read_run(ppo_run)
+    meta = run.meta
+    assert run.algo == "ppo" and run.system == "plant2" and run.custom_plant and meta["status"] == "finished"
+    assert run.env["A"] == PLANT["A"] and run.env["sigma_w2"] == 0.2
+    # PPO collects whole rollouts (128 steps x 4 copies): 1500 requested -> 1536 done, and said so
+    assert meta["n_timesteps"] == 1500 and meta["timesteps_done"] == 1536
+    params = resolve_params(run.env)
+    assert params.horizon == 64 and np.array_equal(params.A, np.array(PLANT["A"]))
+
+
+def test_final_evaluation_numbers_are_reproduced_by_direct_rollouts(ppo_run):
+    """The Gaussian and learned errors recorded in run.json equal rollouts on the same seeds."""
+    meta = read_run(ppo_run).meta
+    ev = meta["final_evaluation"]
+    cfg = dict(read_run(ppo_run).env)
+    params = resolve_params(cfg)
+    g = rollout(GaussianAttacker(params), cfg, episodes=ev["episodes"], seed=ev["seed"], record=False)
+    assert ev["gaussian"]["mean_epsilon"] == g.mean_final()
+    for which in ("final", "best"):
+        r = rollout(load_attacker(ppo_run, which=which), cfg, episodes=ev["episodes"], seed=ev["seed"], record=False)
+        assert ev[which]["mean_epsilon"] == r.mean_final()
+        d = np.log(r.final_epsilon) - np.log(g.final_epsilon)
+        assert ev[which]["mean_log_ratio"] == pytest.approx(d.mean(), rel=1e-12)
+    el = ev["elgamal"]  # the learned policy ran through real ElGamal ciphertexts
+    assert el["key_length"] == 64 and el["N"] == 20 and np.isfinite(el["mean_epsilon"]) and el["mean_epsilon"] > 0
+
+
+def test_saved_and_loaded_policy_gives_identical_actions(ppo_run):
+    """Two loads of the saved run, reset with the same seed, act identically step by step
+    (the policy samples from torch's global generator, so the two play one after the other)."""
+    cfg = dict(read_run(ppo_run).env)
+
+    def play(att):
+        native = EncryptedLTIAttackVectorEnv(5, config=cfg)
+        obs, _ = native.reset(seed=3)
+        att.reset(seed=11)
+        acts = []
+        for _ in range(6):
+            acts.append(att.act(obs))
+            obs, *_ = native.step(acts[-1])
+        return np.stack(acts), obs
+
+    a1, a2 = load_attacker(ppo_run), load_attacker(ppo_run)
+    assert isinstance(a1, SB3Attacker) and not a1.vecnormalize.training
+    x1, obs = play(a1)
+    x2, _ = play(a2)
+    assert np.array_equal(x1, x2) and x1.shape == (6, 5, 2) and np.all(np.abs(x1) <= 1)
+    assert not np.array_equal(x1[0], x1[1])
+    # the deterministic policy is the mean: the same for any seed, and not the sampled action
+    d1 = load_attacker(ppo_run, deterministic=True)
+    d2 = load_attacker(ppo_run, deterministic=True)
+    d1.reset(seed=1)
+    d2.reset(seed=2)
+    assert np.array_equal(d1.act(obs), d2.act(obs))
+    a1.reset(seed=1)
+    assert not np.array_equal(a1.act(obs), d1.act(obs))
+
+
+def test_learning_curve_holds_the_evaluations_and_its_references(ppo_run, tmp_path):
+    curve = load_learning_curve(ppo_run)
+    meta = read_run(ppo_run).meta
+    ev = meta["config"]["eval"]
+    params = resolve_params(read_run(ppo_run).env)
+    design, gauss = reference_designs(params, "full")
+    assert design.kind == "closed_loop"
+    assert curve.N == 64 and curve.gamma_opt == design.gamma(64) and curve.gamma_gauss == gauss.gamma(64)
+    assert curve.gamma == params.gamma(64)
+    # one evaluation before training and one every eval.freq steps (2048 > 1536: none more)
+    assert list(curve.timesteps) == [0] and curve.epsilon.shape == (1, ev["episodes"])
+    assert np.all(curve.epsilon > 0)
+    r, lo, hi = curve.ratio()
+    assert r[0] == pytest.approx(curve.epsilon.mean() / design.gamma(64)) and lo[0] < r[0] < hi[0]
+    assert meta["learning_curve"]["last_ratio_to_gamma_opt"] == pytest.approx(r[-1])
+    # several runs in one figure
+    other = load_learning_curve(ppo_run)
+    other.seed = 1
+    other.append(1536, curve.epsilon[0] * 0.9)
+    png = plot_learning_curves([curve, other, ppo_run], tmp_path / "curves.png")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(ConfigError):
+        other.append(2000, np.ones(3))  # another number of episodes
+    (tmp_path / "broken.npz").write_bytes(b"nope")
+    with pytest.raises(ConfigError, match="cannot read learning curve"):
+        load_learning_curve(tmp_path / "broken.npz")
+
+
+def test_a_second_run_of_the_same_name_gets_a_new_directory_or_overwrites(ppo_run, tmp_path):
+    from agents.config import load_config
+    from agents.train import train
+
+    cfg = load_config("ppo", "small", quick=True)
+    cfg.update(n_timesteps=64, n_envs=2)
+    cfg["hyperparams"].update(n_steps=32, batch_size=64, n_epochs=1)
+    cfg["eval"].update(freq=10_000, episodes=2)
+    first = train(cfg, out=tmp_path, progress=False, tensorboard=False, name="r")
+    (first / "marker").write_text("old run")
+    second = train(cfg, out=tmp_path, progress=False, tensorboard=False, name="r")
+    assert second == tmp_path / "r-2" and (first / "marker").exists()
+    third = train(cfg, out=tmp_path, progress=False, tensorboard=False, name="r", overwrite=True)
+    assert third == first and not (first / "marker").exists() and (first / "model.zip").exists()
+
+
+def test_progress_bar_never_passes_its_total():
+    from stable_baselines3 import PPO
+
+    from agents.callbacks import ProgressCallback
+
+    seen: list[tuple[int, int]] = []
+
+    class Spy(ProgressCallback):
+        def _on_step(self) -> bool:
+            ok = super()._on_step()
+            seen.append((self.bar.n, self.bar.total))
+            return ok
+
+    venv = SB3VecEnv(SMALL, 4, "full")
+    model = PPO("MlpPolicy", venv, n_steps=16, batch_size=64, n_epochs=1, seed=0, device="cpu")
+    spy = Spy(100, "t")
+    model.learn(total_timesteps=100, callback=spy)
+    assert model.num_timesteps == 128  # two rollouts of 16 x 4
+    assert max(n for n, _ in seen) == 100 and all(n <= t for n, t in seen)
+    assert (spy.bar.n, spy.bar.total) == (128, 128)  # grown at the end to the steps really done
+
+
+@pytest.mark.parametrize("algo", ["sac", "recurrent_ppo"])
+def test_train_quick_sac_and_recurrent_ppo(tmp_path, algo):
+    rc = cli.main(["train", "--algo", algo, "--preset", "small", "--quick", "--out", str(tmp_path), "--no-progress",
+                   "--no-tensorboard", "--set", "eval.elgamal.episodes=0", "--set", "horizon=32"])
     assert rc == 0
     (run_dir,) = list(tmp_path.iterdir())
-    _check_run(run_dir, algo, capsys)
+    run = read_run(run_dir)
+    ev = run.meta["final_evaluation"]
+    cfg = dict(run.env)
+    g = rollout(GaussianAttacker(resolve_params(cfg)), cfg, episodes=ev["episodes"], seed=ev["seed"], record=False)
+    assert ev["gaussian"]["mean_epsilon"] == g.mean_final()
+    r = rollout(load_attacker(run_dir, which="final"), cfg, episodes=ev["episodes"], seed=ev["seed"], record=False)
+    assert ev["final"]["mean_epsilon"] == r.mean_final() and r.N[-1] == 32
+    assert "elgamal" not in ev
+    curve = load_learning_curve(run_dir)
+    assert curve.design_kind == ("open_loop" if algo == "recurrent_ppo" else "closed_loop")
 
 
-def test_recurrent_attacker_keeps_and_resets_its_state(tmp_path):
+def test_recurrent_attacker_keeps_and_resets_its_state():
     """A tiny RecurrentPPO model (not trained) wrapped as an attacker: the LSTM state is carried
     between steps, per copy, and cleared by reset."""
     from sb3_contrib import RecurrentPPO
@@ -179,7 +256,36 @@ def test_recurrent_attacker_keeps_and_resets_its_state(tmp_path):
     assert not np.array_equal(np.array(att._state[0]), h_before)  # the state moved on
     att.reset(seed=1)
     assert att._state is None
-    r = rollout(att, cfg, episodes=4, seed=0, record=False)
-    assert np.all(np.isfinite(r.final_epsilon))
-    g = rollout(GaussianAttacker(params), cfg, episodes=4, seed=0, record=False)
-    assert r.N[-1] == g.N[-1] == 20
+    r1 = rollout(att, cfg, episodes=4, seed=0, record=False)
+    r2 = rollout(att, cfg, episodes=4, seed=0, record=False)
+    assert np.array_equal(r1.final_epsilon, r2.final_epsilon)  # reset(seed) restarts the LSTM and the sampling
+
+
+# ------------------------------------------------------------------ evaluate RUN_DIR
+def test_evaluate_prints_the_compare_table_on_paired_seeds(ppo_run, tmp_path, capsys):
+    out = tmp_path / "ev"
+    rc = cli.main(["evaluate", str(ppo_run), "--episodes", "6", "--points", "2", "--seed", "7", "--out", str(out), "--no-progress"])
+    assert rc == 0
+    text = capsys.readouterr()
+    assert "warning" not in text.err
+    table = [line for line in text.out.splitlines() if line.startswith("| plant2 ")]
+    assert [line.split(" | ")[2] for line in table[:4]] == ["gaussian", "colored(rho=0.5)", "optimal-cl (oracle)", "ppo"]
+    with (out / "security.csv").open(newline="") as fh:
+        rows = {r["attacker"]: r for r in csv.DictReader(fh)}
+    cfg = budget_config({k: v for k, v in read_run(ppo_run).env.items() if k not in ("tau_c", "security_parameter")}, 64)
+    params = resolve_params(cfg)
+    for name, att in (("gaussian", GaussianAttacker(params)), ("colored(rho=0.5)", ColoredGaussianAttacker(params, 0.5)),
+                      ("optimal-cl", OptimalDesignAttacker(params))):
+        r = rollout(att, cfg, episodes=6, seed=7, record=False)
+        assert float(rows[name]["mean_error_at_horizon"]) == pytest.approx(r.mean_final(), rel=1e-12), name
+    learned = rollout(load_attacker(ppo_run, which="best", params=params), cfg, episodes=6, seed=7, record=False)
+    assert float(rows["ppo"]["mean_error_at_horizon"]) == pytest.approx(learned.mean_final(), rel=1e-12)
+    g = rollout(GaussianAttacker(params), cfg, episodes=6, seed=7, record=False)
+    ratio = np.exp(np.mean(np.log(learned.final_epsilon) - np.log(g.final_epsilon)))
+    assert float(rows["ppo"]["ratio_to_gaussian"]) == pytest.approx(ratio, rel=1e-12)
+    assert int(rows["ppo"]["horizon"]) == 64
+    assert cli.main(["evaluate", str(ppo_run), "--episodes", "2", "--points", "1", "--deterministic", "--out", str(out),
+                     "--no-progress"]) == 0
+    assert "warning: --deterministic" in capsys.readouterr().err
+    assert cli.main(["evaluate", str(ppo_run), "--delays", "end"]) == 2
+    assert "cannot play with decipher_delay 'end'" in capsys.readouterr().err

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import json
-import time
+import math
 
 import gmpy2
 import numpy as np
 import pytest
 
-from encctl_gym.crypto import arith, group as group_mod
+from encctl_gym.crypto import arith
 from encctl_gym.crypto.arith import (
     PowmodCounter,
     RandomSource,
@@ -25,14 +25,17 @@ from encctl_gym.crypto.arith import (
 )
 from encctl_gym.crypto.elgamal import keygen
 from encctl_gym.crypto.group import (
+    DEFAULT_MAX_GENERATION_SECONDS,
     MIN_GENERATE_BITS,
     SHIPPED_BITS,
     GroupParams,
+    estimate_generation_seconds,
     generate_safe_prime_group,
     get_group,
     shipped_group,
+    sieve_window,
 )
-from encctl_gym.errors import EncctlError, GroupError, ParameterError
+from encctl_gym.errors import EncctlError, GroupError, ParameterError, ResourceLimitError
 
 # Toy group used for known answers (hand-checked):
 #   p = 23 = 2 * 11 + 1, q = 11, g = 4 = 2^2.
@@ -69,7 +72,6 @@ def test_is_prime_and_jacobi():
     # The Legendre symbol mod 23 is +1 exactly on G.
     assert {m for m in range(1, 23) if jacobi(m, 23) == 1} == TOY_G
     assert arith.legendre(5, 23) == -1
-    assert arith.bit_length(23) == 5
 
 
 def test_seeded_random_is_reproducible_and_uniform():
@@ -128,6 +130,8 @@ def test_group_accepts_mpz_and_hex_and_stores_ints():
         (23, 11, 1, "1 < g < p"),  # g = 1
         (23, 11, 23, "1 < g < p"),
         (23, 1, 4, "q must be"),
+        (23, 2, 22, "q must be an odd prime"),  # G = {1, 22}: the only key s = 1 is public
+        (5, 2, 4, "q must be an odd prime"),
         (3, 2, 2, "p must be"),
         ("x", 11, 4, "integer"),
         (23.5, 11, 4, "integer"),
@@ -211,11 +215,9 @@ def test_generate_progress_goes_to_stderr(capsys):
 
 
 @pytest.mark.parametrize("bits", [712, pytest.param(1024, marks=pytest.mark.slow)])
-def test_generation_takes_seconds_not_minutes(bits):
-    t0 = time.perf_counter()
-    grp = generate_safe_prime_group(bits, rng=11)
-    _assert_safe_prime_group(grp, bits)
-    assert time.perf_counter() - t0 < 30.0
+def test_generation_at_key_sizes(bits):
+    # Its time against estimate_generation_seconds: benchmarks/bench_crypto.py.
+    _assert_safe_prime_group(generate_safe_prime_group(bits, rng=11), bits)
 
 
 @pytest.mark.slow
@@ -237,16 +239,16 @@ def test_shipped_groups_are_safe_prime_groups_and_verify_fast():
         grp = shipped_group(bits)
         _assert_safe_prime_group(grp, bits)
         assert get_group(bits) == grp
-    # Verification from scratch (cache cleared) of the largest group is well under 2 s,
-    # and the cached verification is instant.
+    # Verification from scratch exponentiates once (g^q; the primality tests are not counted),
+    # a cached verification not at all (its time: benchmarks/bench_crypto.py).
     big = shipped_group(2048)
-    group_mod._VERIFIED.discard((big.p, big.q, big.g))
-    t0 = time.perf_counter()
-    big.verify()
-    assert time.perf_counter() - t0 < 2.0
-    t0 = time.perf_counter()
-    shipped_group(2048)
-    assert time.perf_counter() - t0 < 0.05
+    with PowmodCounter() as c:
+        assert big.verify(recheck=True) is big
+    assert c.count == 1
+    with PowmodCounter() as c:
+        shipped_group(2048)
+        big.verify()
+    assert c.count == 0
     with pytest.raises(ParameterError, match="no shipped group of 100 bits"):
         shipped_group(100)
 
@@ -261,3 +263,100 @@ def test_errors_are_package_errors():
         GroupParams(27, 13, 4).verify()
     with pytest.raises(ValueError):  # GroupError is also a ValueError
         GroupParams(27, 13, 4).verify()
+
+
+# ---------------------------------------------------------------------------- generation: bounded by an estimate
+def test_sieve_strikes_exactly_the_candidates_with_small_factors():
+    limit, q0, n = 200, (1 << 40) + 1, 3000
+    primes = [ell for ell in range(3, limit) if is_prime(ell)]
+    kept = set(sieve_window(q0, n, limit).tolist())
+    for k in range(n):
+        q = q0 + 2 * k
+        has_small = any(q % ell == 0 or (2 * q + 1) % ell == 0 for ell in primes)
+        assert (k in kept) == (not has_small), k
+
+
+def test_sieve_survival_matches_the_product_of_the_estimate():
+    # The estimate keeps the fraction prod_l (1 - 2/l) of the candidates; count in real windows.
+    limit = 1 << 16
+    primes = np.array([ell for ell in range(3, limit) if is_prime(ell)], dtype=float)
+    expected = float(np.prod(1.0 - 2.0 / primes))
+    src = seeded_random(4)
+    kept = sum(sieve_window(src.between(1 << 500, 1 << 501) | 1, 1 << 14, limit).size for _ in range(20))
+    frac = kept / (20 * (1 << 14))
+    assert abs(frac - expected) < 5 * (expected / (20 * (1 << 14))) ** 0.5 + 0.03 * expected
+
+
+def test_sophie_germain_density_used_by_the_estimate():
+    """Hardy-Littlewood: Sophie Germain primes q near x have density 4 C2 / (ln x ln 2x) among odd q."""
+    x0, n = 1 << 30, 100_000
+    count = sum(1 for k in range(n) if is_prime(x0 + 1 + 2 * k) and is_prime(2 * (x0 + 1 + 2 * k) + 1))
+    expected = n * 4 * 0.6601618158468696 / (math.log(x0) * math.log(2 * x0))
+    assert abs(count - expected) < 4 * expected**0.5 + 0.05 * expected  # ~590 expected
+
+
+def test_generation_estimate_grows_with_bits_and_is_finite_for_any_size():
+    sizes = [16, 64, 256, 512, 712, 1024, 1536, 2048, 2538, 3072, 4096, 8192, 2_560_000]
+    est = [estimate_generation_seconds(b) for b in sizes]
+    assert all(0 < e < math.inf for e in est)
+    assert all(a < b for a, b in zip(est[2:], est[3:]))  # increasing from where the powmod dominates
+    assert est[-1] > 1e9  # the 2.56-million-bit prime of the issue
+    with pytest.raises(ParameterError, match="bits"):
+        estimate_generation_seconds(8)
+
+
+def test_generation_is_refused_before_it_starts_when_the_estimate_exceeds_the_limit():
+    big = estimate_generation_seconds(4096)
+    refusals = [
+        (lambda: generate_safe_prime_group(2_560_000), r"2560000-bit safe-prime group is estimated to take"),
+        (lambda: get_group(2_560_000), "max_seconds = 60 s"),
+        (lambda: keygen(2_560_000, rng=1), "max_seconds = 60 s"),
+        (lambda: generate_safe_prime_group(4096), f"{big:.3g} s"),
+        (lambda: generate_safe_prime_group(3000, max_seconds=1.0), "3000-bit"),
+    ]
+    with PowmodCounter() as counter:
+        for call, match in refusals:
+            with pytest.raises(ResourceLimitError, match=match):
+                call()
+    assert counter.count == 0  # refused before the search started (no Fermat test ran)
+    assert DEFAULT_MAX_GENERATION_SECONDS == 60.0
+    for bad in (0.0, -1.0, math.nan, math.inf, "60"):
+        with pytest.raises(ParameterError, match="max_seconds"):
+            generate_safe_prime_group(64, max_seconds=bad)
+    # Within the limit it runs as before.
+    _assert_safe_prime_group(generate_safe_prime_group(96, rng=1, max_seconds=1.0), 96)
+
+
+def test_int_seed_of_generation_is_keyed_by_the_purpose_group():
+    assert generate_safe_prime_group(80, rng=9) == generate_safe_prime_group(80, rng=seeded_random(9, "group"))
+    assert generate_safe_prime_group(80, rng=9) != generate_safe_prime_group(80, rng=seeded_random(9))
+
+
+def test_error_messages_survive_integers_beyond_the_int_to_str_limit():
+    big = 10**5000 + 1  # 5001 decimal digits; str(big) raises ValueError in Python >= 3.11
+    assert arith.format_int(23) == "23" and arith.format_int(-(2**255)) == str(-(2**255))
+    assert arith.format_int(big).endswith("(16610 bits)") and arith.format_int("x") == "'x'"
+    with pytest.raises(GroupError, match=r"p has 16610 bits, more than MAX_GROUP_BITS = 16384"):
+        GroupParams(big, 5, 4)
+    composite = 10**1000 + 1  # 3322 bits, composite; p - 1 = 10^1000 is divisible by 5
+    with pytest.raises(GroupError, match=r"p is not prime: p = 0x[0-9a-f]+\.\.\.[0-9a-f]+ \(3322 bits\)"):
+        GroupParams(composite, 5, 4).verify()
+    with pytest.raises(GroupError, match=r"q = 11 does not divide p - 1 = 0x.*\(3322 bits\)"):
+        GroupParams(composite, 11, 4)
+    with pytest.raises(GroupError, match=r"declared bits = 0x.*\(16610 bits\)"):
+        GroupParams.from_dict({"p": composite, "q": 5, "g": 4, "bits": big})
+    with pytest.raises(GroupError, match="invalid group JSON: Exceeds the limit"):
+        GroupParams.from_json('{"p": ' + "9" * 5000 + ', "q": 5, "g": 4}')
+    with pytest.raises(GroupError, match=r"\(100001 characters\)"):
+        GroupParams("9" * 100_001, 5, 4)  # beyond int()'s digit limit too
+    # Sizes beyond any float: the estimate is infinite, generation refused at once.
+    assert estimate_generation_seconds(10**400) == math.inf
+    with pytest.raises(ResourceLimitError, match="estimated to take inf s"):
+        generate_safe_prime_group(10**400)
+    with pytest.raises(GroupError, match="fields"):
+        GroupParams.from_dict([big])
+    with pytest.raises(ParameterError, match="no inverse"):
+        invert(big - 1, big - 1)
+    with pytest.raises(ParameterError, match=r"rng=0x.*\(16610 bits\)"):
+        arith.as_random_stream(big, "encrypt")
+    assert "16610 bits" in repr(seeded_random(big))

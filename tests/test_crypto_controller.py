@@ -1,4 +1,6 @@
-"""Tests of the encrypted linear controller of eq:ec (crypto.controller)."""
+"""Tests of the encrypted linear controller of eq:ec (crypto.controller and its parties:
+crypto.quantized, crypto.servers, crypto.plant_side, crypto.schemes) and of the forging of
+injected inputs (attacks.forgery)."""
 
 from __future__ import annotations
 
@@ -12,16 +14,12 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from encctl_gym.crypto.arith import PowmodCounter, RandomSource, seeded_random
-from encctl_gym.crypto.controller import (
-    ControllerServer,
-    EncryptedLinearController,
-    PlantCryptoSide,
-    QuantizedLinearController,
-    TokenControllerServer,
-    forge_injection,
-    forge_injection_token,
-    injection_value,
-)
+from encctl_gym.attacks.forgery import forge, forge_injection, forge_injection_token, injection_value
+from encctl_gym.crypto.controller import EncryptedLinearController
+from encctl_gym.crypto.plant_side import PlantParty, StaticPlant
+from encctl_gym.crypto.quantized import QuantizedLinearController
+from encctl_gym.crypto.schemes import SCHEMES
+from encctl_gym.crypto.servers import ControllerServer, StaticControllerServer, TokenControllerServer
 from encctl_gym.crypto.dyn_elgamal import UpdateToken, key_update, recover_next_secret_key
 from encctl_gym.crypto.elgamal import Ciphertext, SecretKey, decrypt, encrypt, keygen
 from encctl_gym.crypto.encoding import Encoder
@@ -77,10 +75,10 @@ def test_encrypted_equals_quantized_bit_for_bit(phi, seed, log_delta, scheme, bi
 
 def test_two_key_decryption_matches_modified_decrypt():
     ctrl = EncryptedLinearController(PHI, G128, 2.0**12, 10.0, rng=1)
-    sk0 = ctrl.plant._sk0
+    sk0 = ctrl.plant.initial_secret_key
     for t in range(3):
         x = _x(t)
-        sk_t = ctrl.plant._sk
+        sk_t = ctrl.plant.secret_key
         ct_x = ctrl.plant.encrypt_state(x)
         out = ctrl.server.evaluate(ct_x)
         fast = ctrl.plant.decrypt_products(out)
@@ -126,7 +124,7 @@ def test_keys_advance_and_eavesdropper_view():
 
 
 # ---------------------------------------------------------------------------- no secrets on the server
-_SECRET_TYPES = (SecretKey, UpdateToken, RandomSource, PlantCryptoSide, EncryptedLinearController)
+_SECRET_TYPES = (SecretKey, UpdateToken, RandomSource, PlantParty, EncryptedLinearController)
 
 
 def _reachable(root):
@@ -157,14 +155,14 @@ def _secrets_reachable(server, secret_ints):
 def test_server_holds_no_secret_key_or_token(scheme):
     ctrl = EncryptedLinearController(PHI, G128, 2.0**12, 10.0, scheme=scheme, rng=4)
     plant = ctrl.plant
-    secret_ints = {plant._sk0.s}
+    secret_ints = {plant.initial_secret_key.s}
     tokens = []
     original = plant.update_keys
 
     def recording_update():
         tok = original()
         tokens.append(tok)
-        secret_ints.update({plant._sk.s, tok.d})
+        secret_ints.update({plant.secret_key.s, tok.d})
         return tok
 
     plant.update_keys = recording_update
@@ -187,7 +185,7 @@ def test_server_holds_no_secret_key_or_token(scheme):
 def test_token_scheme_malicious_server_reads_all_later_states():
     """Proposition prop:vulnerability end to end: one broken key + tokens = every later state."""
     ctrl = EncryptedLinearController(PHI, G128, 2.0**12, 10.0, scheme="token", rng=5)
-    stolen = ctrl.plant._sk  # the server breaks sk_0 once
+    stolen = ctrl.plant.secret_key  # the server breaks sk_0 once
     for t in range(6):
         x = _x(t)
         ctrl.step(x)
@@ -195,7 +193,7 @@ def test_token_scheme_malicious_server_reads_all_later_states():
         got = [decrypt(stolen, c) for c in ctrl.last_state_ciphertexts]
         assert [m if m <= G128.half else m - G128.p for m in got] == expected
         stolen = recover_next_secret_key(stolen, ctrl.server.last_token)
-    assert stolen == ctrl.plant._sk
+    assert stolen == ctrl.plant.secret_key
 
 
 # ---------------------------------------------------------------------------- overflow and bad input
@@ -240,7 +238,7 @@ def test_step_bad_input(x, err, match):
 
 def test_constructor_bad_input():
     with pytest.raises(ParameterError, match="scheme"):
-        EncryptedLinearController(PHI, G64, 2.0**10, 10.0, scheme="static")
+        EncryptedLinearController(PHI, G64, 2.0**10, 10.0, scheme="rsa")
     with pytest.raises(ParameterError, match="delta"):
         EncryptedLinearController(PHI, G64, 0.0, 10.0)
     with pytest.raises(ParameterError, match="x_bound"):
@@ -261,16 +259,16 @@ def test_server_rejects_bad_state_ciphertexts():
     with pytest.raises(CiphertextError, match="expected 4 state ciphertexts, got 3"):
         ctrl.server.evaluate(cts[:3])
     with pytest.raises(CiphertextError, match="expected an ElGamal Ciphertext"):
-        ctrl.server.evaluate(cts[:3] + [ModifiedCiphertext(4, 4, 4)])
+        ctrl.server.evaluate(cts[:3] + [ModifiedCiphertext(G64, 4, 4, 4)])
     with pytest.raises(CiphertextError, match="outside"):
-        ctrl.server.evaluate(cts[:3] + [Ciphertext(G64.p + 1, 4)])
+        ctrl.server.evaluate(cts[:3] + [Ciphertext(G64, G64.p + 1, 4)])
     with pytest.raises(CiphertextError, match="rectangular"):
         ControllerServer(ctrl.pk0, [[cts[0]], [cts[0], cts[1]]])
     with pytest.raises(CiphertextError, match="matrix"):
         ControllerServer(ctrl.pk0, 5)
     token = EncryptedLinearController(PHI, G64, 2.0**10, 10.0, scheme="token", rng=8)
     with pytest.raises(KeyMismatchError, match="token is for step t = 5"):
-        token.server.receive_token(UpdateToken(4, 1, 5))
+        token.server.receive_token(UpdateToken(G64, 4, 1, 5))
     old = token.plant.encrypt_state(_x(1))
     token.step(_x(1))
     with pytest.raises(KeyMismatchError, match="state ciphertext is of step t = 0"):
@@ -331,33 +329,57 @@ def test_injection_bad_input():
         injection_value([1.0], ctrl.encoder, 0)
     # Forged with a stale public key: the plant detects the wrong step.
     ctrl.step(_x(0))
-    stale = forge_injection(ctrl.pk0, ctrl.pk0, np.ones(4), ctrl.encoder, 4, 1)
+    stale = forge_injection(ctrl.pk0, ctrl.pk0, np.ones(4), ctrl.encoder, 4, seeded_random(1))
     with pytest.raises(KeyMismatchError, match=r"\(t1, t2\) = \(0, 0\)"):
         ctrl.step(_x(1), inject=stale)
     # Wrong shape or type.
-    good = forge_injection(ctrl.pk0, ctrl.pk, np.ones(4), ctrl.encoder, 4, 1)
+    good = forge_injection(ctrl.pk0, ctrl.pk, np.ones(4), ctrl.encoder, 4, seeded_random(1))
     with pytest.raises(CiphertextError, match="shape"):
         ctrl.step(_x(1), inject=[row[:3] for row in good])
     with pytest.raises(CiphertextError, match="ModifiedCiphertext"):
-        ctrl.step(_x(1), inject=[[Ciphertext(4, 4)] * 4] * 4)
+        ctrl.step(_x(1), inject=[[Ciphertext(G64, 4, 4)] * 4] * 4)
     bad = [list(r) for r in good]
-    bad[2][1] = ModifiedCiphertext(good[2][1].c1, good[2][1].c2, 0, 0, ctrl.t)
+    bad[2][1] = ModifiedCiphertext(G64, good[2][1].c1, good[2][1].c2, 0, 0, ctrl.t)
     with pytest.raises(CiphertextError, match="c3 = 0"):
         ctrl.step(_x(1), inject=bad)
 
 
 # ---------------------------------------------------------------------------- quantized twin
-def test_quantized_batch_matches_single():
-    ref = QuantizedLinearController(PHI, Encoder(G128, 2.0**14), 10.0)
-    X = np.random.default_rng(0).uniform(-10, 10, (7, 4))
-    batch = ref.compute_batch(X)
-    assert batch.shape == (7, 4)
-    for k in range(7):
-        assert np.array_equal(batch[k], ref.compute(X[k]))
-    with pytest.raises(ParameterError, match="shape"):
-        ref.compute_batch(X[:, :3])
-    with pytest.raises(EncodingOverflowError):
-        ref.compute_batch(X * 2)
+def test_every_scheme_pairs_its_plant_and_server_and_forgery():
+    """The registry's parties run the loop for every scheme; static keys never change and the
+    forged output of each scheme decodes to injection_value."""
+    assert set(SCHEMES) == {"modified", "token", "static"}
+    a = np.array([0.5, -1.0, 2.0, 0.0])
+    for name, scheme in SCHEMES.items():
+        ctrl = EncryptedLinearController(PHI, G128, 2.0**12, 10.0, scheme=name, rng=3)
+        assert isinstance(ctrl.plant, scheme.plant)
+        pk0 = ctrl.pk0
+        for t in range(3):
+            assert np.array_equal(ctrl.step(_x(t)), ctrl.reference(_x(t)))
+        assert (ctrl.pk == pk0) == (name == "static") and (ctrl.t == 0) == (name == "static")
+        forged = forge(name, ctrl.pk0, ctrl.pk, a, ctrl.encoder, 4, seeded_random(2))
+        assert np.array_equal(ctrl.step(_x(5), inject=forged), injection_value(a, ctrl.encoder, 4))
+    static = EncryptedLinearController(PHI, G128, 2.0**12, 10.0, scheme="static", rng=3)
+    assert type(static.server) is StaticControllerServer and isinstance(static.plant, StaticPlant)
+    assert static.plant.update_keys() is None
+
+
+@pytest.mark.parametrize("scheme", ["modified", "token"])
+def test_per_entry_forgery_hides_the_input_and_decodes_the_same(scheme):
+    """With one randomness per matrix the entries that encrypt Ecd(0)^2 = 1 carry the mask, so
+    an onlooker divides it out and reads Ecd(a_i) Ecd(1); with per_entry=True the masks differ."""
+    ctrl = EncryptedLinearController(PHI, G128, 2.0**12, 10.0, scheme=scheme, rng=5)
+    a = np.array([1.25, -0.5, 0.0, 3.0])
+    p = G128.p
+    last = (lambda c: c.c3) if scheme == "modified" else (lambda c: c.c2)
+    for per_entry in (False, True):
+        out = forge(scheme, ctrl.pk0, ctrl.pk, a, ctrl.encoder, 4, seeded_random(7), per_entry=per_entry)
+        masks = {last(c) for row in out for c in row[1:]}  # entries that encrypt the known 1
+        read = [last(row[0]) * pow(last(row[1]), -1, p) % p for row in out]
+        truth = [w % p for w in (ctrl.encoder.encode_signed(float(ai)) * ctrl.encoder.encode_signed(1.0) for ai in a)]
+        assert (read == truth) == (not per_entry)
+        assert (len(masks) == 1) == (not per_entry)
+        assert np.array_equal(ctrl.step(_x(per_entry), inject=out), injection_value(a, ctrl.encoder, 4))
 
 
 @pytest.mark.parametrize("bits", [712])
@@ -369,6 +391,6 @@ def test_encrypted_controller_at_712_bits(bits):
             x = _x(t, bound=100.0)
             assert np.array_equal(ctrl.step(x), ctrl.reference(x))
         a = np.array([1.5, -2.25, 0.0, 7.0])
-        forged = (forge_injection(ctrl.pk0, ctrl.pk, a, ctrl.encoder, 4, 1) if scheme == "modified"
-                  else forge_injection_token(ctrl.pk, a, ctrl.encoder, 4, 1))
+        forged = (forge_injection(ctrl.pk0, ctrl.pk, a, ctrl.encoder, 4, seeded_random(1)) if scheme == "modified"
+                  else forge_injection_token(ctrl.pk, a, ctrl.encoder, 4, seeded_random(1)))
         assert np.array_equal(ctrl.step(_x(9), inject=forged), injection_value(a, ctrl.encoder, 4))

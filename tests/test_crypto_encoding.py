@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from encctl_gym.crypto.arith import PowmodCounter
+from encctl_gym.crypto.arith import PowmodCounter, seeded_random
 from encctl_gym.crypto.elgamal import decrypt, encrypt, keygen
 from encctl_gym.crypto.encoding import (
     DEFAULT_MAX_SHIFT,
@@ -22,7 +22,7 @@ from encctl_gym.crypto.encoding import (
     nearest_member,
 )
 from encctl_gym.crypto.group import GroupParams, shipped_group
-from encctl_gym.errors import EncodingOverflowError, ParameterError, PlaintextError
+from encctl_gym.errors import EncodingOverflowError, GroupError, ParameterError, PlaintextError
 
 TOY = GroupParams(23, 11, 4)  # G = {1, 2, 3, 4, 6, 8, 9, 12, 13, 16, 18}
 G64, G128 = shipped_group(64), shipped_group(128)
@@ -106,7 +106,7 @@ def test_shift_statistics_are_small():
 def test_membership_uses_jacobi_not_powmod_for_safe_primes():
     enc = Encoder(shipped_group(712), 2.0**16)
     with PowmodCounter() as c:
-        enc.encode_array(np.linspace(-5, 5, 101))
+        enc.encode_signed_array(np.linspace(-5, 5, 101))
     assert c.count == 0
 
 
@@ -126,7 +126,7 @@ def test_other_cofactor_uses_powmod_membership():
         assert abs(enc.decode(m) - x) <= 0.5 + 6
     # Full ElGamal round trip in that group.
     pk, sk = keygen(grp, 4)
-    assert decrypt(sk, encrypt(pk, enc.encode(-3), 5)) == enc.encode(-3)
+    assert decrypt(sk, encrypt(pk, enc.encode(-3), seeded_random(5))) == enc.encode(-3)
     with pytest.raises(ParameterError, match="cofactor"):
         q = 1009
         n = next(n for n in range(2000, 4000, 2) if gmpy2.is_prime(n * q + 1))
@@ -136,14 +136,11 @@ def test_other_cofactor_uses_powmod_membership():
 def test_vectorised_matches_scalar():
     enc = Encoder(G128, 1000.0)
     X = np.array([[0.1234, -5.0, 0.0], [1e-9, -1e-3, 7.77]])
-    M = enc.encode_array(X)
     W = enc.encode_signed_array(X)
-    assert M.shape == X.shape and M.dtype == object
+    assert W.shape == X.shape and W.dtype == object
     for idx in np.ndindex(X.shape):
-        assert M[idx] == enc.encode(X[idx]) and W[idx] == enc.encode_signed(X[idx])
-        assert M[idx] == W[idx] % G128.p
-    assert np.array_equal(enc.decode_array(M), np.vectorize(enc.decode)(M).astype(float))
-    assert np.array_equal(enc.decode_signed_array(W), enc.decode_array(M))
+        assert W[idx] == enc.encode_signed(X[idx]) and W[idx] % G128.p == enc.encode(X[idx])
+        assert enc.decode_signed_array(W)[idx] == enc.decode(enc.encode(X[idx]))
     assert np.array_equal(enc.quantize_array(X), np.vectorize(enc.quantize)(X))
     assert enc.decode(enc.encode(2.0) * enc.encode(3.0) % G128.p, power=2) == pytest.approx(6.0, abs=1e-2)
 
@@ -162,7 +159,7 @@ def test_overflow_is_never_silent():
     with pytest.raises(EncodingOverflowError, match=r"x = 100.5 is outside the declared input range \|x\| <= 100.0"):
         enc.encode(100.5)
     with pytest.raises(EncodingOverflowError, match="x = -1000.0"):
-        enc.encode_array([1.0, -1000.0])
+        enc.encode_signed_array([1.0, -1000.0])
     # Without a declared bound, the representable range of the group is the limit.
     free = Encoder(G64, 2.0**40)
     limit = (G64.half - free.max_shift) / 2.0**40
@@ -184,7 +181,7 @@ def test_non_finite_inputs_raise_parameter_error(bad):
         enc.encode(bad)
     if bad is not None and not isinstance(bad, (str, bool)):
         with pytest.raises(ParameterError, match="finite"):
-            enc.encode_array([0.0, bad])
+            enc.encode_signed_array([0.0, bad])
 
 
 @pytest.mark.parametrize("delta", [0, -1.0, float("nan"), float("inf"), "2", None])
@@ -206,3 +203,85 @@ def test_bad_encoder_arguments():
         decode_int(TOY, 23)
     with pytest.raises(PlaintextError, match="integer"):
         decode_int(TOY, 2.0)
+
+
+# ---------------------------------------------------------------------------- bad input, arrays and powers
+@pytest.mark.parametrize("x", [
+    [1.0, 2.0 + 3.0j],
+    np.array([1.0, 2.0], dtype=np.complex128),  # complex even with a zero imaginary part
+    np.array([[0.5 + 0.5j]]),
+])
+def test_complex_arrays_are_refused_not_truncated(x):
+    enc = Encoder(G64, 2.0**10)
+    with pytest.raises(ParameterError, match="complex"):
+        enc.encode_signed_array(x)
+    with pytest.raises(ParameterError, match="complex"):
+        enc.quantize_array(x)
+    with pytest.raises(ParameterError, match="real number"):
+        enc.encode(2.0 + 3.0j)
+
+
+@pytest.mark.parametrize("x, match", [
+    (np.array([True, False]), "dtype bool"),
+    (["1.0", "2.0"], "dtype <U3"),
+    ([1.0, "a"], "dtype <U32"),
+    ([[1.0, 2.0], [3.0]], "numeric"),  # ragged
+    (np.array([1.0, None], dtype=object), "real numbers, got None"),
+    (np.array([1.0, True], dtype=object), "real numbers, got True"),
+    (np.array([1.0, 10**400], dtype=object), "too large for a float"),
+])
+def test_non_numeric_arrays_are_refused(x, match):
+    enc = Encoder(G64, 2.0**10)
+    with pytest.raises((ParameterError, EncodingOverflowError), match=match):
+        enc.encode_signed_array(x)
+
+
+def test_object_arrays_of_real_numbers_are_accepted():
+    enc = Encoder(G64, 2.0**10)
+    mixed = np.array([1, 2.5, np.float32(-0.75), Fraction(1, 4), gmpy2.mpz(3)], dtype=object)
+    w = enc.encode_signed_array(mixed)
+    assert list(w) == [enc.encode_signed(float(v)) for v in mixed]
+
+
+@pytest.mark.parametrize("power", [0, -1, 3, 1.0, 2.5, True, "2", None])
+def test_decode_power_is_one_or_two(power):
+    enc = Encoder(G64, 2.0**10)
+    m = enc.encode(1.5)
+    with pytest.raises(ParameterError, match="power must be one of"):
+        enc.decode(m, power=power)
+    with pytest.raises(ParameterError, match="power must be one of"):
+        enc.decode_signed(12, power=power)
+    with pytest.raises(ParameterError, match="power must be one of"):
+        enc.decode_signed_array([12, 13], power=power)
+    # An encoded value at power 1, the product of two at power 2 (exact quotients).
+    w1, w2 = enc.encode_signed(1.5), enc.encode_signed(-2.0)
+    assert enc.decode(m, power=1) == float(Fraction(w1, 1024))
+    assert enc.decode_signed(w1 * w2, power=2) == float(Fraction(w1 * w2, 1024**2))
+    assert enc.decode(m, power=np.int64(1)) == enc.decode(m)
+
+
+@pytest.mark.parametrize("shift", [-5, -1, 65, 2.5, "1", True])
+def test_error_bound_needs_a_possible_shift(shift):
+    enc = Encoder(G64, 2.0**10)  # max_shift = 64
+    with pytest.raises(ParameterError, match="shift"):
+        enc.error_bound(shift)
+
+
+def test_error_bound_known_values():
+    enc = Encoder(G64, 4.0)
+    assert enc.error_bound(0) == 0.125 and enc.error_bound(3) == 3.5 / 4
+    assert enc.error_bound() == (0.5 + 64) / 4 and enc.error_bound(64) == enc.error_bound()
+
+
+def test_encoder_needs_a_verified_group_and_huge_values_give_one_line_errors():
+    with pytest.raises(GroupError, match="p is not prime"):
+        Encoder(GroupParams(27, 13, 4), 1.0)  # Jacobi symbols modulo a composite would lie
+    with pytest.raises(GroupError):
+        encode_int(GroupParams(27, 13, 4), 3)
+    enc = Encoder(G64, 2.0**10)
+    with pytest.raises(EncodingOverflowError, match=r"x = 0x[0-9a-f]+\.\.\.[0-9a-f]+ \(1329 bits\) is too large"):
+        enc.encode(10**400)
+    with pytest.raises(EncodingOverflowError, match="too large"):
+        Encoder(G64, 2.0**10, x_bound=10**400)
+    with pytest.raises(PlaintextError, match=r"\(66439 bits\)"):
+        decode_int(G64, 10**20000)  # more than Python's 4300-digit limit of int-to-str

@@ -63,15 +63,15 @@ def test_elgamal_known_answers_toy_group():
     assert (pk.h, sk.s, pk.t) == (18, 3, 0)
     # Enc(9; r = 5): c1 = 4^5 = 12, c2 = 9 * 18^5 = 9 * 4^15 = 9 * 4^4 = 9 * 3 = 27 = 4.
     ct1 = encrypt(pk, 9, Fixed(5))
-    assert ct1 == Ciphertext(12, 4, 0)
+    assert ct1 == Ciphertext(TOY, 12, 4, 0)
     # Dec: 12^-3 = 4^-15 = 4^7 = 8; 8 * 4 = 32 = 9.
     assert decrypt(sk, ct1) == 9
     # Enc(2; r = 1): (4, 2 * 18 = 36 = 13).
     ct2 = encrypt(pk, 2, Fixed(1))
-    assert ct2 == Ciphertext(4, 13, 0)
+    assert ct2 == Ciphertext(TOY, 4, 13, 0)
     # Eval: (12 * 4 = 48 = 2, 4 * 13 = 52 = 6); Dec: 2^-3 = 4^-18 = 4^4 = 3; 3 * 6 = 18 = 9 * 2.
     ct = mult(pk, ct1, ct2)
-    assert ct == Ciphertext(2, 6, 0)
+    assert ct == Ciphertext(TOY, 2, 6, 0)
     assert decrypt(sk, ct) == 18
 
 
@@ -84,7 +84,7 @@ def test_dyn_elgamal_known_answers_toy_group():
     assert (tok.h, tok.d, tok.t) == (18, 4, 0)
     # CtUpd with r = 2: c1' = 12 * 4^2 = 192 = 8; c2' = 8^4 * 4 * 18^2 = 2 * 4 * 2 = 16.
     ct1 = ciphertext_update(pk, ct, tok, Fixed(2))
-    assert ct1 == Ciphertext(8, 16, 1)
+    assert ct1 == Ciphertext(TOY, 8, 16, 1)
     # Dec with s' = 7: 8^-7 = 4^-49 = 4^-5 = 4^6 = 2; 2 * 16 = 32 = 9.
     assert decrypt(sk1, ct1) == 9
     # Proposition prop:vulnerability: s + d = 3 + 4 = 7.
@@ -96,10 +96,10 @@ def test_modified_known_answers_toy_group():
     pk1, sk1, _ = key_update(pk0, sk0, Fixed(7))
     ct1 = encrypt(pk0, 9, Fixed(5))  # (12, 4), step 0
     ct2 = encrypt(pk1, 2, Fixed(1))  # (4, 2 * 8 = 16), step 1
-    assert ct2 == Ciphertext(4, 16, 1)
+    assert ct2 == Ciphertext(TOY, 4, 16, 1)
     # Eval_bar: (12, 4, 4 * 16 = 64 = 18).
     mct = modified_eval(pk0, ct1, ct2)
-    assert mct == ModifiedCiphertext(12, 4, 18, 0, 1)
+    assert mct == ModifiedCiphertext(TOY, 12, 4, 18, 0, 1)
     # c~ = 4^-7 * 18 = 4^4 * 18 = 3 * 18 = 54 = 8; m = 12^-3 * 8 = 8 * 8 = 64 = 18 = 9 * 2.
     assert modified_decrypt(sk0, sk1, mct) == 18
 
@@ -185,7 +185,7 @@ def test_modified_theorem(seed, t, k, x1, x2, big):
         with pytest.raises(KeyMismatchError, match="same time step"):
             mult(pk_t, encrypt(pk_t, m1, rng), encrypt(pk_tk, m2, rng))
         a, b = encrypt(pk_t, m1, rng), encrypt(pk_tk, m2, rng)
-        raw = mult(pk_t, Ciphertext(a.c1, a.c2), Ciphertext(b.c1, b.c2))
+        raw = mult(pk_t, Ciphertext(grp, a.c1, a.c2), Ciphertext(grp, b.c1, b.c2))
         if sk_t.s != sk_tk.s:
             assert decrypt(SecretKey(grp, sk_tk.s), raw) != m1 * m2 % grp.p
 
@@ -223,11 +223,11 @@ def test_encrypt_rejects_bad_plaintexts(m, match):
 
 
 @pytest.mark.parametrize("ct, match", [
-    (Ciphertext(0, 4), "c1 = 0 is outside"),
-    (Ciphertext(12, 23), "c2 = 23 is outside"),
-    (Ciphertext(5, 4), "c1 = 5 is not in the subgroup"),
-    (Ciphertext(12, 7), "c2 = 7 is not in the subgroup"),
-    (ModifiedCiphertext(12, 4, 18), "expected an ElGamal Ciphertext"),
+    (Ciphertext(TOY, 0, 4), "c1 = 0 is outside"),
+    (Ciphertext(TOY, 12, 23), "c2 = 23 is outside"),
+    (Ciphertext(TOY, 5, 4), "c1 = 5 is not in the subgroup"),
+    (Ciphertext(TOY, 12, 7), "c2 = 7 is not in the subgroup"),
+    (ModifiedCiphertext(TOY, 12, 4, 18), "expected an ElGamal Ciphertext"),
     ((12, 4), "expected an ElGamal Ciphertext"),
 ])
 def test_decrypt_rejects_bad_ciphertexts(ct, match):
@@ -235,24 +235,29 @@ def test_decrypt_rejects_bad_ciphertexts(ct, match):
     with pytest.raises(CiphertextError, match=match):
         decrypt(sk, ct)
     with pytest.raises(CiphertextError):
-        mult(pk, ct, Ciphertext(12, 4))
+        mult(pk, ct, Ciphertext(TOY, 12, 4))
 
 
 def test_ciphertext_construction_rejects_non_integers():
     with pytest.raises(CiphertextError, match="c1 must be an integer"):
-        Ciphertext("12", 4)
+        Ciphertext(TOY, "12", 4)
     with pytest.raises(CiphertextError, match="time step"):
-        Ciphertext(12, 4, -1)
+        Ciphertext(TOY, 12, 4, -1)
     with pytest.raises(CiphertextError, match="c3 must be an integer"):
-        ModifiedCiphertext(12, 4, 1.5)
+        ModifiedCiphertext(TOY, 12, 4, 1.5)
+    # The group comes first, as in PublicKey(group, h, t): the old (c1, c2, t) order is refused.
+    with pytest.raises(CiphertextError, match="group must be a GroupParams"):
+        Ciphertext(12, 4, 0)
+    with pytest.raises(CiphertextError, match="group must be a GroupParams"):
+        ModifiedCiphertext(12, 4, 18, 0, 1)
 
 
 def test_modified_decrypt_rejects_two_component_ciphertext():
     _, sk = keygen(TOY, 1)
     with pytest.raises(CiphertextError, match="ModifiedCiphertext"):
-        modified_decrypt(sk, sk, Ciphertext(12, 4))
+        modified_decrypt(sk, sk, Ciphertext(TOY, 12, 4))
     with pytest.raises(CiphertextError, match="c3 = 5 is not in the subgroup"):
-        modified_decrypt(sk, sk, ModifiedCiphertext(12, 4, 5))
+        modified_decrypt(sk, sk, ModifiedCiphertext(TOY, 12, 4, 5))
 
 
 def test_wrong_time_step_is_detected():
@@ -278,7 +283,7 @@ def test_wrong_time_step_is_detected():
     with pytest.raises(KeyMismatchError, match="c1 is of step t = 0, sk1 is of step t = 1"):
         modified_decrypt(sk1, sk2, mct)
     # Without recorded steps nothing can be detected and Dec simply returns another element.
-    bare = Ciphertext(ct0.c1, ct0.c2)
+    bare = Ciphertext(G64, ct0.c1, ct0.c2)
     assert decrypt(sk0, bare) == 4 and decrypt(sk1, bare) != 4
 
 
@@ -288,20 +293,20 @@ def test_keys_from_another_group_are_rejected():
     with pytest.raises(KeyMismatchError, match="different groups"):
         key_update(pk_a, sk_b)
     with pytest.raises(KeyMismatchError, match="different groups"):
-        modified_decrypt(sk_a, sk_b, ModifiedCiphertext(4, 4, 4))
-    # A 128-bit ciphertext is outside [1, p) of the 64-bit group.
-    ct_b = encrypt(pk_b, 2**100 % G128.p, 1)
-    with pytest.raises(CiphertextError, match="outside"):
+        modified_decrypt(sk_a, sk_b, ModifiedCiphertext(G64, 4, 4, 4))
+    # A ciphertext knows its group: decrypting it under a key of another group is refused.
+    ct_b = encrypt(pk_b, 2**100 % G128.p, seeded_random(1))
+    with pytest.raises(KeyMismatchError, match="belongs to the group"):
         decrypt(sk_a, ct_b)
     # A public key element that is not in the group.
     with pytest.raises(KeyMismatchError, match="not an element of the group"):
         PublicKey(TOY, 5)
     with pytest.raises(KeyMismatchError, match="token h = 5"):
-        ciphertext_update(keygen(TOY, 1)[0], Ciphertext(12, 4), UpdateToken(5, 1))
+        UpdateToken(TOY, 5, 1)
     with pytest.raises(ParameterError, match="PublicKey"):
         encrypt(sk_a, 4)
     with pytest.raises(ParameterError, match="SecretKey"):
-        decrypt(pk_a, Ciphertext(4, 4))
+        decrypt(pk_a, Ciphertext(G64, 4, 4))
 
 
 def test_secret_key_and_token_repr_hide_secrets():
@@ -313,12 +318,15 @@ def test_secret_key_and_token_repr_hide_secrets():
         SecretKey(TOY, 11)
 
 
-def test_int_seed_restarts_the_stream_but_a_source_does_not():
-    # Documented behaviour: an int seed makes a fresh seeded source per call.
+def test_int_seed_is_refused_by_encrypt_but_a_stream_is_fresh():
+    # Documented rule (crypto.arith): Enc draws a fresh r at every call, so a bare int seed,
+    # which would repeat r, is refused; one seeded stream gives fresh numbers at each call.
     pk, _ = keygen(G64, 1)
-    assert encrypt(pk, 4, 5) == encrypt(pk, 4, 5)
+    with pytest.raises(ParameterError, match=r"rng=seeded_random\(5\)"):
+        encrypt(pk, 4, 5)
     rng = seeded_random(5)
     assert encrypt(pk, 4, rng) != encrypt(pk, 4, rng)
+    assert encrypt(pk, 4, seeded_random(5)) == encrypt(pk, 4, seeded_random(5))  # reproducible
 
 
 def test_keygen_accepts_bits_and_secure_rng():

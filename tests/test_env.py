@@ -12,7 +12,7 @@ import pytest
 import encctl_gym  # noqa: F401  (registers the environment)
 from encctl_gym.envs import ENV_ID, EncryptedLTIAttackEnv, resolve_params
 from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
-from encctl_gym.errors import BudgetError, EncctlError, ParameterError, ShapeError, UnstableSystemError
+from encctl_gym.errors import BudgetError, ParameterError, ResourceLimitError, ShapeError, UnstableSystemError
 
 SMALL = {"preset": "small", "gamma_opt": False}
 
@@ -40,6 +40,7 @@ def random_actions(rng, n_steps, m, scale=0.3):
         {"decipher_delay": 3},
         {"decipher_delay": "end"},
         {"reward": "logdet"},
+        {"reward": "a_optimality", "decipher_delay": "end"},
         {"warmup_steps": 5},
         {"scheme": "token", "adversary": "server", "max_samples": 40},
         {"scheme": "static", "max_samples": 40},
@@ -84,19 +85,23 @@ def test_seed_reproduces_episode_exactly():
 # ------------------------------------------------------------------ information flow
 @pytest.mark.parametrize("delay", [0, 1, 4, "end"])
 def test_observations_never_contain_undelivered_data(delay):
-    """Change the plant's future after step s0: observations up to step s0 + d are unchanged."""
+    """Change the plant's future after step s0 (the replayed noise from w_{s0} on): observations
+    up to step s0 + d are unchanged."""
     cfg = {**SMALL, "decipher_delay": delay}
     s0 = 15
     acts = random_actions(np.random.default_rng(3), 200, 2)
+    p = resolve_params(cfg)
+    draws = np.random.default_rng(12)
+    x0, noise = draws.normal(size=p.n), draws.normal(0.0, np.sqrt(p.sigma_w2), (p.warmup_steps + p.horizon, p.n))
 
     def trajectory(perturb):
         env = EncryptedLTIAttackEnv(config=cfg)
-        env.reset(seed=11)
+        w = noise.copy()
+        if perturb:
+            w[s0:] += 5.0  # every noise sample from step s0 on changes
+        env.reset(seed=11, options={"x0": x0, "noise": w})
         obs_list = []
-        for k, a in enumerate(acts):
-            if k == s0 and perturb:
-                core = env._core
-                core._noise[core._noise_pos :] += 5.0  # every future noise sample changes
+        for a in acts:
             obs, _, te, tr, _ = env.step(a)
             obs_list.append(obs)
             if te or tr:
@@ -112,6 +117,29 @@ def test_observations_never_contain_undelivered_data(delay):
         assert not np.array_equal(base[s0 + d], changed[s0 + d])
     else:
         assert not np.array_equal(base[-1], changed[-1])
+
+
+def test_replayed_draws_give_the_drawn_episode_and_bad_options_raise():
+    """reset(options={"x0", "noise"}) with the values the generator would draw reproduces the
+    drawn episode bit for bit; wrong shapes, non-finite values and unknown keys are errors."""
+    env = EncryptedLTIAttackEnv(config=SMALL)
+    p = env.params
+    acts = random_actions(np.random.default_rng(4), p.horizon, p.m)
+    drawn, _, _ = run_episode(env, acts, seed=3)
+    g = np.random.default_rng(3)
+    x0 = g.standard_normal(p.n) * np.sqrt(p.sigma_x2)
+    w = g.standard_normal((p.warmup_steps + p.horizon, p.n)) * np.sqrt(p.sigma_w2)
+    obs, info = env.reset(seed=99, options={"x0": x0, "noise": w})
+    replay = [(obs, 0.0, info)] + [env.step(a)[:3:2] for a in acts]
+    assert all(np.array_equal(a[0], b[0]) for a, b in zip(drawn, replay))
+    with pytest.raises(ShapeError, match="noise"):
+        env.reset(seed=0, options={"noise": w[:-1]})
+    with pytest.raises(ShapeError, match="x0"):
+        env.reset(seed=0, options={"x0": np.zeros(p.n + 1)})
+    with pytest.raises(ParameterError, match="x0"):
+        env.reset(seed=0, options={"x0": np.full(p.n, np.nan)})
+    with pytest.raises(ParameterError, match="w0"):
+        env.reset(seed=0, options={"w0": w})
 
 
 def test_end_delay_delivers_nothing_before_the_end():
@@ -171,14 +199,17 @@ def test_energy_budget_is_enforced_and_reported():
     env.reset(seed=0)
     full = np.ones(p.m, dtype=np.float32)  # 16 sigma_u2 per channel: 16 times the allowed power
     while True:
-        _, _, te, tr, info = env.step(full)
+        obs, _, te, tr, info = env.step(full)
         if te or tr:
             break
     assert info["input_energy"] == pytest.approx(p.energy_budget, rel=1e-12)
     assert info["average_power"] == pytest.approx(p.sigma_u2, rel=1e-12)
-    # after the budget is spent the injected input is zero: the plant applies the quantised 0
+    # after the budget is spent the injected input is zero: the plant applies the quantised 0,
+    # and that is the input the last delivered sample reports
     zero = env.loop.inject(np.zeros((1, p.m)))[0]
-    assert np.array_equal(env._core.U[-1, 0], zero) and np.abs(zero).max() < 2 / p.delta
+    _, inputs = env.episode.delivered_data()
+    assert np.array_equal(inputs[0, -1], zero) and np.abs(zero).max() < 2 / p.delta
+    assert np.array_equal(obs[p.layout.input], zero.astype(np.float32))
 
 
 def test_log_error_return_telescopes():
@@ -195,8 +226,7 @@ def test_log_error_return_telescopes():
 
 
 def test_final_epsilon_equals_batch_least_squares():
-    from encctl_gym.sim.identification import least_squares
-    from encctl_gym.security.complexity import estimation_error
+    from encctl_gym.ident import estimation_error, least_squares
 
     env = EncryptedLTIAttackEnv(config=SMALL)
     env.reset(seed=2)
@@ -204,8 +234,9 @@ def test_final_epsilon_equals_batch_least_squares():
         _, _, te, tr, info = env.step(env.action_space.sample() * 0.3)
         if te or tr:
             break
-    core = env._core
-    A_hat, B_hat = least_squares(core.X[:, 0], core.U[:, 0])
+    states, inputs = env.episode.delivered_data()
+    assert states.shape == (1, env.params.horizon, env.params.n) and inputs.shape[1] == env.params.horizon - 1
+    A_hat, B_hat = least_squares(states[0], inputs[0])
     assert info["epsilon"] == pytest.approx(estimation_error(env.params.A, env.params.B, A_hat, B_hat), rel=1e-8)
 
 
@@ -219,7 +250,7 @@ def test_a_constant_input_gets_the_minimum_norm_estimate_every_step():
     single = EncryptedLTIAttackEnv(config=SMALL)
     venv.reset(seed=7)
     single.reset(seed=7)
-    p, core = venv.params, venv._core
+    p, core = venv.params, venv.episode
     d = p.n + p.m
     theta = np.hstack([p.A, p.B])
     for _ in range(p.horizon):
@@ -228,8 +259,9 @@ def test_a_constant_input_gets_the_minimum_norm_estimate_every_step():
         assert np.array_equal(obs_v[0], obs) and r_v[0] == r and info_v["epsilon"][0] == info["epsilon"]
         N = info["samples_delivered"]
         if N - 1 >= d:
-            Z = np.hstack([core.X[: N - 1, 0], core.U[: N - 1, 0]])
-            th = np.linalg.lstsq(Z, core.X[1:N, 0], rcond=np.sqrt(d * np.finfo(float).eps))[0].T
+            X, U = core.delivered_data()
+            Z = np.hstack([X[0, : N - 1], U[0]])
+            th = np.linalg.lstsq(Z, X[0, 1:N], rcond=np.sqrt(d * np.finfo(float).eps))[0].T
             assert info["epsilon"] == pytest.approx(np.sum((th - theta) ** 2) / theta.size, rel=1e-6)
         if te or tr:
             break
@@ -251,7 +283,7 @@ def test_vector_env_matches_single_envs_bit_for_bit(gamma_opt):
         acts = random_actions(rng, K, venv.params.m)
         obs_v, r_v, te_v, tr_v, info_v = venv.step(acts)
         for i, e in enumerate(singles):
-            if e._core.done:
+            if e.episode.done:
                 obs, info = e.reset()
                 r, te = 0.0, False
             else:
@@ -371,12 +403,6 @@ def test_state_outside_declared_range_raises_overflow():
                 env.step(env.action_space.sample())
 
 
-def test_errors_belong_to_the_hierarchy():
-    assert issubclass(BudgetError, EncctlError) and issubclass(UnstableSystemError, EncctlError)
-    p = resolve_params(SMALL)
-    assert p.horizon >= p.n + p.m + 1
-
-
 def test_both_backends_refuse_a_state_outside_x_bound_at_the_same_step():
     from encctl_gym.errors import EncodingOverflowError
 
@@ -396,7 +422,7 @@ def test_both_backends_refuse_a_state_outside_x_bound_at_the_same_step():
 def test_parallel_vector_env_gives_the_same_numbers():
     from encctl_gym.envs import _kernels
 
-    K = 2 * _kernels._CHUNK + 3  # three tasks, one of them short
+    K = 2 * _kernels.PARALLEL_CHUNK + 3  # three tasks, one of them short
     serial = EncryptedLTIAttackVectorEnv(num_envs=K, config=SMALL)
     parallel = EncryptedLTIAttackVectorEnv(num_envs=K, config=SMALL, parallel=True)
     o1, _ = serial.reset(seed=5)
@@ -409,19 +435,17 @@ def test_parallel_vector_env_gives_the_same_numbers():
         assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1]) and np.array_equal(a[2], b[2])
 
 
-def test_helper_thread_gives_the_same_numbers_through_refreshes_and_early_resets(monkeypatch):
+def test_helper_thread_gives_the_same_numbers_through_refreshes_and_early_resets():
     """The helper thread (noise drawn ahead, Gram catch-up) changes where work runs, not the
     numbers: a vector env with it matches single envs without it, step for step, through noise
     chunks, Gram hand-overs, exact refreshes, the episode end and resets in mid-episode."""
-    from encctl_gym.envs import episode
+    from encctl_gym.envs.episode import EpisodeSchedule
 
-    monkeypatch.setattr(episode, "_CHUNK", 16)  # many chunk, hand-over and refresh boundaries
-    monkeypatch.setattr(episode, "_GRAM_BATCH", 4)
-    monkeypatch.setattr(episode, "_REFRESH", 40)
+    schedule = EpisodeSchedule(chunk=16, gram_batch=4, refresh=40)  # many chunk, hand-over and refresh boundaries
     K, cfg = 4, {**SMALL, "scheme": "static", "max_samples": 150}
-    venv = EncryptedLTIAttackVectorEnv(num_envs=K, config=cfg, helper_thread=True)
-    singles = [EncryptedLTIAttackEnv(config=cfg) for _ in range(K)]
-    assert venv._core._use_helper and not singles[0]._core._use_helper
+    venv = EncryptedLTIAttackVectorEnv(num_envs=K, config=cfg, helper_thread=True, schedule=schedule)
+    singles = [EncryptedLTIAttackEnv(config=cfg, schedule=schedule) for _ in range(K)]
+    assert venv.helper is not None and singles[0].episode.helper is None
     obs_v, _ = venv.reset(seed=7)
     obs_s = [e.reset(seed=7 + i)[0] for i, e in enumerate(singles)]
     rng = np.random.default_rng(1)
@@ -434,14 +458,16 @@ def test_helper_thread_gives_the_same_numbers_through_refreshes_and_early_resets
         acts = random_actions(rng, K, venv.params.m)
         obs_v, r_v, te_v, _, info_v = venv.step(acts)
         for i, e in enumerate(singles):
-            if e._core.done:
+            if e.episode.done:
                 obs, _ = e.reset()
-                r, eps = 0.0, e._core.eps[0]
+                r, eps = 0.0, e.episode.eps[0]
             else:
                 obs, r, _, _, info = e.step(acts[i])
                 eps = info["epsilon"]
             assert np.array_equal(obs_v[i], obs) and r_v[i] == r and info_v["epsilon"][i] == eps, f"step {step}"
+    assert venv.helper.started
     venv.close()
+    assert not venv.helper.started
 
 
 def test_a_vector_env_with_the_helper_busy_can_be_pickled_and_copied():
@@ -465,13 +491,11 @@ def test_helper_thread_works_in_a_forked_child():
     """A child forked after the parent used the helper thread starts its own."""
     import multiprocessing as mp
 
-    from encctl_gym.envs import episode
-
     venv = EncryptedLTIAttackVectorEnv(num_envs=2, config=LONG, helper_thread=True)
     venv.reset(seed=0)
     for _ in range(300):  # past a noise chunk: the parent's helper thread has run
         venv.step(np.zeros((2, venv.params.m), np.float32))
-    assert episode._helper_pool is not None and venv.params.horizon == 600
+    assert venv.helper.started and venv.params.horizon == 600
     child = mp.get_context("fork").Process(target=_step_past_a_chunk)
     child.start()
     child.join(120)
@@ -490,3 +514,82 @@ def _step_past_a_chunk() -> None:
     for _ in range(300):
         venv.step(np.zeros((2, venv.params.m), np.float32))
     venv.close()
+
+
+# ------------------------------------------------------------------ hardening (issue 16 classes)
+@pytest.mark.parametrize(
+    "overrides,error,text",
+    [
+        ({"gamma_opt": "no"}, ParameterError, "gamma_opt"),
+        ({"gamma_opt": 1}, ParameterError, "gamma_opt"),
+        ({"preset": ["small"]}, ParameterError, "preset"),
+        ({"decipher_delay": np.array([1, 2])}, ParameterError, "decipher_delay"),
+        ({"scheme": ["modified"]}, ParameterError, "scheme"),
+        ({"warmup_steps": 10**9}, ParameterError, "warmup_steps"),
+        ({"input_history": 10**9}, ParameterError, "GiB"),
+        ({"scheme": "static", "max_samples": 10**12}, ParameterError, "GiB"),
+    ],
+)
+def test_bad_values_are_refused_before_any_work(overrides, error, text):
+    with pytest.raises(error, match=text):
+        EncryptedLTIAttackEnv(config={**SMALL, **overrides})
+
+
+def test_a_config_that_is_not_a_mapping_is_a_config_error():
+    from encctl_gym.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="abc"):
+        EncryptedLTIAttackEnv(config="abc")
+
+
+def test_a_huge_batch_is_refused_with_its_memory_estimate():
+    with pytest.raises(ParameterError, match=r"num_envs = 1000000 .* GiB"):
+        EncryptedLTIAttackVectorEnv(num_envs=10**6, config=SMALL)
+
+
+def test_step_before_reset_and_bool_seeds_are_refused():
+    env = EncryptedLTIAttackEnv(config=SMALL)
+    with pytest.raises(ParameterError, match="before reset"):
+        env.step(np.zeros(2, np.float32))
+    with pytest.raises(ParameterError, match="seed"):
+        env.reset(seed=True)
+    venv = EncryptedLTIAttackVectorEnv(num_envs=2, config=SMALL)
+    with pytest.raises(ParameterError, match="seed"):
+        venv.reset(seed=[0, True])
+    with pytest.raises(ParameterError, match="seed"):
+        venv.reset(seed=-1)
+
+
+@pytest.mark.parametrize("action", [["a", "b"], [1 + 2j, 0.0], np.array([0.5 + 0.1j, 0.0]), None])
+def test_non_numeric_and_complex_actions_are_refused(action):
+    env = EncryptedLTIAttackEnv(config=SMALL)
+    env.reset(seed=0)
+    with pytest.raises(ParameterError, match="action"):
+        env.step(action)
+
+
+def test_a_tiny_logdet_regularization_still_gives_finite_rewards():
+    env = EncryptedLTIAttackEnv(config={**SMALL, "reward": "logdet", "logdet_regularization": 1e-300})
+    env.reset(seed=0)
+    rewards = [env.step(env.action_space.sample())[1] for _ in range(20)]
+    assert all(math.isfinite(r) for r in rewards)
+
+
+def test_a_users_plant_is_not_completed_from_the_default_preset():
+    A, B = [[0.5, 0.0], [0.1, 0.4]], [[1.0], [0.5]]
+    with pytest.raises(ParameterError) as err:
+        resolve_params({"A": A, "B": B})
+    for key in ("sigma_w2", "sigma_u2", "upsilon", "tau_c", "gamma_c"):
+        assert key in str(err.value)  # every missing value named at once
+    full = {"A": A, "B": B, "sigma_w2": 0.1, "sigma_u2": 1.0, "upsilon": 1e9, "tau_c": 1e3, "gamma_c": 1e-3, "key_length": 64}
+    p = resolve_params(full)
+    assert p.sources["sigma_x2"] == "default" and p.sources["A"] == "config" and p.sources["tau_c"] == "config"
+    with pytest.warns(UserWarning, match="preset 'small'.*sigma_w2"):
+        q = resolve_params({"preset": "small", "A": A, "B": B, "gamma_opt": False})
+    assert q.sources["sigma_w2"] == "preset small" and q.sources["A"] == "config"
+
+
+@pytest.mark.parametrize("x_bound", [1e5, 1e6])
+def test_a_quantisation_table_too_large_is_refused_with_its_size(x_bound):
+    with pytest.raises(ResourceLimitError, match="x_bound"):
+        EncryptedLTIAttackEnv(config={**SMALL, "x_bound": x_bound})

@@ -9,12 +9,19 @@ import scipy.optimize
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from encctl_gym.errors import ParameterError, SolverError, UnstableSystemError
+from encctl_gym._validation import format_value
+from encctl_gym.errors import (
+    ParameterError,
+    ResourceLimitError,
+    SolverError,
+    UnstableSystemError,
+)
 from encctl_gym.security.attack_design import (
     gamma_opt,
     gaussian_attack_design,
     optimal_attack_design,
     robust_security_design,
+    sdp_estimate,
 )
 from encctl_gym.security.complexity import sic_asymptotic_from_traces
 from encctl_gym.security.design import paper_design_example, sample_size_for_rate
@@ -214,3 +221,49 @@ def test_feedback_can_beat_open_loop_slightly() -> None:
     M = cl.Sigma.copy()
     M[:3, :3] -= noise_gramian(A)
     assert np.linalg.eigvalsh(M).min() < -1e-5  # not realisable without feedback (min eig about -4e-5)
+
+
+# --------------------------------------------------------------------------- hardening (bad input gets a clear error)
+@pytest.mark.parametrize("bad", ["no", "False", 0, 1, None, [True], np.array([True])])
+def test_feedback_must_be_a_bool(bad: object) -> None:
+    A, B = np.array([[0.5]]), np.array([[1.0]])
+    with pytest.raises(ParameterError, match="feedback must be True or False") as info:
+        optimal_attack_design(A, B, sigma_u2=1, sigma_w2=1, feedback=bad)
+    assert format_value(bad) in str(info.value)
+    with pytest.raises(ParameterError, match="feedback"):
+        gamma_opt(5, A, B, sigma_u2=1, sigma_w2=1, feedback=bad)
+    assert optimal_attack_design(A, B, sigma_u2=1, sigma_w2=1, feedback=np.bool_(False)).kind == "open_loop"
+
+
+def test_robust_design_refuses_a_design_made_for_other_values() -> None:
+    A, B = np.array([[0.5, 0.1], [0.0, 0.3]]), np.array([[1.0], [0.5]])
+    kw = dict(gamma_c=1e-3, tau_c=1e6, upsilon=1e12)
+    for kind, feedback in (("closed_loop", True), ("open_loop", False)):
+        made = optimal_attack_design(A, B, sigma_u2=1, sigma_w2=1, feedback=feedback)
+        assert robust_security_design(A, B, sigma_u2=1, sigma_w2=1, kind=kind, design=made, **kw).method == kind
+        with pytest.raises(ParameterError, match="sigma_u2 = 1.0, not sigma_u2 = 2.0"):
+            robust_security_design(A, B, sigma_u2=2, sigma_w2=1, kind=kind, design=made, **kw)
+        with pytest.raises(ParameterError, match="sigma_w2"):
+            robust_security_design(A, B, sigma_u2=1, sigma_w2=0.5, kind=kind, design=made, **kw)
+        with pytest.raises(ParameterError, match="does not fit this plant"):
+            robust_security_design(0.5 * A, B, sigma_u2=1, sigma_w2=1, kind=kind, design=made, **kw)
+    g = gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1)
+    with pytest.raises(ParameterError, match="does not fit this plant"):
+        robust_security_design(A, 2 * B, sigma_u2=1, sigma_w2=1, kind="gaussian", design=g, **kw)
+    with pytest.raises(ParameterError, match="AttackDesign"):
+        robust_security_design(A, B, sigma_u2=1, sigma_w2=1, kind="gaussian", design="gaussian", **kw)
+
+
+def test_large_sdp_refused_before_solving_with_an_estimate() -> None:
+    # n + m = 60 > 48: refused at once (the solve would take about a minute and 3 GB)
+    n = m = 30
+    A, B = 0.5 * np.eye(n), np.ones((n, m)) / n
+    with pytest.raises(ResourceLimitError, match="n \\+ m = 60") as info:
+        optimal_attack_design(A, B, sigma_u2=1, sigma_w2=1)
+    secs, gb = sdp_estimate(60)
+    assert f"{secs:.3g} s" in str(info.value) and f"{gb:.3g} GB" in str(info.value)
+    assert secs > sdp_estimate(56)[0] and sdp_estimate(56) == (40.0, 1.6)
+    with pytest.raises(ParameterError, match="max_dimension"):
+        optimal_attack_design(A, B, sigma_u2=1, sigma_w2=1, max_dimension=1)
+    # the closed-form Gaussian design has no such limit
+    assert gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1).Sigma.shape == (60, 60)

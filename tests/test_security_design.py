@@ -10,12 +10,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from encctl_gym.errors import ParameterError
+from encctl_gym._validation import format_value
+from encctl_gym.errors import ModelRangeError, ParameterError
 from encctl_gym.security.complexity import sic_asymptotic_from_traces, sic_from_traces
 from encctl_gym.security.deciphering import sample_deciphering_time_exact
 from encctl_gym.security.design import (
     PAPER_EXAMPLE,
     bit_security_of_key_length,
+    design_for_sample_size,
     design_from_traces,
     design_security_parameter,
     exact_optimal_sample_size,
@@ -103,7 +105,7 @@ def test_exact_and_asymptotic_can_differ() -> None:
     # x = (m+n)/(gamma_c K) with frac(x) < delta = sigma_x2 tr_w / (sigma_w2 K): N* differs by one.
     # m = n = 1, tr_u = 0, tr_w = 1, R = 1: K = 2, x = 1/gamma_c; gamma_c = 1/10.05 -> x = 10.05
     # delta = sigma_x2 / (sigma_w2 * 2) = 0.5 with sigma_w2 = sigma_u2 = 1, sigma_x2 = 1.
-    kw = dict(sigma_u2=1, sigma_w2=1, sigma_x2=1, gamma_c=Fraction(20, 201), tau_c=1, upsilon=2**20)
+    kw = dict(sigma_u2=1, sigma_w2=1, sigma_x2=1, gamma_c=Fraction(20, 201), tau_c=1, upsilon=2**40)
     a = design_from_traces(0, 1, 1, 1, method="asymptotic", **kw)
     e = design_from_traces(0, 1, 1, 1, method="exact", **kw)
     assert (a.N_star, e.N_star) == (12, 11)
@@ -159,7 +161,7 @@ def test_theorem_is_minimal(tr_u, tr_w, m, n, r, g_c, tau, ups) -> None:
 
 
 def test_gnfs() -> None:
-    ks = np.arange(2, 4000)
+    ks = np.arange(40, 4000)
     bits = gnfs_log2_complexity(ks)
     assert np.all(np.diff(bits) > 0)  # Omega monotone
     # independent evaluation of the paper's formula
@@ -169,10 +171,50 @@ def test_gnfs() -> None:
     assert bit_security_of_key_length(k) == pytest.approx(math.log2(omega), rel=1e-13)
     assert gnfs_log2_complexity(711) < 74 <= gnfs_log2_complexity(712)
     assert minimum_key_length(74) == 712
-    for lam in (1, 10, 40, 80, 112, 128, 200):
+    for lam in (19, 40, 80, 112, 128, 200, 481):
         k = minimum_key_length(lam)
-        assert gnfs_log2_complexity(k) >= lam and (k == 2 or gnfs_log2_complexity(k - 1) < lam)
-    assert gnfs_complexity(10**7) == math.inf
+        assert gnfs_log2_complexity(k) >= lam and (k == 40 or gnfs_log2_complexity(k - 1) < lam)
+    assert gnfs_complexity(65536) == pytest.approx(2 ** gnfs_log2_complexity(65536), rel=1e-9)
+
+
+@pytest.mark.parametrize("k", [2, 16, 39, 65537, 10**308])
+def test_key_length_outside_the_formula_range(k: int) -> None:
+    with pytest.raises(ModelRangeError, match="40 ... 65536") as info:
+        gnfs_log2_complexity(k)
+    assert format_value(k) in str(info.value)
+    with pytest.raises(ModelRangeError):
+        bit_security_of_key_length([64, k])
+
+
+@pytest.mark.parametrize("lam", [1, 10, 18.6, 482])
+def test_security_parameter_outside_the_key_length_range(lam: float) -> None:
+    with pytest.raises(ModelRangeError, match="lam") as info:
+        minimum_key_length(lam)
+    assert format_value(lam) in str(info.value)
+
+
+def test_tiny_defense_period_is_an_error_not_a_two_bit_key() -> None:
+    # Upsilon tau_c = 4.4e-283 < N*: thm:opt_sec clips lam* at 1, and eq:opt_key has no key
+    # length for 1 bit inside the GNFS range: an error that says so, never k* = 2
+    kw = dict(PAPER_EXAMPLE)
+    kw["tau_c"] = 1e-300
+    with pytest.raises(ModelRangeError, match="lam\\* = 1") as info:
+        design_from_traces(kw.pop("tr_psi_u"), kw.pop("tr_psi_w"), kw.pop("m"), kw.pop("n"), **kw)
+    assert "1e-300" in str(info.value)
+    assert optimal_security_parameter(13159, tau_c=1e-300, upsilon=442e15) == 1
+
+
+def test_design_for_sample_size_is_the_last_step_of_every_design() -> None:
+    d = paper_design_example()
+    g = exact_sic_asymptotic_function(2, 8, 4, 4, r_sigma=100)
+    again = design_for_sample_size(
+        "asymptotic", d.N_star, g, m=4, n=4, sigma_u2=10, sigma_w2=0.1, sigma_x2=1, tr_psi_u=2, tr_psi_w=8,
+        gamma_c=1e-6, tau_c=31536e4, upsilon=442e15,
+    )
+    assert again == d
+    with pytest.raises(ParameterError, match="'magic'"):
+        design_for_sample_size("magic", 10, g, m=4, n=4, sigma_u2=10, sigma_w2=0.1, sigma_x2=1, tr_psi_u=2,
+                               tr_psi_w=8, gamma_c=1e-6, tau_c=1, upsilon=1)
 
 
 def test_bad_inputs() -> None:
@@ -184,6 +226,12 @@ def test_bad_inputs() -> None:
         gnfs_log2_complexity(1)
     with pytest.raises(ParameterError, match="lam"):
         minimum_key_length(0)
+    for big in (10**400, -(10**400)):  # beyond the float range: refused with its size, no OverflowError
+        with pytest.raises(ParameterError, match="float64 range") as info:
+            design_from_traces(2, 8, 4, 4, sigma_u2=big, sigma_w2=0.1, gamma_c=1e-6, tau_c=1, upsilon=1)
+        assert "1329 bits" in str(info.value)
+    with pytest.raises(ParameterError, match="upsilon"):
+        optimal_security_parameter(10, tau_c=1, upsilon=10**400)
     with pytest.raises(ParameterError, match="method"):
         design_from_traces(1, 2, 1, 1, sigma_u2=1, sigma_w2=1, gamma_c=0.1, tau_c=1, upsilon=1, method="magic")
     with pytest.raises(ParameterError, match="gamma_c"):

@@ -35,9 +35,9 @@ import threading
 import time
 from typing import Any, ClassVar, Mapping, Optional
 
-from .._validation import check_int, check_positive
+from .._validation import check_int, check_positive, format_value
 from ..crypto import arith
-from ..crypto.arith import RandomSource, RngLike
+from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, KeyMismatchError, ParameterError
 
@@ -168,12 +168,12 @@ def check_element(group: GroupParams, h: Any) -> int:
         If ``h`` is not an integer of ``[1, p)`` in the order-q subgroup (a key of another group).
     """
     if isinstance(h, bool) or not (isinstance(h, int) or type(h).__name__ in ("mpz", "int64", "uint64")):
-        raise KeyMismatchError(f"a public-key element must be an integer, got {h!r}")
+        raise KeyMismatchError(f"a public-key element must be an integer, got {format_value(h)}")
     h = int(h)
     if not group.contains(h):
         raise KeyMismatchError(
-            f"h = {h} is not an element of the order-q subgroup of this group "
-            f"({group.bits}-bit p = {group.p:#x}): a key of another group?"
+            f"h = {format_int(h)} is not an element of the order-q subgroup of this group "
+            f"({group.bits}-bit p = {format_int(group.p)}): a key of another group?"
         )
     return h
 
@@ -188,7 +188,7 @@ def verify_exponent(group: GroupParams, h: int, s: int, who: str) -> int:
     """
     s = int(s) % group.q
     if int(arith.powmod(group.g, s, group.p)) != h:
-        raise BreakerError(f"{who}: the recovered exponent fails the check g^s = h for h = {h}")
+        raise BreakerError(f"{who}: the recovered exponent fails the check g^s = h for h = {format_int(h)}")
     return s
 
 
@@ -256,7 +256,7 @@ class Precomputation:
         """
         h = check_element(self.group, h)
         src = arith.as_random_source(rng) if rng is not None else (self.rng or arith.secure_random())
-        deadline = Deadline(_check_time_limit(time_limit), f"{self.breaker}: breaking h = {h:#x}")
+        deadline = Deadline(_check_time_limit(time_limit), f"{self.breaker}: breaking h = {format_int(h)}")
         s, ops, method = self._solve(h, deadline, src)
         s = verify_exponent(self.group, h, s, self.breaker)
         cost = deadline.cost(ops)

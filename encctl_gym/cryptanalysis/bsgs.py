@@ -21,7 +21,7 @@ import gmpy2
 import numpy as np
 
 from .._validation import check_int
-from ..crypto.arith import RandomSource, RngLike
+from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, BreakerLimitError
 from .base import Breaker, Deadline, Precomputation, format_seconds
@@ -80,7 +80,7 @@ class BabyStepTable(Precomputation):
                 return (i * m + j) % q, {"group_operations": i + 1, "table_lookups": i + 1}, ""
             steps += n
             deadline.check()
-        raise BreakerError(f"bsgs: no giant step met the table for h = {h:#x} (is h in <g>?)")
+        raise BreakerError(f"bsgs: no giant step met the table for h = {format_int(h)} (is h in <g>?)")
 
 
 class BabyStepGiantStep(Breaker):

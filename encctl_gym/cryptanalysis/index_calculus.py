@@ -52,7 +52,7 @@ import gmpy2
 
 from .._validation import check_int, check_positive
 from ..crypto import arith
-from ..crypto.arith import RandomSource, RngLike
+from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, GroupError
 from .base import Breaker, Deadline, Precomputation
@@ -288,7 +288,7 @@ class FactorBaseLogs(Precomputation):
                 r += c
             deadline.check()
             if trials > give_up:
-                raise BreakerError(f"index-calculus: no smooth randomisation after {trials} trials for h = {h:#x}")
+                raise BreakerError(f"index-calculus: no smooth randomisation after {trials} trials for h = {format_int(h)}")
 
 
 class IndexCalculus(Breaker):

@@ -20,7 +20,8 @@ import math
 import threading
 from typing import Any, ClassVar, Mapping, Optional
 
-from ..crypto.arith import RandomSource
+from ..crypto.arith import RandomSource, format_int
+from .._validation import format_value
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, OptionalDependencyError
 from .base import Breaker, Deadline, Precomputation
@@ -106,7 +107,7 @@ class PariContext(Precomputation):
             except cp.AlarmInterrupt:
                 raise deadline.error() from None
         if result.type() != "t_INT":
-            raise BreakerError(f"pari: znlog found no logarithm of h = {h:#x} (result {result})")
+            raise BreakerError(f"pari: znlog found no logarithm of h = {format_int(h)} (result {format_value(str(result))})")
         return int(result), {}, ""
 
 

@@ -30,7 +30,7 @@ import gmpy2
 
 from .._validation import check_int
 from ..crypto import arith
-from ..crypto.arith import RandomSource, RngLike
+from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError
 from .base import Breaker, Deadline, Precomputation
@@ -146,7 +146,7 @@ class RandomWalk(Precomputation):
             else:
                 pending[y] = (a, b)
             if s is None and steps > give_up:  # 100 times the expected work: something is wrong
-                raise BreakerError(f"{self.breaker}: no collision after {steps} steps ({walks} walks) for h = {h:#x}")
+                raise BreakerError(f"{self.breaker}: no collision after {steps} steps ({walks} walks) for h = {format_int(h)}")
         if self.reuse:
             for y, (a, b) in pending.items():
                 self.known.setdefault(y, (a + b * s) % q)

@@ -19,8 +19,8 @@ from typing import Any, ClassVar, Iterable, Mapping, Optional, Union
 
 import gmpy2
 
-from .._validation import check_int
-from ..crypto.arith import RandomSource, RngLike
+from .._validation import check_int, format_value
+from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import KeyMismatchError, ParameterError
 from .base import Breaker, Deadline, Precomputation, RecoveredKey, check_element
@@ -42,11 +42,11 @@ def as_token(group: GroupParams, token: Any) -> tuple[int, int]:
         try:
             h, d = token
         except (TypeError, ValueError) as exc:
-            raise ParameterError(f"an update token must have fields h and d, or be a pair (h, d); got {token!r}") from exc
+            raise ParameterError(f"an update token must have fields h and d, or be a pair (h, d); got {format_value(token)}") from exc
     h = check_element(group, h)
     d = check_int("token d", d)
     if not 0 <= d < group.q:
-        raise KeyMismatchError(f"update token d is outside [0, q) for this group (token of h = {h:#x})")
+        raise KeyMismatchError(f"update token d is outside [0, q) for this group (token of h = {format_int(h)})")
     return h, d
 
 

@@ -2,23 +2,45 @@
 talks to gmpy2 directly (as ``phe.util`` does in python-paillier).
 
 Everything above this layer (groups, ElGamal, the encrypted controller) calls
-:func:`powmod`, :func:`mulmod`, :func:`invert`, :func:`is_prime`, :func:`jacobi` and a
-:class:`RandomSource`, never gmpy2 or :func:`pow` itself. That keeps the fast backend
-swappable and lets :func:`powmod` count its calls (the benchmark reports the number of
-modular exponentiations per control step, see :class:`PowmodCounter`).
+:func:`powmod`, :func:`mulmod`, :func:`invert`, :func:`is_prime`, :func:`jacobi`,
+:func:`legendre` and a :class:`RandomSource`, never gmpy2 or :func:`pow` itself. That keeps
+the fast backend swappable and lets :func:`powmod` count its calls (the benchmark reports the
+number of modular exponentiations per control step, see :class:`PowmodCounter`).
 
 Randomness
 ----------
-Every function of the package that needs random numbers takes ``rng``:
+The exponents of Example ex:elgamal and ex:dyn_elgamal (the secret key s, the encryption
+randomness r, the updated key s', the re-randomisation r of CtUpd) and the starting point of
+the safe-prime search are drawn from a :class:`RandomSource`. Every function that needs random
+numbers takes ``rng``:
 
-* ``None``: a cryptographically secure source (:func:`secure_random`, ``secrets``/``os.urandom``);
-* an ``int`` seed, or a :class:`numpy.random.Generator`: a *seeded, reproducible and
-  therefore UNSAFE* source (:func:`seeded_random`), meant for reproducible experiments only;
-* a :class:`RandomSource` instance, used as is.
+* ``None``: a cryptographically secure source (:func:`secure_random`, ``secrets``);
+* a :class:`RandomSource` *stream* (e.g. ``seeded_random(seed)``), used as is: every draw
+  continues the stream, so passing one stream to many calls gives fresh numbers each time;
+* a :class:`numpy.random.Generator`: a seeded stream whose 256-bit key is drawn from the
+  generator at each call (reproducible when the generator is);
+* an ``int`` seed, only where the call is made once per object or per experiment (key and
+  group generation, the parties of the encrypted controller): it becomes the stream
+  ``seeded_random(seed, purpose)``, *keyed by the purpose of the call* (``"group"`` for the
+  prime search, ``"keygen"`` for s, ...), so one seed never feeds two purposes with the same
+  numbers (a secret key that followed from the public prime by a short scan was the result of
+  that mistake).
+
+Functions that draw fresh randomness on every call (Enc, KeyUpd, CtUpd, the forging of an
+injected input) refuse a bare int seed (:func:`as_random_stream`): the same int would repeat
+r on every call (``c1`` would equal ``h`` after ``keygen(..., rng=5)``, and the quotient of two
+ciphertexts would reveal the quotient of their plaintexts). Pass one stream instead.
+
+Seeded streams are UNSAFE for deployment (whoever knows or guesses the seed recomputes every
+key); they exist for reproducible experiments and tests. A stream is SHAKE-256 in counter mode
+under a key derived from (seed, purpose); :meth:`RandomSource.spawn` derives independent child
+streams, one way (a child cannot recompute its parent's draws), so that the parties of a
+protocol can each hold their own.
 """
 
 from __future__ import annotations
 
+import hashlib
 import numbers
 import secrets
 from typing import Any, Union
@@ -37,7 +59,7 @@ __all__ = [
     "is_prime",
     "jacobi",
     "legendre",
-    "bit_length",
+    "format_int",
     "PowmodCounter",
     "powmod_count",
     "RandomSource",
@@ -46,6 +68,7 @@ __all__ = [
     "secure_random",
     "seeded_random",
     "as_random_source",
+    "as_random_stream",
     "RngLike",
 ]
 
@@ -76,7 +99,9 @@ def powmod(base: int, exp: int, mod: int) -> int:
     try:
         return gmpy2.powmod(base, exp, mod)
     except (ValueError, ZeroDivisionError) as exc:  # e.g. no inverse for a negative exponent
-        raise ParameterError(f"powmod({base!r}, {exp!r}, {mod!r}) is undefined: {exc}") from exc
+        raise ParameterError(
+            f"powmod({format_int(base)}, {format_int(exp)}, {format_int(mod)}) is undefined: {exc}"
+        ) from exc
 
 
 def powmod_count() -> int:
@@ -124,7 +149,7 @@ def invert(a: int, mod: int) -> int:
     try:
         return gmpy2.invert(a, mod)
     except ZeroDivisionError as exc:
-        raise ParameterError(f"{a} has no inverse modulo {mod}") from exc
+        raise ParameterError(f"{format_int(a)} has no inverse modulo {format_int(mod)}") from exc
 
 
 def is_prime(n: int, reps: int = 25) -> bool:
@@ -160,9 +185,21 @@ def legendre(a: int, p: int) -> int:
     return int(gmpy2.legendre(a, p))
 
 
-def bit_length(n: int) -> int:
-    """Number of bits of ``|n|`` (0 for 0); the bit length of p is the group's ``bits``."""
-    return int(gmpy2.mpz(n).bit_length())
+def format_int(n: Any) -> str:
+    """An integer for an error message or a repr: decimal up to 256 bits, else abbreviated hex.
+
+    Python refuses to convert integers of more than 4300 decimal digits to text, so a message
+    that printed such a number in decimal would itself raise; ``0x1234abcd...89ef (N bits)``
+    always works and still tells numbers apart.
+    """
+    try:
+        v = int(n)
+    except (TypeError, ValueError):
+        return repr(n)
+    if abs(v).bit_length() <= 256:
+        return str(v)
+    h = hex(v)
+    return f"{h[:14]}...{h[-8:]} ({abs(v).bit_length()} bits)"
 
 
 # --------------------------------------------------------------------------- randomness
@@ -182,12 +219,17 @@ class RandomSource:
     def between(self, low: int, high: int) -> int:
         """Return an integer uniform in ``[low, high)``; requires ``low < high``."""
         if not high > low:
-            raise ParameterError(f"empty range [{low}, {high})")
+            raise ParameterError(f"empty range [{format_int(low)}, {format_int(high)})")
         return low + self.below(high - low)
 
-    def randbits(self, k: int) -> int:
-        """Return an integer uniform in ``[0, 2**k)``."""
-        return self.below(1 << k)
+    def spawn(self, purpose: str) -> "RandomSource":
+        """An independent child stream for another party or purpose.
+
+        The child is keyed by 256 bits drawn from this source and by ``purpose``; knowing the
+        child's key does not reveal this source's draws. :class:`SecureRandom` returns a new
+        secure source.
+        """
+        return SeededRandom(self.below(1 << 256), _check_purpose(purpose))
 
     @staticmethod
     def _check_n(n: int) -> int:
@@ -196,7 +238,7 @@ class RandomSource:
         if isinstance(n, bool) or not isinstance(n, (numbers.Integral, type(mpz(0)))):
             raise ParameterError(f"the bound n must be an integer, got {n!r}")
         if n < 1:
-            raise ParameterError(f"the bound n must be >= 1, got {n}")
+            raise ParameterError(f"the bound n must be >= 1, got {format_int(n)}")
         return n
 
 
@@ -209,30 +251,91 @@ class SecureRandom(RandomSource):
         n = self._check_n(n)
         return secrets.randbelow(int(n))
 
+    def spawn(self, purpose: str) -> "SecureRandom":
+        _check_purpose(purpose)
+        return SecureRandom()
+
     def __repr__(self) -> str:
         return "SecureRandom()"
 
 
+def _length_prefixed(data: bytes) -> bytes:
+    return len(data).to_bytes(8, "big") + data
+
+
+def _check_purpose(purpose: Any) -> str:
+    if not isinstance(purpose, str):
+        raise ParameterError(f"the purpose of a random stream must be a string, got {purpose!r}")
+    return purpose
+
+
 class SeededRandom(RandomSource):
-    """Reproducible randomness from a seed (GMP's Mersenne Twister via ``gmpy2.random_state``).
+    """Reproducible randomness: SHAKE-256 in counter mode under a key derived from (seed, purpose).
+
+    Draw j of the stream is ``SHAKE-256("draw" || key || j)`` cut to the bit length of the
+    bound, with rejection of values >= n (exactly uniform). Streams of different seeds or
+    different purposes are independent; so are the children of :meth:`spawn`.
 
     .. warning:: UNSAFE for deployment: anybody who knows or guesses the seed can recompute
        every key and every encryption randomness. Use only for reproducible experiments
        and tests.
+
+    Parameters
+    ----------
+    seed : int
+        A non-negative integer.
+    purpose : str, default ""
+        What the stream is for (see the module docstring): the same seed with another purpose
+        gives an unrelated stream.
     """
 
     secure = False
 
-    def __init__(self, seed: int) -> None:
+    def __init__(self, seed: int, purpose: str = "") -> None:
         self.seed = check_int("seed", seed, minimum=0)
-        self._state = gmpy2.random_state(self.seed)
+        self.purpose = _check_purpose(purpose)
+        seed_bytes = self.seed.to_bytes((self.seed.bit_length() + 7) // 8, "big")
+        material = _length_prefixed(seed_bytes) + _length_prefixed(self.purpose.encode("utf-8"))
+        self._key = hashlib.shake_256(b"encctl-gym seed\0" + material).digest(32)
+        self._draws = 0
+        self._spawned = 0
 
     def below(self, n: int) -> int:
         n = self._check_n(n)
-        return int(gmpy2.mpz_random(self._state, n))
+        bits = (n - 1).bit_length()
+        if bits == 0:
+            return 0
+        nbytes = (bits + 7) >> 3
+        drop = 8 * nbytes - bits
+        while True:
+            block = hashlib.shake_256(
+                b"encctl-gym draw\0" + self._key + self._draws.to_bytes(8, "big")
+            ).digest(nbytes)
+            self._draws += 1
+            v = int.from_bytes(block, "big") >> drop
+            if v < n:
+                return v
+
+    def spawn(self, purpose: str) -> "SeededRandom":
+        """An independent child stream keyed by this stream's key, a spawn counter and ``purpose``.
+
+        Spawning does not consume draws of this stream; spawning twice with the same purpose
+        gives two different children.
+        """
+        child = SeededRandom.__new__(SeededRandom)
+        child.seed = self.seed
+        child.purpose = f"{self.purpose}/{_check_purpose(purpose)}"
+        child._key = hashlib.shake_256(
+            b"encctl-gym spawn\0" + self._key + self._spawned.to_bytes(8, "big")
+            + _length_prefixed(purpose.encode("utf-8"))
+        ).digest(32)
+        child._draws = 0
+        child._spawned = 0
+        self._spawned += 1
+        return child
 
     def __repr__(self) -> str:
-        return f"SeededRandom(seed={self.seed})"
+        return f"SeededRandom(seed={format_int(self.seed)}, purpose={self.purpose!r})"
 
 
 def secure_random() -> SecureRandom:
@@ -240,26 +343,35 @@ def secure_random() -> SecureRandom:
     return SecureRandom()
 
 
-def seeded_random(seed: int) -> SeededRandom:
-    """Return a reproducible :class:`RandomSource` from a non-negative integer seed.
+def seeded_random(seed: int, purpose: str = "") -> SeededRandom:
+    """Return a reproducible stream from a non-negative integer seed (and a purpose).
 
     UNSAFE for deployment (see :class:`SeededRandom`); for reproducible experiments only.
+    Pass the returned object to every call that should continue the stream.
     """
-    return SeededRandom(seed)
+    return SeededRandom(seed, purpose)
 
 
 RngLike = Union[None, int, RandomSource, np.random.Generator]
 
 
-def as_random_source(rng: RngLike) -> RandomSource:
-    """Normalise the ``rng`` argument accepted throughout :mod:`encctl_gym.crypto`.
+def _generator_seed(gen: np.random.Generator) -> int:
+    # 256 bits of key material from the generator (four 64-bit words).
+    words = gen.integers(0, 2**64, size=4, dtype=np.uint64)
+    return int.from_bytes(words.astype(">u8").tobytes(), "big")
+
+
+def as_random_source(rng: RngLike, purpose: str = "") -> RandomSource:
+    """Normalise the ``rng`` argument of calls made once per object (keys, groups, parties).
 
     Parameters
     ----------
     rng : None, int, numpy.random.Generator or RandomSource
-        ``None`` gives :func:`secure_random`; an int seed gives :func:`seeded_random`; a
-        NumPy generator gives a seeded source whose seed is drawn from it (reproducible,
-        unsafe for deployment); a :class:`RandomSource` is returned unchanged.
+        ``None`` gives :func:`secure_random`; an int seed gives ``seeded_random(seed,
+        purpose)``; a NumPy generator gives a seeded stream keyed by 256 bits drawn from it
+        (reproducible, unsafe for deployment); a :class:`RandomSource` is returned unchanged.
+    purpose : str, default ""
+        The purpose an int seed (or a generator's draw) is keyed by (module docstring).
 
     Raises
     ------
@@ -271,9 +383,38 @@ def as_random_source(rng: RngLike) -> RandomSource:
     if isinstance(rng, RandomSource):
         return rng
     if isinstance(rng, np.random.Generator):
-        return SeededRandom(int(rng.integers(0, 2**63 - 1)))
+        return SeededRandom(_generator_seed(rng), purpose)
     if isinstance(rng, bool) or not isinstance(rng, (numbers.Integral, np.integer)):
         raise ParameterError(
             f"rng must be None, an int seed, a numpy Generator or a RandomSource, got {rng!r}"
         )
-    return SeededRandom(int(rng))
+    return SeededRandom(int(rng), purpose)
+
+
+def as_random_stream(rng: RngLike, caller: str) -> RandomSource:
+    """Normalise ``rng`` for a call that needs fresh randomness every time (Enc, KeyUpd, CtUpd, ...).
+
+    As :func:`as_random_source`, except that a bare int seed is refused: it would restart the
+    same stream at every call and repeat the randomness (module docstring).
+
+    Parameters
+    ----------
+    rng : None, numpy.random.Generator or RandomSource
+    caller : str
+        The name of the calling function, for the error message.
+
+    Raises
+    ------
+    ParameterError
+        For an int seed (naming it and the stream to pass instead) or another bad type.
+    """
+    if rng is None:
+        return SecureRandom()
+    if isinstance(rng, RandomSource):
+        return rng
+    if isinstance(rng, (numbers.Integral, np.integer)) and not isinstance(rng, bool):
+        raise ParameterError(
+            f"{caller} draws fresh randomness at every call, so the int seed rng={format_int(rng)} "
+            f"would repeat it; pass one stream and reuse it, e.g. rng=seeded_random({format_int(rng)})"
+        )
+    return as_random_source(rng, caller)

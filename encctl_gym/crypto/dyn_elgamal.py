@@ -17,16 +17,9 @@ from typing import Optional
 from ..errors import KeyMismatchError, ParameterError
 from . import arith
 from .arith import RngLike
-from .elgamal import (
-    Ciphertext,
-    PublicKey,
-    SecretKey,
-    _check_key,
-    _int_field,
-    _step_field,
-    check_ciphertext,
-    check_same_group,
-)
+from .checks import check_group_of, check_instance, check_same_group, group_field, integer_field, step_field
+from .elgamal import Ciphertext, PublicKey, SecretKey, check_ciphertext
+from .group import GroupParams
 
 __all__ = [
     "UpdateToken",
@@ -36,28 +29,44 @@ __all__ = [
 ]
 
 
-@dataclasses.dataclass(frozen=True, slots=True)
+@dataclasses.dataclass(frozen=True, slots=True, repr=False)
 class UpdateToken:
     """Update token sigma_t = (h, d) of Example ex:dyn_elgamal (``d`` hidden from ``repr``).
 
     Attributes
     ----------
+    group : GroupParams
+        The group of the keys it updates.
     h : int
-        The public-key element ``h = g^s`` of step ``t``.
+        The public-key element ``h = g^s`` of step ``t`` (in G, not 1).
     d : int
-        ``s' - s mod q``.
+        ``s' - s mod q``, in [0, q).
     t : int or None
         The step ``t`` the token moves away from (to ``t + 1``).
+
+    Raises
+    ------
+    KeyMismatchError
+        If ``h`` is not an element of G other than 1, or ``d`` is outside [0, q).
     """
 
+    group: GroupParams
     h: int
     d: int = dataclasses.field(repr=False)
     t: Optional[int] = None
 
     def __post_init__(self) -> None:
-        _int_field(self, "h", ParameterError)
-        _int_field(self, "d", ParameterError)
-        _step_field(self, "t", ParameterError, optional=True)
+        grp = group_field(self, ParameterError)
+        integer_field(self, "h", ParameterError)
+        integer_field(self, "d", ParameterError)
+        step_field(self, "t", ParameterError, optional=True)
+        if self.h == 1 or not grp.contains(self.h):
+            raise KeyMismatchError(f"update token h = {arith.format_int(self.h)} is not an element of the group other than 1")
+        if not 0 <= self.d < grp.q:
+            raise KeyMismatchError("update token d is outside [0, q) for its group")
+
+    def __repr__(self) -> str:
+        return f"UpdateToken(bits={self.group.bits}, h={arith.format_int(self.h)}, t={self.t})"
 
 
 def key_update(
@@ -72,7 +81,8 @@ def key_update(
     ----------
     pk, sk : PublicKey, SecretKey
         The key pair of step t (same group and same step).
-    rng : None, int, RandomSource or numpy.random.Generator
+    rng : None, RandomSource or numpy.random.Generator
+        A stream (an int seed is refused: it would draw the same s' at every step).
 
     Returns
     -------
@@ -84,18 +94,18 @@ def key_update(
     KeyMismatchError
         If the keys belong to different groups or different steps.
     """
-    _check_key(pk, PublicKey, "pk")
-    _check_key(sk, SecretKey, "sk")
+    check_instance(pk, PublicKey, "pk")
+    check_instance(sk, SecretKey, "sk")
     grp = check_same_group(pk, sk, "pk and sk")
     if pk.t != sk.t:
         raise KeyMismatchError(f"pk is of step t = {pk.t} but sk is of step t = {sk.t}")
-    s_next = arith.as_random_source(rng).between(1, grp.q)
+    s_next = arith.as_random_stream(rng, "key_update").between(1, grp.q)
     d = (s_next - sk.s) % grp.q
     h_next = int(arith.mulmod(pk.h, arith.powmod(grp.g, d, grp.p), grp.p))
     return (
         PublicKey(grp, h_next, pk.t + 1),
         SecretKey(grp, s_next, sk.t + 1),
-        UpdateToken(pk.h, d, pk.t),
+        UpdateToken(grp, pk.h, d, pk.t),
     )
 
 
@@ -103,6 +113,9 @@ def ciphertext_update(
     pk: PublicKey, ct: Ciphertext, token: UpdateToken, rng: RngLike = None
 ) -> Ciphertext:
     """CtUpd of Example ex:dyn_elgamal: ``(c1 g^r, (c1 g^r)^d c2 h^r) mod p`` (re-randomised).
+
+    ``r`` is drawn again in the (probability 1/(q - 1)) case ``c1 g^r = 1``, which would output
+    the plaintext as the second component.
 
     Parameters
     ----------
@@ -112,7 +125,8 @@ def ciphertext_update(
         A ciphertext under the key of step t.
     token : UpdateToken
         sigma_t = (h, d) from :func:`key_update`.
-    rng : None, int, RandomSource or numpy.random.Generator
+    rng : None, RandomSource or numpy.random.Generator
+        A stream (an int seed is refused: it would repeat r at every call).
 
     Returns
     -------
@@ -124,28 +138,29 @@ def ciphertext_update(
     CiphertextError
         If ``ct`` is malformed.
     KeyMismatchError
-        If ``ct`` and ``token`` record different steps, or the token's ``h`` is not in G.
+        If ``pk``, ``ct`` and ``token`` do not belong to one group, or ``ct`` and ``token``
+        record different steps.
     """
-    _check_key(pk, PublicKey, "pk")
-    _check_key(token, UpdateToken, "token")
+    check_instance(pk, PublicKey, "pk")
+    check_instance(token, UpdateToken, "token")
     grp = pk.group
     check_ciphertext(grp, ct)
-    if not grp.contains(token.h):
-        raise KeyMismatchError(f"update token h = {token.h} is not an element of the group")
-    if not 0 <= token.d < grp.q:
-        raise KeyMismatchError(f"update token d = {token.d} is outside [0, q) for this group")
+    check_group_of(token, grp, "update token")
     if ct.t is not None and token.t is not None and ct.t != token.t:
         raise KeyMismatchError(
             f"ciphertext is of step t = {ct.t} but the token updates step t = {token.t}"
         )
     base_t = token.t if token.t is not None else ct.t
     p = grp.p
-    r = arith.as_random_source(rng).between(1, grp.q)
-    c1 = arith.mulmod(ct.c1, arith.powmod(grp.g, r, p), p)
+    src = arith.as_random_stream(rng, "ciphertext_update")
+    c1 = 1
+    while c1 == 1:
+        r = src.between(1, grp.q)
+        c1 = arith.mulmod(ct.c1, arith.powmod(grp.g, r, p), p)
     c2 = arith.mulmod(
         arith.mulmod(arith.powmod(c1, token.d, p), ct.c2, p), arith.powmod(token.h, r, p), p
     )
-    return Ciphertext(int(c1), int(c2), None if base_t is None else base_t + 1)
+    return Ciphertext(grp, int(c1), int(c2), None if base_t is None else base_t + 1)
 
 
 def recover_next_secret_key(sk_t: SecretKey, token: UpdateToken) -> SecretKey:
@@ -157,13 +172,11 @@ def recover_next_secret_key(sk_t: SecretKey, token: UpdateToken) -> SecretKey:
     Raises
     ------
     KeyMismatchError
-        If the token is of another step than ``sk_t`` or ``d`` is outside [0, q).
+        If the token belongs to another group or another step than ``sk_t``.
     """
-    _check_key(sk_t, SecretKey, "sk_t")
-    _check_key(token, UpdateToken, "token")
+    check_instance(sk_t, SecretKey, "sk_t")
+    check_instance(token, UpdateToken, "token")
     if token.t is not None and token.t != sk_t.t:
         raise KeyMismatchError(f"token is of step t = {token.t} but sk_t is of step t = {sk_t.t}")
-    grp = sk_t.group
-    if not 0 <= token.d < grp.q:
-        raise KeyMismatchError("update token d is outside [0, q) for the secret key's group")
+    grp = check_same_group(sk_t, token, "sk_t and the token")
     return SecretKey(grp, (sk_t.s + token.d) % grp.q, sk_t.t + 1)

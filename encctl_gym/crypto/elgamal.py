@@ -1,13 +1,21 @@
 """ElGamal encryption (Example ex:elgamal): KeyGen, Enc, Dec and the multiplicative Eval.
 
 Keys and ciphertexts are small frozen dataclasses over plain functions, as in ECLib and
-python-paillier. Keys carry the time step ``t`` of the dynamic-key scheme
-(:mod:`.dyn_elgamal`; 0 for a fresh key) and a ciphertext may record the step of the key it
-was made under, so that decrypting with the key of another step raises
-:class:`~encctl_gym.errors.KeyMismatchError` instead of returning garbage.
+python-paillier. Each carries its group (p, q, g): an algorithm that combines a key with a
+ciphertext (or two ciphertexts) of different groups raises
+:class:`~encctl_gym.errors.KeyMismatchError` instead of returning garbage. Keys carry the
+time step ``t`` of the dynamic-key scheme (:mod:`.dyn_elgamal`; 0 for a fresh key) and a
+ciphertext may record the step of the key it was made under, so that decrypting with the key
+of another step raises :class:`~encctl_gym.errors.KeyMismatchError` too.
+
+Keys are made only over verified groups (:meth:`~.group.GroupParams.verify`), and the
+degenerate keys are refused: ``s = 0`` (then ``h = 1``) and ``h = 1``, under which Enc leaves
+the message in the clear (``c2 = m h^r = m``).
 
 Randomness: ``s`` and ``r`` are drawn uniformly from ``{1, ..., q - 1}`` (the paper's Z_q
-without 0, which would make ``h = 1`` or leave ``m`` in the clear).
+without 0, which would make ``h = 1`` or leave ``m`` in the clear). :func:`keygen` accepts an
+int seed (keyed by the purpose ``"keygen"``); :func:`encrypt` draws a fresh r at every call
+and refuses one (see :mod:`.arith`).
 """
 
 from __future__ import annotations
@@ -21,6 +29,16 @@ import numpy as np
 from ..errors import CiphertextError, KeyMismatchError, ParameterError, PlaintextError
 from . import arith
 from .arith import RngLike
+from .arith import format_int as fmt
+from .checks import (
+    check_component,
+    check_group_of,
+    check_instance,
+    check_same_group,
+    group_field,
+    integer_field,
+    step_field,
+)
 from .group import GroupParams, as_group
 
 __all__ = [
@@ -29,54 +47,36 @@ __all__ = [
     "Ciphertext",
     "keygen",
     "encrypt",
+    "encrypt_member",
     "decrypt",
+    "decrypt_components",
     "mult",
+    "mult_members",
     "check_plaintext",
     "check_ciphertext",
     "check_same_group",
 ]
 
 
-_MPZ = type(arith.mpz(0))
-
-
-def _int_field(obj: Any, name: str, err: type) -> None:
-    value = getattr(obj, name)
-    if type(value) is int:  # fast path (hot in the control loop)
-        return
-    if type(value) is _MPZ:
-        object.__setattr__(obj, name, int(value))
-        return
-    if isinstance(value, bool) or not (
-        isinstance(value, (numbers.Integral, np.integer)) or type(value).__name__ == "mpz"
-    ):
-        raise err(f"{type(obj).__name__}.{name} must be an integer, got {value!r}")
-    object.__setattr__(obj, name, int(value))
-
-
-def _step_field(obj: Any, name: str, err: type, optional: bool) -> None:
-    value = getattr(obj, name)
-    if value is None and optional:
-        return
-    if type(value) is int and value >= 0:  # fast path
-        return
-    if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)) or value < 0:
-        raise err(f"{type(obj).__name__}.{name} must be a time step >= 0, got {value!r}")
-    object.__setattr__(obj, name, int(value))
-
-
-@dataclasses.dataclass(frozen=True, slots=True)
+@dataclasses.dataclass(frozen=True, slots=True, repr=False)
 class PublicKey:
     """Public key pk = (p, q, g, h) of Example ex:elgamal, at time step ``t``.
 
     Attributes
     ----------
     group : GroupParams
-        (p, q, g).
+        (p, q, g), verified.
     h : int
-        g^s mod p.
+        g^s mod p, an element of G other than 1.
     t : int
         Time step of the dynamic-key scheme (0 after :func:`keygen`).
+
+    Raises
+    ------
+    GroupError
+        If the group does not verify.
+    KeyMismatchError
+        If ``h`` is not an element of G, or ``h = 1`` (Enc would leave messages in the clear).
     """
 
     group: GroupParams
@@ -84,19 +84,32 @@ class PublicKey:
     t: int = 0
 
     def __post_init__(self) -> None:
-        if not isinstance(self.group, GroupParams):
-            raise ParameterError(f"PublicKey.group must be a GroupParams, got {self.group!r}")
-        _int_field(self, "h", ParameterError)
-        _step_field(self, "t", ParameterError, optional=False)
+        group_field(self, ParameterError).verify()
+        integer_field(self, "h", ParameterError)
+        step_field(self, "t", ParameterError, optional=False)
+        if self.h == 1:
+            raise KeyMismatchError(
+                "public key h = 1 is degenerate: Enc would output c2 = m, the message in the clear"
+            )
         if not self.group.contains(self.h):
-            raise KeyMismatchError(f"public key h = {self.h} is not an element of the group")
+            raise KeyMismatchError(f"public key h = {fmt(self.h)} is not an element of the group")
+
+    def __repr__(self) -> str:
+        return f"PublicKey(bits={self.group.bits}, h={fmt(self.h)}, t={self.t})"
 
 
-@dataclasses.dataclass(frozen=True, slots=True)
+@dataclasses.dataclass(frozen=True, slots=True, repr=False)
 class SecretKey:
     """Secret key sk = s of Example ex:elgamal (with its group), at time step ``t``.
 
-    ``s`` is hidden from ``repr``.
+    ``s`` lies in {1, ..., q - 1} (``s = 0`` would give ``h = 1``) and is hidden from ``repr``.
+
+    Raises
+    ------
+    GroupError
+        If the group does not verify.
+    ParameterError
+        If ``s`` is not an integer in [1, q) (the message does not show ``s``).
     """
 
     group: GroupParams
@@ -104,12 +117,17 @@ class SecretKey:
     t: int = 0
 
     def __post_init__(self) -> None:
-        if not isinstance(self.group, GroupParams):
-            raise ParameterError(f"SecretKey.group must be a GroupParams, got {self.group!r}")
-        _int_field(self, "s", ParameterError)
-        _step_field(self, "t", ParameterError, optional=False)
-        if not 0 <= self.s < self.group.q:
-            raise ParameterError(f"secret exponent must lie in [0, q), got s outside (t = {self.t})")
+        group_field(self, ParameterError).verify()
+        integer_field(self, "s", ParameterError)
+        step_field(self, "t", ParameterError, optional=False)
+        if not 0 < self.s < self.group.q:
+            raise ParameterError(
+                f"secret exponent must lie in [1, q), got s outside (t = {self.t}; s = 0 would "
+                "give the public key h = 1)"
+            )
+
+    def __repr__(self) -> str:
+        return f"SecretKey(bits={self.group.bits}, t={self.t})"
 
     def public_key(self) -> PublicKey:
         """The matching public key ``(p, q, g, g^s mod p)`` at the same step (one exponentiation)."""
@@ -117,37 +135,32 @@ class SecretKey:
         return PublicKey(grp, int(arith.powmod(grp.g, self.s, grp.p)), self.t)
 
 
-@dataclasses.dataclass(frozen=True, slots=True)
+@dataclasses.dataclass(frozen=True, slots=True, repr=False)
 class Ciphertext:
-    """Ciphertext ct = (c1, c2) = (g^r, m h^r) mod p of Example ex:elgamal.
+    """Ciphertext ct = (c1, c2) = (g^r, m h^r) mod p of Example ex:elgamal, in ``group``.
 
     ``t`` optionally records the time step of the public key used (``None``: unknown, no
-    check); :func:`decrypt` compares it with the secret key's step.
+    check); :func:`decrypt` compares it with the secret key's step, and the group with the
+    key's group.
     """
 
+    group: GroupParams
     c1: int
     c2: int
     t: Optional[int] = None
 
     def __post_init__(self) -> None:
-        _int_field(self, "c1", CiphertextError)
-        _int_field(self, "c2", CiphertextError)
-        _step_field(self, "t", CiphertextError, optional=True)
+        group_field(self, CiphertextError)
+        integer_field(self, "c1", CiphertextError)
+        integer_field(self, "c2", CiphertextError)
+        step_field(self, "t", CiphertextError, optional=True)
+
+    def __repr__(self) -> str:
+        return f"Ciphertext(bits={self.group.bits}, c1={fmt(self.c1)}, c2={fmt(self.c2)}, t={self.t})"
 
 
 # ---------------------------------------------------------------------- checks
-def check_same_group(a: Any, b: Any, what: str = "keys") -> GroupParams:
-    """Return the common group of two keys, raising :class:`KeyMismatchError` if they differ."""
-    if a.group != b.group:
-        raise KeyMismatchError(
-            f"{what} belong to different groups: {a.group!r} and {b.group!r}"
-        )
-    return a.group
-
-
-def _check_key(key: Any, cls: type, name: str) -> None:
-    if not isinstance(key, cls):
-        raise ParameterError(f"{name} must be a {cls.__name__}, got {type(key).__name__}: {key!r}")
+_MPZ = type(arith.mpz(0))
 
 
 def check_plaintext(group: GroupParams, m: Any) -> int:
@@ -167,31 +180,27 @@ def check_plaintext(group: GroupParams, m: Any) -> int:
     if m == 0:
         raise PlaintextError("plaintext m = 0 is not an element of G (0 has no order)")
     if not 0 < m < group.p:
-        raise PlaintextError(f"plaintext m = {m} is outside [1, p) for p = {group.p}")
+        raise PlaintextError(f"plaintext m = {fmt(m)} is outside [1, p) for p = {fmt(group.p)}")
     if not group.contains(m):
-        raise PlaintextError(f"plaintext m = {m} is not in the order-q subgroup G")
+        raise PlaintextError(f"plaintext m = {fmt(m)} is not in the order-q subgroup G")
     return m
 
 
-def _check_component(group: GroupParams, c: int, name: str) -> None:
-    if not 0 < c < group.p:
-        raise CiphertextError(f"ciphertext component {name} = {c} is outside [1, p)")
-    if not group.contains(c):
-        raise CiphertextError(f"ciphertext component {name} = {c} is not in the subgroup G")
-
-
 def check_ciphertext(group: GroupParams, ct: Any) -> "Ciphertext":
-    """Check that ``ct`` is a :class:`Ciphertext` whose components lie in G.
+    """Check that ``ct`` is a :class:`Ciphertext` of ``group`` whose components lie in G.
 
     Raises
     ------
     CiphertextError
         For another type (e.g. a three-component ciphertext) or a component outside G.
+    KeyMismatchError
+        If ``ct`` belongs to another group.
     """
     if not isinstance(ct, Ciphertext):
         raise CiphertextError(f"expected an ElGamal Ciphertext (c1, c2), got {ct!r}")
-    _check_component(group, ct.c1, "c1")
-    _check_component(group, ct.c2, "c2")
+    check_group_of(ct, group)
+    check_component(group, ct.c1, "c1")
+    check_component(group, ct.c2, "c2")
     return ct
 
 
@@ -205,9 +214,12 @@ def keygen(
     ----------
     group_or_bits : GroupParams or int
         A group (verified, cached) or a bit length (:func:`~.group.get_group`: the shipped
-        group if there is one, else a freshly generated safe-prime group).
+        group if there is one, else a freshly generated safe-prime group, within the default
+        time limit of :func:`~.group.generate_safe_prime_group`).
     rng : None, int, RandomSource or numpy.random.Generator
-        Randomness (``None``: secure; a seed is reproducible and unsafe for deployment).
+        Randomness (``None``: secure). An int seed is reproducible and unsafe for deployment;
+        the prime search (purpose ``"group"``) and s (purpose ``"keygen"``) get independent
+        streams of it. A stream is used as is, first for the prime search, then for s.
 
     Returns
     -------
@@ -215,7 +227,7 @@ def keygen(
         The key pair at time step 0.
     """
     group = as_group(group_or_bits, rng=rng)
-    src = arith.as_random_source(rng)
+    src = arith.as_random_source(rng, purpose="keygen")
     s = src.between(1, group.q)
     sk = SecretKey(group, s, 0)
     return sk.public_key(), sk
@@ -227,32 +239,45 @@ def encrypt(pk: PublicKey, m: int, rng: RngLike = None) -> Ciphertext:
     Parameters
     ----------
     pk : PublicKey
-        The public key; the ciphertext records ``pk.t``.
+        The public key; the ciphertext records ``pk.t`` and ``pk.group``.
     m : int
         A plaintext in G (see :class:`~.encoding.Encoder` for real numbers).
-    rng : None, int, RandomSource or numpy.random.Generator
+    rng : None, RandomSource or numpy.random.Generator
+        A stream (an int seed is refused: it would repeat r at every call, see :mod:`.arith`).
 
     Raises
     ------
     PlaintextError
         If ``m`` is 0 or not in G.
+    ParameterError
+        If ``pk`` is not a :class:`PublicKey` or ``rng`` is an int.
     """
-    _check_key(pk, PublicKey, "pk")
-    return _encrypt_member(pk, check_plaintext(pk.group, m), arith.as_random_source(rng))
+    check_instance(pk, PublicKey, "pk")
+    return encrypt_member(pk, check_plaintext(pk.group, m), arith.as_random_stream(rng, "encrypt"))
 
 
-def _encrypt_member(pk: PublicKey, m: int, src: arith.RandomSource) -> Ciphertext:
-    # Enc for a plaintext already known to lie in G (e.g. produced by the encoder).
+def encrypt_member(pk: PublicKey, m: int, src: arith.RandomSource) -> Ciphertext:
+    """Enc of Example ex:elgamal for a plaintext already known to lie in G (no checks).
+
+    The raw algorithm under :func:`encrypt`, for callers whose plaintexts come from the
+    encoder (which returns members of G only) and who hold a :class:`~.arith.RandomSource`.
+    Two exponentiations.
+    """
     grp = pk.group
     r = src.between(1, grp.q)
     c1 = arith.powmod(grp.g, r, grp.p)
     c2 = arith.mulmod(m, arith.powmod(pk.h, r, grp.p), grp.p)
-    return Ciphertext(int(c1), int(c2), pk.t)
+    return Ciphertext(grp, int(c1), int(c2), pk.t)
 
 
-def _dec(grp: GroupParams, s: int, c1: int, c2: int) -> int:
-    # c1 is in G (checked), so c1^(-s) = c1^(q - s): no inversion needed.
-    return int(arith.mulmod(arith.powmod(c1, grp.q - s, grp.p), c2, grp.p))
+def decrypt_components(group: GroupParams, s: int, c1: int, c2: int) -> int:
+    """Dec of Example ex:elgamal on raw components: ``c1^(-s) c2 mod p`` (no checks).
+
+    ``c1`` must lie in G (the callers check it), so ``c1^(-s) = c1^(q - s)``: one
+    exponentiation, no inversion. :func:`decrypt` and :func:`~.modified.modified_decrypt`
+    are built on it.
+    """
+    return int(arith.mulmod(arith.powmod(c1, group.q - s, group.p), c2, group.p))
 
 
 def decrypt(sk: SecretKey, ct: Ciphertext) -> int:
@@ -263,15 +288,15 @@ def decrypt(sk: SecretKey, ct: Ciphertext) -> int:
     CiphertextError
         If ``ct`` is not a two-component ciphertext with components in G.
     KeyMismatchError
-        If ``ct`` records a time step different from ``sk.t``.
+        If ``ct`` belongs to another group or records a time step different from ``sk.t``.
     """
-    _check_key(sk, SecretKey, "sk")
+    check_instance(sk, SecretKey, "sk")
     check_ciphertext(sk.group, ct)
     if ct.t is not None and ct.t != sk.t:
         raise KeyMismatchError(
             f"ciphertext was made under the key of step t = {ct.t}, secret key is of step t = {sk.t}"
         )
-    return _dec(sk.group, sk.s, ct.c1, ct.c2)
+    return decrypt_components(sk.group, sk.s, ct.c1, ct.c2)
 
 
 def mult(pk: PublicKey, ct1: Ciphertext, ct2: Ciphertext) -> Ciphertext:
@@ -282,11 +307,12 @@ def mult(pk: PublicKey, ct1: Ciphertext, ct2: Ciphertext) -> Ciphertext:
     CiphertextError
         If a ciphertext is malformed.
     KeyMismatchError
-        If the two ciphertexts record different time steps (the homomorphism of
-        Example ex:dyn_elgamal holds only for ciphertexts of the same step; see
-        :func:`~.modified.modified_eval` for the cross-step version).
+        If a ciphertext belongs to another group than ``pk``, or the two ciphertexts record
+        different time steps (the homomorphism of Example ex:dyn_elgamal holds only for
+        ciphertexts of the same step; see :func:`~.modified.modified_eval` for the
+        cross-step version).
     """
-    _check_key(pk, PublicKey, "pk")
+    check_instance(pk, PublicKey, "pk")
     grp = pk.group
     check_ciphertext(grp, ct1)
     check_ciphertext(grp, ct2)
@@ -294,6 +320,14 @@ def mult(pk: PublicKey, ct1: Ciphertext, ct2: Ciphertext) -> Ciphertext:
         raise KeyMismatchError(
             f"Eval needs ciphertexts of the same time step, got t = {ct1.t} and t = {ct2.t}"
         )
-    t = ct1.t if ct1.t is not None else ct2.t
-    p = grp.p
-    return Ciphertext(int(arith.mulmod(ct1.c1, ct2.c1, p)), int(arith.mulmod(ct1.c2, ct2.c2, p)), t)
+    return mult_members(grp, ct1, ct2, ct1.t if ct1.t is not None else ct2.t)
+
+
+def mult_members(group: GroupParams, ct1: Ciphertext, ct2: Ciphertext, t: Optional[int]) -> Ciphertext:
+    """Eval of Example ex:elgamal on ciphertexts already checked to belong to ``group`` (no checks).
+
+    The raw algorithm under :func:`mult`, for a caller that checks its inputs once (the
+    conventional controller server). Two modular multiplications; the result records step ``t``.
+    """
+    p = group.p
+    return Ciphertext(group, int(arith.mulmod(ct1.c1, ct2.c1, p)), int(arith.mulmod(ct1.c2, ct2.c2, p)), t)

@@ -17,7 +17,8 @@ Encoding ``Ecd(x; Delta)``
 
 Decoding ``Dcd(m; Delta)``
     Lift m to the signed representative in (-p/2, p/2] and divide by ``Delta`` (a single
-    value) or ``Delta**2`` (a product of two encoded values, or a sum of such products).
+    value, ``power=1``) or ``Delta**2`` (a product of two encoded values, or a sum of such
+    products, ``power=2``); no other power occurs in eq:ec and none is accepted.
     The division is exact rational arithmetic rounded once to the nearest double, so every
     party that decodes the same integer gets the bit-identical float.
 
@@ -27,7 +28,8 @@ Round-trip error
 
 Overflow is never silent: an :class:`Encoder` has a declared input range ``x_bound``
 (default: everything representable); a value outside raises
-:class:`~encctl_gym.errors.EncodingOverflowError` naming it. NaN and infinities raise
+:class:`~encctl_gym.errors.EncodingOverflowError` naming it. NaN, infinities, booleans and
+complex numbers (also inside arrays: their imaginary part would be lost) raise
 :class:`~encctl_gym.errors.ParameterError`.
 """
 
@@ -42,6 +44,7 @@ import numpy as np
 from .._validation import check_int, check_positive
 from ..errors import EncodingOverflowError, ParameterError, PlaintextError
 from . import arith
+from .arith import format_int as fmt
 from .group import GroupParams
 
 __all__ = [
@@ -54,7 +57,12 @@ __all__ = [
     "decode_int",
     "lift",
     "decode_scaled",
+    "DECODE_POWERS",
 ]
+
+#: The powers of Delta that Dcd divides by: 1 for an encoded value, 2 for a product of two
+#: encoded values or a sum of such products (eq:ec).
+DECODE_POWERS = (1, 2)
 
 #: Default largest distance from ``round(Delta x)`` to the chosen element of G, for
 #: safe-prime groups. Quadratic residues have density 1/2, so a longer gap around a given
@@ -127,7 +135,7 @@ def nearest_member(group: GroupParams, v: int, max_shift: int) -> tuple[int, int
         if _is_member_residue(group, (v - k) % p):
             return v - k, k
     raise PlaintextError(
-        f"no element of the order-q subgroup within max_shift = {max_shift} of v = {v}"
+        f"no element of the order-q subgroup within max_shift = {max_shift} of v = {fmt(v)}"
     )
 
 
@@ -138,11 +146,12 @@ def encode_int(group: GroupParams, v: int, max_shift: Optional[int] = None) -> i
     :class:`EncodingOverflowError` if ``|w| > (p - 1)/2`` (it would not decode back).
     """
     v = _as_int("v", v)
+    group.verify()
     ms = default_max_shift(group) if max_shift is None else check_int("max_shift", max_shift, 0)
     w, _ = nearest_member(group, v, ms)
     if abs(w) > group.half:
         raise EncodingOverflowError(
-            f"v = {v} encodes to w = {w}, outside the representable range |w| <= (p-1)/2"
+            f"v = {fmt(v)} encodes to w = {fmt(w)}, outside the representable range |w| <= (p-1)/2"
         )
     return w % group.p
 
@@ -162,8 +171,19 @@ def decode_int(group: GroupParams, m: int) -> int:
     """
     m = _as_int("m", m, PlaintextError)
     if not 0 <= m < group.p:
-        raise PlaintextError(f"plaintext m = {m} is outside [0, p) for p = {group.p}")
+        raise PlaintextError(f"plaintext m = {fmt(m)} is outside [0, p) for p = {fmt(group.p)}")
     return lift(group, m)
+
+
+def _check_power(power: Any) -> int:
+    if type(power) is int and power in DECODE_POWERS:  # fast path
+        return power
+    if isinstance(power, bool) or not isinstance(power, (numbers.Integral, np.integer)) or int(power) not in DECODE_POWERS:
+        raise ParameterError(
+            f"power must be one of {DECODE_POWERS} (Delta for a value, Delta^2 for a product), "
+            f"got {power!r}"
+        )
+    return int(power)
 
 
 def decode_scaled(w: int, delta_ratio: tuple[int, int], power: int = 1) -> float:
@@ -171,15 +191,18 @@ def decode_scaled(w: int, delta_ratio: tuple[int, int], power: int = 1) -> float
 
     Raises
     ------
+    ParameterError
+        If ``power`` is not in :data:`DECODE_POWERS`.
     EncodingOverflowError
         If the quotient does not fit in a double.
     """
+    power = _check_power(power)
     num, den = delta_ratio
     try:
         return (w * den**power) / num**power
     except OverflowError as exc:
         raise EncodingOverflowError(
-            f"decoded value {w} / Delta^{power} does not fit in a float"
+            f"decoded value {fmt(w)} / Delta^{power} does not fit in a float"
         ) from exc
 
 
@@ -194,10 +217,47 @@ def _as_int(name: str, value: Any, err: type = ParameterError) -> int:
 def _as_finite(name: str, x: Any) -> float:
     if isinstance(x, bool) or not isinstance(x, (numbers.Real, np.floating, np.integer)):
         raise ParameterError(f"{name} must be a real number, got {x!r}")
-    xf = float(x)
+    try:
+        xf = float(x)
+    except OverflowError:
+        raise EncodingOverflowError(f"{name} = {fmt(x)} is too large for a float") from None
     if not math.isfinite(xf):
         raise ParameterError(f"{name} must be finite, got {x!r}")
     return xf
+
+
+def _as_finite_array(name: str, x: Any) -> np.ndarray:
+    """``x`` as a float64 array of finite real numbers (no complex, boolean or text entries)."""
+    try:
+        arr = x if isinstance(x, np.ndarray) else np.asarray(x)
+    except (TypeError, ValueError) as exc:  # e.g. a ragged nested list
+        raise ParameterError(f"{name} must be a numeric (real) array, got {x!r}: {exc}") from None
+    kind = arr.dtype.kind
+    if kind == "O":  # e.g. a list mixing Python ints and floats, or gmpy2 numbers
+        flat = arr.ravel().tolist()
+        for v in flat:
+            real = isinstance(v, (numbers.Real, np.floating, np.integer)) or type(v).__name__ == "mpz"
+            if isinstance(v, bool) or not real:
+                raise ParameterError(f"{name} must contain real numbers, got {v!r}")
+        try:
+            arr = np.asarray([float(v) for v in flat], dtype=np.float64).reshape(arr.shape)
+        except OverflowError as exc:
+            raise EncodingOverflowError(f"{name} has an entry too large for a float: {exc}") from None
+    elif kind == "c":
+        bad = arr.ravel()[np.flatnonzero(arr.ravel().imag != 0)[:1]]
+        shown = bad[0] if bad.size else arr.ravel()[0]
+        raise ParameterError(
+            f"{name} must be real, got a complex array (e.g. {shown!r}); its imaginary part "
+            "would be lost"
+        )
+    elif kind not in "iuf":
+        raise ParameterError(f"{name} must be a numeric (real) array, got dtype {arr.dtype}: {x!r}")
+    else:
+        arr = arr.astype(np.float64, copy=False)
+    if not np.all(np.isfinite(arr)):
+        bad_v = float(arr[~np.isfinite(arr)].flat[0])
+        raise ParameterError(f"{name} must be finite, got {bad_v!r}")
+    return arr
 
 
 class Encoder:
@@ -219,6 +279,8 @@ class Encoder:
 
     Raises
     ------
+    GroupError
+        If ``group`` does not verify (:meth:`~.group.GroupParams.verify`).
     ParameterError
         If ``delta`` is not a finite number > 0, or ``x_bound`` is not finite and >= 0.
     EncodingOverflowError
@@ -241,7 +303,7 @@ class Encoder:
     ) -> None:
         if not isinstance(group, GroupParams):
             raise ParameterError(f"group must be a GroupParams, got {group!r}")
-        self.group = group
+        self.group = group.verify()  # membership tests are only meaningful in a verified group
         self.delta = check_positive("delta", delta)
         self.delta_ratio: tuple[int, int] = self.delta.as_integer_ratio()
         self.max_shift = (
@@ -266,7 +328,7 @@ class Encoder:
         if abs(v) + self.max_shift > self.group.half:
             raise EncodingOverflowError(
                 f"{name} = {x!r} is not representable: |round(Delta x)| + max_shift = "
-                f"{abs(v) + self.max_shift} > (p-1)/2 for a {self.group.bits}-bit group "
+                f"{fmt(abs(v) + self.max_shift)} > (p-1)/2 for a {self.group.bits}-bit group "
                 f"and Delta = {self.delta!r}"
             )
 
@@ -306,7 +368,8 @@ class Encoder:
         """Dcd of Definition def:ec: lift ``m`` to (-p/2, p/2] and divide by ``Delta**power``.
 
         ``power=1`` for an encoded value, ``power=2`` for a product of two encoded values
-        (or a sum of such products, see :meth:`decode_signed`).
+        (or a sum of such products, see :meth:`decode_signed`); any other power raises
+        :class:`ParameterError`.
         """
         return decode_scaled(decode_int(self.group, m), self.delta_ratio, power)
 
@@ -315,8 +378,18 @@ class Encoder:
         return decode_scaled(_as_int("w", w), self.delta_ratio, power)
 
     def error_bound(self, shift: Optional[int] = None) -> float:
-        """Round-trip bound ``(1/2 + s)/Delta`` (default ``s = max_shift``)."""
-        s = self.max_shift if shift is None else shift
+        """Round-trip bound ``(1/2 + s)/Delta`` (default ``s = max_shift``).
+
+        Raises
+        ------
+        ParameterError
+            If ``shift`` is not an integer in ``[0, max_shift]`` (no encoding has another).
+        """
+        s = self.max_shift if shift is None else check_int("shift", shift, 0)
+        if s > self.max_shift:
+            raise ParameterError(
+                f"shift must be <= max_shift = {self.max_shift} (no encoding has a larger one), got {s}"
+            )
         return (0.5 + s) / self.delta
 
     def max_abs_signed(self, x_bound: float) -> int:
@@ -326,14 +399,7 @@ class Encoder:
     # ------------------------------------------------------------------ arrays
     def quantize_array(self, x: Any) -> np.ndarray:
         """Vectorised :meth:`quantize`: an object array of Python ints of the shape of ``x``."""
-        arr = np.asarray(x, dtype=np.float64) if not isinstance(x, np.ndarray) else x
-        try:
-            arr = arr.astype(np.float64, copy=False)
-        except (TypeError, ValueError) as exc:
-            raise ParameterError(f"x must be numeric, got {x!r}") from exc
-        if not np.all(np.isfinite(arr)):
-            bad = float(arr[~np.isfinite(arr)].flat[0])
-            raise ParameterError(f"x must be finite, got {bad!r}")
+        arr = _as_finite_array("x", x)
         if self.x_bound is not None and arr.size and np.max(np.abs(arr)) > self.x_bound:
             bad = float(arr.flat[int(np.argmax(np.abs(arr)))])
             raise EncodingOverflowError(
@@ -358,26 +424,10 @@ class Encoder:
             out.flat[idx] = nearest_member(self.group, vi, self.max_shift)[0]
         return out
 
-    def encode_array(self, x: Any) -> np.ndarray:
-        """Vectorised :meth:`encode`: object array of plaintexts (ints in [1, p))."""
-        w = self.encode_signed_array(x)
-        p = self.group.p
-        out = np.empty(w.shape, dtype=object)
-        for idx, wi in enumerate(w.flat):
-            out.flat[idx] = wi % p
-        return out
-
-    def decode_array(self, m: Any, power: int = 1) -> np.ndarray:
-        """Vectorised :meth:`decode`: float64 array of the shape of ``m``."""
-        arr = np.asarray(m, dtype=object)
-        out = np.empty(arr.shape, dtype=np.float64)
-        for idx, mi in enumerate(arr.flat):
-            out.flat[idx] = self.decode(mi, power)
-        return out
-
     def decode_signed_array(self, w: Any, power: int = 1) -> np.ndarray:
         """Vectorised :meth:`decode_signed`: float64 array of the shape of ``w``."""
         arr = np.asarray(w, dtype=object)
+        power = _check_power(power)
         out = np.empty(arr.shape, dtype=np.float64)
         for idx, wi in enumerate(arr.flat):
             out.flat[idx] = self.decode_signed(wi, power)

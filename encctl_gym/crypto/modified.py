@@ -17,31 +17,31 @@ from typing import Any, Optional
 
 from ..errors import CiphertextError, KeyMismatchError
 from . import arith
-from .elgamal import (
-    Ciphertext,
-    PublicKey,
-    SecretKey,
-    _check_component,
-    _check_key,
-    _dec,
-    _int_field,
-    _step_field,
-    check_ciphertext,
+from .checks import (
+    check_component,
+    check_group_of,
+    check_instance,
     check_same_group,
+    group_field,
+    integer_field,
+    step_field,
 )
+from .elgamal import Ciphertext, PublicKey, SecretKey, check_ciphertext, decrypt_components
 from .group import GroupParams
 
-__all__ = ["ModifiedCiphertext", "modified_eval", "modified_decrypt", "check_modified_ciphertext"]
+__all__ = ["ModifiedCiphertext", "modified_eval", "modified_eval_members", "modified_decrypt", "check_modified_ciphertext"]
 
 
-@dataclasses.dataclass(frozen=True, slots=True)
+@dataclasses.dataclass(frozen=True, slots=True, repr=False)
 class ModifiedCiphertext:
     """Three-component ciphertext (c1, c2, c3) = (c11, c21, c12 c22 mod p) of Definition def:modification.
 
-    ``t1`` and ``t2`` optionally record the steps of the keys that decrypt ``c1`` and ``c2``
-    (the steps of the two input ciphertexts); ``None`` means unknown (no check).
+    ``group`` is the group of both input ciphertexts. ``t1`` and ``t2`` optionally record the
+    steps of the keys that decrypt ``c1`` and ``c2`` (the steps of the two input
+    ciphertexts); ``None`` means unknown (no check).
     """
 
+    group: GroupParams
     c1: int
     c2: int
     c3: int
@@ -49,10 +49,18 @@ class ModifiedCiphertext:
     t2: Optional[int] = None
 
     def __post_init__(self) -> None:
+        group_field(self, CiphertextError)
         for name in ("c1", "c2", "c3"):
-            _int_field(self, name, CiphertextError)
-        _step_field(self, "t1", CiphertextError, optional=True)
-        _step_field(self, "t2", CiphertextError, optional=True)
+            integer_field(self, name, CiphertextError)
+        step_field(self, "t1", CiphertextError, optional=True)
+        step_field(self, "t2", CiphertextError, optional=True)
+
+    def __repr__(self) -> str:
+        fmt = arith.format_int
+        return (
+            f"ModifiedCiphertext(bits={self.group.bits}, c1={fmt(self.c1)}, c2={fmt(self.c2)}, "
+            f"c3={fmt(self.c3)}, t1={self.t1}, t2={self.t2})"
+        )
 
 
 def modified_eval(pk: PublicKey, ct1: Ciphertext, ct2: Ciphertext) -> ModifiedCiphertext:
@@ -64,22 +72,42 @@ def modified_eval(pk: PublicKey, ct1: Ciphertext, ct2: Ciphertext) -> ModifiedCi
     ------
     CiphertextError
         If an input is not a two-component ciphertext with components in G.
+    KeyMismatchError
+        If an input belongs to another group than ``pk``.
     """
-    _check_key(pk, PublicKey, "pk")
+    check_instance(pk, PublicKey, "pk")
     grp = pk.group
     check_ciphertext(grp, ct1)
     check_ciphertext(grp, ct2)
-    c3 = arith.mulmod(ct1.c2, ct2.c2, grp.p)
-    return ModifiedCiphertext(ct1.c1, ct2.c1, int(c3), ct1.t, ct2.t)
+    return modified_eval_members(grp, ct1, ct2)
+
+
+def modified_eval_members(group: GroupParams, ct1: Ciphertext, ct2: Ciphertext) -> ModifiedCiphertext:
+    """Eval_bar of Definition def:modification on ciphertexts already checked to belong to ``group``.
+
+    The raw algorithm under :func:`modified_eval`, for a caller that checks its inputs once
+    (the controller server of eq:ec checks each state ciphertext once per step, its own
+    parameter ciphertexts once at set-up). One modular multiplication.
+    """
+    return ModifiedCiphertext(group, ct1.c1, ct2.c1, int(arith.mulmod(ct1.c2, ct2.c2, group.p)), ct1.t, ct2.t)
 
 
 def check_modified_ciphertext(grp: GroupParams, ct: Any) -> ModifiedCiphertext:
-    """Check that ``ct`` is a :class:`ModifiedCiphertext` with components in G (CiphertextError)."""
+    """Check that ``ct`` is a :class:`ModifiedCiphertext` of ``grp`` with components in G.
+
+    Raises
+    ------
+    CiphertextError
+        For another type or a component outside G.
+    KeyMismatchError
+        If ``ct`` belongs to another group.
+    """
     if not isinstance(ct, ModifiedCiphertext):
         raise CiphertextError(f"expected a ModifiedCiphertext (c1, c2, c3), got {ct!r}")
-    _check_component(grp, ct.c1, "c1")
-    _check_component(grp, ct.c2, "c2")
-    _check_component(grp, ct.c3, "c3")
+    check_group_of(ct, grp)
+    check_component(grp, ct.c1, "c1")
+    check_component(grp, ct.c2, "c2")
+    check_component(grp, ct.c3, "c3")
     return ct
 
 
@@ -102,18 +130,18 @@ def modified_decrypt(sk1: SecretKey, sk2: SecretKey, ct: ModifiedCiphertext) -> 
     Raises
     ------
     KeyMismatchError
-        If the keys belong to different groups, or ``ct`` records steps other than
+        If the keys and ``ct`` do not belong to one group, or ``ct`` records steps other than
         ``sk1.t`` / ``sk2.t``.
     CiphertextError
         If ``ct`` is malformed.
     """
-    _check_key(sk1, SecretKey, "sk1")
-    _check_key(sk2, SecretKey, "sk2")
+    check_instance(sk1, SecretKey, "sk1")
+    check_instance(sk2, SecretKey, "sk2")
     grp = check_same_group(sk1, sk2, "sk1 and sk2")
     check_modified_ciphertext(grp, ct)
     if ct.t1 is not None and ct.t1 != sk1.t:
         raise KeyMismatchError(f"component c1 is of step t = {ct.t1}, sk1 is of step t = {sk1.t}")
     if ct.t2 is not None and ct.t2 != sk2.t:
         raise KeyMismatchError(f"component c2 is of step t = {ct.t2}, sk2 is of step t = {sk2.t}")
-    c_tilde = _dec(grp, sk2.s, ct.c2, ct.c3)
-    return _dec(grp, sk1.s, ct.c1, c_tilde)
+    c_tilde = decrypt_components(grp, sk2.s, ct.c2, ct.c3)
+    return decrypt_components(grp, sk1.s, ct.c1, c_tilde)

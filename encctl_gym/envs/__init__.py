@@ -11,22 +11,10 @@
 
 from __future__ import annotations
 
+from ..registration import ENV_ID, register_envs
 from .config import AttackParams, default_config, resolve_params
 from .encrypted_lti_attack import EncryptedLTIAttackEnv
 
 __all__ = ["EncryptedLTIAttackEnv", "default_config", "resolve_params", "AttackParams", "ENV_ID", "register_envs"]
 
-ENV_ID = "encctl_gym/EncryptedLTIAttack-v0"
-
-
-def register_envs() -> None:
-    """Register ``encctl_gym/EncryptedLTIAttack-v0`` with gymnasium (idempotent)."""
-    import gymnasium as gym
-
-    if ENV_ID in gym.registry:
-        return
-    gym.register(
-        id=ENV_ID,
-        entry_point="encctl_gym.envs.encrypted_lti_attack:EncryptedLTIAttackEnv",
-        vector_entry_point="encctl_gym.envs.vector:EncryptedLTIAttackVectorEnv",
-    )
+register_envs()

@@ -12,10 +12,19 @@ times, measured on the energy stage); called once per range it is paid once per 
 
 The small batched kernels (energy budget, plant update, regression columns, error,
 observation) are used one by one by the ElGamal backend, between calls into the crypto layer;
-:func:`step_fused` does a whole ideal-backend period (energy budget, forged input quantised
-through the residue table of :mod:`encctl_gym.crypto.residue_table`, plant, delivery,
-recursive least squares, error, reward, observation) in one call. The batched kernels release
-the GIL, so the episode's helper thread (noise draws, Gram catch-up) runs while they do.
+:func:`step_fused` does a whole ideal-backend period (energy budget, forged input and collected
+state in the loop's exact fixed-point arithmetic, :mod:`encctl_gym.loop.quantize`, plant,
+delivery, recursive least squares, error, reward, observation, info) in one call. The batched
+kernels release the GIL, so the episode's helper thread (noise draws, Gram catch-up) runs
+while they do.
+
+Arguments come grouped in plain tuples, built once per episode (numba dispatches a plain tuple
+as fast as separate arguments): ``consts`` = ``(A, B, theta_true_T, c, u_max, budget)``,
+``arrays`` = ``(x, energy, X, U, hist, Q, eps, reward, a_buf, q_buf, qx_buf, sc)``, ``quant`` =
+the loop's :class:`~encctl_gym.loop.quantize.Quantization`, ``obs_at`` = the observation
+offsets of :class:`~encctl_gym.envs.layout.ObservationLayout`; each kernel unpacks them in
+that order. The observation and the info rows are written where
+:mod:`encctl_gym.envs.layout` says.
 
 Data layout: ``X`` (N, K, n) and ``U`` (N, K, m) are time-major, so the copies' data of one
 period are contiguous. The running least squares are kept with the copies innermost: the
@@ -31,12 +40,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-# status codes
-OK = 0
-STATE_OVERFLOW = 1
+from ..loop.quantize import OK, STATE_OVERFLOW, _collect, _forge
+from .layout import C_COLLECTED, C_DELIVERED, F_ENERGY, F_EPSILON, F_GAMMA, F_GAMMA_OPT, F_POWER, F_TIME
+
+__all__ = ["OK", "STATE_OVERFLOW", "PARALLEL_CHUNK", "dims"]
 
 #: copies per task of the parallel kernel
-_CHUNK = 256
+PARALLEL_CHUNK = 256
 #: copies whose running least squares are updated together over a run of periods
 _BLOCK = 16
 
@@ -94,39 +104,6 @@ def _history(k0, k1, m, L, hist, act):
             hist[k, i] = hist[k, i - m]
         for j in range(min(m, L)):
             hist[k, j] = act[k, j]
-
-
-@njit(inline="always")
-def _forge(k0, k1, m, a_buf, q_buf, U, u_at, delta, offset, limit, one, zero2, n_cols):
-    """The forged input as the plant decodes it (``crypto.controller.injection_value``):
-    ``(Ecd(a) Ecd(1) + (n - 1) Ecd(0)^2) / Delta^2``, with ``Ecd`` the nearest subgroup member
-    to ``round(Delta a)`` (Definition def:ec) from the residue table. ``|a| <= u_max`` lies
-    inside the table, so no range check is needed here."""
-    dd = delta * delta
-    for k in range(k0, k1):
-        for j in range(m):
-            i = np.int64(np.rint(a_buf[k, j] * delta))
-            q_buf[k, j] = i + offset[i + limit]
-            a_buf[k, j] = (q_buf[k, j] * one + (n_cols - 1) * zero2) / dd
-            U[u_at, k, j] = a_buf[k, j]
-
-
-@njit(inline="always")
-def _collect(k0, k1, n, x, X, collect_at, x_bound, delta, offset, limit, qx_buf):
-    """The collected state ``Dcd(Ecd(x))`` into ``X[collect_at]``; STATE_OVERFLOW if an entry
-    leaves the encoder's declared range ``|x| <= x_bound`` (NaN included) or the table."""
-    for k in range(k0, k1):
-        for i in range(n):
-            v = x[k, i]
-            if not abs(v) <= x_bound:
-                return STATE_OVERFLOW
-            q = np.int64(np.rint(v * delta))
-            if q > limit or q < -limit:
-                return STATE_OVERFLOW
-            qx_buf[k, i] = q + offset[q + limit]
-        for i in range(n):
-            X[collect_at, k, i] = qx_buf[k, i] / delta
-    return OK
 
 
 @njit(inline="always")
@@ -242,52 +219,55 @@ def _error(k0, k1, n, m, Q, theta_true_T, c, ready, eps):
 
 
 @njit(inline="always")
-def _observation(k0, k1, n, m, H, obs, X, U, j, new, hist, time_frac, energy, budget):
-    """[x_j | u_{j-1} | new | own inputs | deciphering-time fraction | energy fraction]."""
+def _observation(k0, k1, n, m, H, obs, obs_at, X, U, j, new, hist, time_frac, energy, budget):
+    """[x_j | u_{j-1} | new | own inputs | deciphering-time fraction | energy fraction], at the
+    offsets ``obs_at`` of :class:`~encctl_gym.envs.layout.ObservationLayout`."""
+    s0, u0, f0, h0, t0, e0 = obs_at
     for k in range(k0, k1):
         for i in range(n):
-            obs[k, i] = X[j, k, i] if j >= 0 else 0.0
+            obs[k, s0 + i] = X[j, k, i] if j >= 0 else 0.0
         for i in range(m):
-            obs[k, n + i] = U[j - 1, k, i] if j >= 1 else 0.0
-        obs[k, n + m] = new
+            obs[k, u0 + i] = U[j - 1, k, i] if j >= 1 else 0.0
+        obs[k, f0] = new
         for i in range(H):
-            obs[k, n + m + 1 + i] = hist[k, i]
-        obs[k, n + m + 1 + H] = time_frac
-        obs[k, n + m + 2 + H] = energy[k] / budget
+            obs[k, h0 + i] = hist[k, i]
+        obs[k, t0] = time_frac
+        obs[k, e0] = energy[k] / budget
 
 
 @njit(inline="always")
-def _info(k0, k1, f, counts, eps, energy, gamma, time, power_den, gamma_opt, collected, delivered):
-    """The info rows: epsilon, gamma, deciphering time, input energy, average power
-    (energy / power_den) and, if ``f`` has a sixth row, gamma_opt; the sample counts."""
+def _info(k0, k1, f, counts, eps, energy, scalars):
+    """The info rows of :mod:`encctl_gym.envs.layout`: epsilon, gamma, deciphering time, input
+    energy, average power (energy / power_den) and, if ``f`` has the row, gamma_opt; the sample
+    counts. ``scalars`` = ``(gamma, time, power_den, gamma_opt, collected, delivered)``."""
+    gamma, time, power_den, gamma_opt, collected, delivered = scalars
     for k in range(k0, k1):
-        f[0, k] = eps[k]
-        f[1, k] = gamma
-        f[2, k] = time
-        f[3, k] = energy[k]
-        f[4, k] = energy[k] / power_den
-        counts[0, k] = collected
-        counts[1, k] = delivered
-    if f.shape[0] > 5:
+        f[F_EPSILON, k] = eps[k]
+        f[F_GAMMA, k] = gamma
+        f[F_TIME, k] = time
+        f[F_ENERGY, k] = energy[k]
+        f[F_POWER, k] = energy[k] / power_den
+        counts[C_COLLECTED, k] = collected
+        counts[C_DELIVERED, k] = delivered
+    if f.shape[0] > F_GAMMA_OPT:
         for k in range(k0, k1):
-            f[5, k] = gamma_opt
+            f[F_GAMMA_OPT, k] = gamma_opt
 
 
 @njit(inline="always")
-def _period(
-    k0, k1, n, m, H, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, tmp,
-):
+def _period(k0, k1, n, m, H, consts, arrays, quant, act, w, u_at, collect_at, tmp):
     """One ideal-backend period of the copies ``k0 <= k < k1``, stage by stage: energy budget,
     forged input, plant update, own-input history and, if ``collect_at >= 0``, the collected
     state. Returns a status code."""
+    A, B, theta_true_T, c, u_max, budget = consts
+    x, energy, X, U, hist, Q, eps, reward, a_buf, q_buf, qx_buf, sc = arrays
     _energy(k0, k1, m, act, u_max, energy, budget, a_buf)
-    _forge(k0, k1, m, a_buf, q_buf, U, u_at, delta, offset, limit, one, zero2, n_cols)
+    _forge(k0, k1, m, quant, a_buf, q_buf, U, u_at)
     _plant(k0, k1, n, m, x, a_buf, w, A, B, tmp)
     if H > 0:
         _history(k0, k1, m, H, hist, act)
     if collect_at >= 0:
-        return _collect(k0, k1, n, x, X, collect_at, x_bound, delta, offset, limit, qx_buf)
+        return _collect(k0, k1, n, quant, x, X, collect_at, qx_buf)
     return OK
 
 
@@ -411,9 +391,9 @@ def estimation_error(dims, Q, theta_true_T, c, ready, eps):
 
 
 @njit(cache=True, nogil=True)
-def fill_observation(dims, obs, X, U, j, new, hist, time_frac, energy, budget):
+def fill_observation(dims, obs, obs_at, X, U, j, new, hist, time_frac, energy, budget):
     n, m, H = len(dims[0]), len(dims[1]), len(dims[2])
-    _observation(0, obs.shape[0], n, m, H, obs, X, U, j, new, hist, time_frac, energy, budget)
+    _observation(0, obs.shape[0], n, m, H, obs, obs_at, X, U, j, new, hist, time_frac, energy, budget)
 
 
 @njit(cache=True, nogil=True)
@@ -454,9 +434,9 @@ def load_actions(src, dst):
 
 
 @njit(cache=True, nogil=True)
-def fill_info(f, counts, eps, energy, gamma, time, power_den, gamma_opt, collected, delivered):
+def fill_info(f, counts, eps, energy, scalars):
     """The info of every copy (see :func:`_info`)."""
-    _info(0, f.shape[1], f, counts, eps, energy, gamma, time, power_den, gamma_opt, collected, delivered)
+    _info(0, f.shape[1], f, counts, eps, energy, scalars)
 
 
 @njit(cache=True, nogil=True)
@@ -467,71 +447,61 @@ def log_ratio(before, after, out):
 
 
 @njit(cache=True, nogil=True)
-def step_ideal(
-    dims, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
-):
+def step_ideal(dims, consts, arrays, quant, act, w, u_at, collect_at):
     """The period alone (no delivery): see :func:`_period`."""
     n, m, H = len(dims[0]), len(dims[1]), len(dims[2])
-    return _period(
-        0, act.shape[0], n, m, H, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-        x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, np.empty(n),
-    )
+    return _period(0, act.shape[0], n, m, H, consts, arrays, quant, act, w, u_at, collect_at, np.empty(n))
+
+
+@njit(inline="always")
+def _steady(k0, k1, n, m, H, consts, arrays, obs, obs_at, first, target, j_obs, new, time_frac, info, scalars):
+    """The stages after the period of a steady-state step: delivery by recursive least squares,
+    error and reward (:func:`_deliver`), observation and info, for the copies ``k0 <= k < k1``."""
+    A, B, theta_true_T, c, u_max, budget = consts
+    x, energy, X, U, hist, Q, eps, reward, a_buf, q_buf, qx_buf, sc = arrays
+    _deliver(k0, k1, n, m, X, U, first, target, Q, sc, theta_true_T, c, eps, reward)
+    _observation(k0, k1, n, m, H, obs, obs_at, X, U, j_obs, new, hist, time_frac, energy, budget)
+    _info(k0, k1, info[0], info[1], eps, energy, scalars)
 
 
 @njit(cache=True, nogil=True)
 def step_fused(
-    dims, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
-    first, target, Q, sc, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
-    info, counts, gamma, time, power_den, gamma_opt, collected, delivered,
+    dims, consts, arrays, quant, act, w, u_at, collect_at, first, target, obs, obs_at, j_obs, new, time_frac, info, scalars,
 ):
     """A whole steady-state ideal-backend period for every copy in one call: the period, the
-    delivery by recursive least squares, the error, the reward and the observation (the Gram
-    matrices are left behind; :func:`add_gram` catches them up when they are needed). Stage
-    by stage over the whole batch: measured faster here than chunk by chunk. Also writes the
-    info rows (see :func:`_info`) for the period's new sample counts.
+    delivery of the columns ``first <= j < target`` by recursive least squares, the error, the
+    reward, the observation and the info rows (``info`` = ``(f, counts)``, ``scalars`` as for
+    :func:`_info`). The Gram matrices are left behind; :func:`add_gram` catches them up when
+    they are needed. Stage by stage over the whole batch: measured faster here than chunk by
+    chunk.
     """
     K = act.shape[0]
     n, m, H = len(dims[0]), len(dims[1]), len(dims[2])
-    tmp = np.empty(n)
-    status = _period(
-        0, K, n, m, H, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-        x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, tmp,
-    )
+    status = _period(0, K, n, m, H, consts, arrays, quant, act, w, u_at, collect_at, np.empty(n))
     if status != OK:
         return status
-    _deliver(0, K, n, m, X, U, first, target, Q, sc, theta_true_T, c, eps, reward)
-    _observation(0, K, n, m, H, obs, X, U, j_obs, new, hist, time_frac, energy, budget)
-    _info(0, K, info, counts, eps, energy, gamma, time, power_den, gamma_opt, collected, delivered)
+    _steady(0, K, n, m, H, consts, arrays, obs, obs_at, first, target, j_obs, new, time_frac, info, scalars)
     return OK
 
 
 @njit(cache=True, nogil=True, parallel=True)
 def step_fused_parallel(
-    dims, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-    x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf,
-    first, target, Q, sc, theta_true_T, c, eps, reward, obs, j_obs, new, time_frac,
-    info, counts, gamma, time, power_den, gamma_opt, collected, delivered,
+    dims, consts, arrays, quant, act, w, u_at, collect_at, first, target, obs, obs_at, j_obs, new, time_frac, info, scalars,
 ):
-    """:func:`step_fused` with its chunks spread over the cores (``prange``): the same stages
-    on the same chunks, which do not interact, so the numbers are identical."""
+    """:func:`step_fused` with its chunks of :data:`PARALLEL_CHUNK` copies spread over the cores
+    (``prange``): the same stages on the same chunks, which do not interact, so the numbers are
+    identical."""
     K = act.shape[0]
     n, m, H = len(dims[0]), len(dims[1]), len(dims[2])
-    n_chunks = (K + _CHUNK - 1) // _CHUNK
+    n_chunks = (K + PARALLEL_CHUNK - 1) // PARALLEL_CHUNK
     status = np.zeros(n_chunks, dtype=np.int64)
     for t in prange(n_chunks):
-        k0 = t * _CHUNK
-        k1 = min(k0 + _CHUNK, K)
+        k0 = t * PARALLEL_CHUNK
+        k1 = min(k0 + PARALLEL_CHUNK, K)
         tmp = np.empty(n)  # per task: the tasks run concurrently (sc: each its own columns)
-        s = _period(
-            k0, k1, n, m, H, act, u_max, energy, budget, delta, offset, limit, one, zero2, n_cols, x_bound,
-            x, A, B, w, X, U, u_at, collect_at, hist, a_buf, q_buf, qx_buf, tmp,
-        )
+        s = _period(k0, k1, n, m, H, consts, arrays, quant, act, w, u_at, collect_at, tmp)
         if s != OK:
             status[t] = s
         else:
-            _deliver(k0, k1, n, m, X, U, first, target, Q, sc, theta_true_T, c, eps, reward)
-            _observation(k0, k1, n, m, H, obs, X, U, j_obs, new, hist, time_frac, energy, budget)
-            _info(k0, k1, info, counts, eps, energy, gamma, time, power_den, gamma_opt, collected, delivered)
+            _steady(k0, k1, n, m, H, consts, arrays, obs, obs_at, first, target, j_obs, new, time_frac, info, scalars)
     return status.max()

@@ -8,23 +8,55 @@ the user's ``config`` and keyword arguments and resolved once into an immutable
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+import warnings
+from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 import numpy as np
 
-from .._validation import check_int, check_nonnegative, check_positive, check_schur_stable, check_system
-from ..errors import BudgetError, ParameterError
+from .._validation import (
+    check_bool,
+    check_int,
+    check_nonnegative,
+    check_positive,
+    check_schur_stable,
+    check_system,
+    format_value,
+)
+from ..errors import BudgetError, ConfigError, ParameterError
 from ..presets import get_preset
 from ..security.complexity import sic_from_traces
-from ..security.deciphering import ADVERSARIES, SCHEMES, keys_to_break, max_affordable_samples, per_sample_cost
-from ..security.design import bit_security_of_key_length, design_from_traces, minimum_key_length
+from ..security.cost_models import (
+    DECIPHERING_MODELS,
+    GENERIC_MIN_KEY_LENGTH,
+    GUILLEVIC_CORRECTION,
+    KeyBreakCost,
+    PaperModel,
+    check_gnfs_correction,
+    check_security_parameter,
+    deciphering_model,
+)
+from ..security.deciphering import (
+    ADVERSARIES,
+    SCHEMES,
+    independent_keys,
+    max_affordable_samples,
+    per_sample_cost,
+    sample_deciphering_time,
+)
+from ..security.design import design_from_traces
+from ..security.exact import decimal_fraction
 from ..security.gramians import controllability_gramian, noise_gramian
+from ..units import parse_duration
+from ..loop import BACKENDS as _LOOP_BACKENDS
+from .layout import ObservationLayout
+from .rewards import REWARDS as _REWARD_CLASSES
 
 __all__ = ["default_config", "AttackParams", "resolve_params", "REWARDS", "BACKENDS"]
 
-REWARDS = ("log_error", "logdet")
-BACKENDS = ("ideal", "elgamal")
+#: Names of the rewards (:data:`encctl_gym.envs.rewards.REWARDS`) and backends (:data:`encctl_gym.loop.BACKENDS`).
+REWARDS: tuple[str, ...] = tuple(_REWARD_CLASSES)
+BACKENDS: tuple[str, ...] = tuple(_LOOP_BACKENDS)
 
 
 def default_config() -> dict[str, Any]:
@@ -43,14 +75,23 @@ def default_config() -> dict[str, Any]:
     ``security_parameter``        lambda in bits; ``None``: from ``key_length``, else lambda* of
                                   Theorem thm:opt_sec for the preset's design parameters
     ``key_length``                key length k in bits (lambda = log2 Omega(k), eq:opt_key)
-    ``upsilon``, ``tau_c``        attacker FLOPS and defense period in s (preset's if ``None``)
+    ``deciphering_model``         what breaking the keys costs (:mod:`encctl_gym.security.cost_models`):
+                                  ``"paper"`` (def:sdt: ``2^lambda`` per key), ``"precomputation"``
+                                  (one GNFS precomputation per group, then a cheap step per key),
+                                  ``"generic"`` (Pollard rho per key)
+    ``gnfs_correction``           o(1) correction of the GNFS cost in bits (0: the paper's; the
+                                  documented alternative ``"guillevic"``, 11.91)
+    ``upsilon``, ``tau_c``        attacker FLOPS and defense period in s or a duration such as
+                                  ``"10y"`` (preset's if ``None``)
     ``gamma_c``                   acceptable error, used for the default lambda*
     ``max_samples``               cap on the attack length N (truncation); required when one
                                   break reveals every sample (static; token vs server)
     ``decipher_delay``            0 (adaptive), an integer number of steps, or ``"end"``
     ``warmup_steps``              steps of normal encrypted LQR control before the attack
-    ``reward``                    ``"log_error"`` or ``"logdet"``
-    ``logdet_regularization``     delta of ``log det(G + delta I)`` for ``reward="logdet"``
+    ``reward``                    ``"log_error"``, ``"logdet"`` or ``"a_optimality"``
+                                  (:mod:`encctl_gym.envs.rewards`)
+    ``logdet_regularization``     delta of ``G + delta I`` in the Gram-matrix rewards
+                                  (``logdet``, ``a_optimality``)
     ``crypto``                    ``"ideal"`` (exact arithmetic, no big integers) or ``"elgamal"``
     ``delta``                     encoder scaling factor Delta (Definition def:ec)
     ``x_bound``                   declared state range of the encoder (overflow raises)
@@ -71,6 +112,8 @@ def default_config() -> dict[str, Any]:
         "adversary": "eavesdropper",
         "security_parameter": None,
         "key_length": None,
+        "deciphering_model": "paper",
+        "gnfs_correction": 0.0,
         "upsilon": None,
         "tau_c": None,
         "gamma_c": None,
@@ -100,12 +143,15 @@ class AttackParams:
     sigma_u2: float
     scheme: str
     adversary: str
-    security_parameter: float
+    security_parameter: float  # lambda of the paper's model for this key (def:bit_sec, eq:opt_key)
     key_length: int
     upsilon: float
     tau_c: float
     gamma_c: float
-    sample_cost: float  # 2^lambda / Upsilon, seconds per broken key
+    deciphering_model: str
+    cost: KeyBreakCost  # operations for the first key of the group and for each further key
+    sample_cost: float  # seconds to break the first key (2^lambda / Upsilon under the paper's model)
+    next_sample_cost: float  # seconds to break each further key of the same group
     budget_samples: float  # samples affordable within tau_c (inf if one break reveals all)
     horizon: int  # N: the attack length in samples
     independent_keys: bool  # every sample under its own key (def:sdt), else one break reveals all
@@ -123,6 +169,7 @@ class AttackParams:
     crypto_seed: int | None
     tr_psi_u: float
     tr_psi_w: float
+    sources: dict[str, str] = field(default_factory=dict)  # where A, B, the variances and design values came from
 
     @property
     def n(self) -> int:
@@ -132,78 +179,120 @@ class AttackParams:
     def m(self) -> int:
         return int(self.B.shape[1])
 
+    def deciphering_time(self, N: Any) -> Any:
+        """tau(N) of the configured model (Definition def:sdt, :func:`sample_deciphering_time`), seconds."""
+        return sample_deciphering_time(N, self.cost, self.upsilon, scheme=self.scheme, adversary=self.adversary)
+
     @property
     def energy_budget(self) -> float:
         """Total input energy sum_t ||a_t||^2 allowed over the episode: m sigma_u2 N."""
         return self.m * self.sigma_u2 * self.horizon
 
     @property
+    def layout(self) -> ObservationLayout:
+        """The observation layout of this environment."""
+        return ObservationLayout.of(self)
+
+    @property
     def obs_dim(self) -> int:
-        return self.n + self.m + 1 + self.input_history * self.m + 2
+        return self.layout.dim
 
     def observation_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Finite bounds of the observation: states within the encoder's declared range
-        ``x_bound`` (encoding beyond it raises) plus the encoder's largest shift to the group
-        (64/Delta), inputs within the actuator bound plus the forged input's quantisation,
-        flag and fractions within [0, 1]."""
-        n, m, H = self.n, self.m, self.input_history
-        x_hi = self.x_bound + 65.0 / self.delta
-        u_hi = (self.u_max + 65.0 / self.delta) * (1.0 + 65.0 / self.delta) + n / self.delta**2
-        high = np.concatenate([np.full(n, x_hi), np.full(m, u_hi), [1.0], np.ones(H * m), [1.0, 1.0]])
-        low = np.concatenate([-high[: n + m], [0.0], -np.ones(H * m), [0.0, 0.0]])
-        return low.astype(np.float32), high.astype(np.float32)
+        """Finite bounds of the observation (:meth:`ObservationLayout.bounds`)."""
+        return self.layout.bounds(x_bound=self.x_bound, u_max=self.u_max, delta=self.delta)
 
     def gamma(self, N: Any) -> Any:
         """gamma(N) of eq:sic (Theorem thm:sic) for this plant and the attacker's input power."""
         return sic_from_traces(N, self.tr_psi_u, self.tr_psi_w, self.m, self.n, self.sigma_u2, self.sigma_w2, self.sigma_x2)
 
 
+#: Longest warm-up accepted: the warm-up runs the encrypted controller period by period, and the
+#: plant forgets x_0 geometrically fast under it, so more is never needed.
+MAX_WARMUP_STEPS = 100_000
+
+#: Values taken from the preset, the package's defaults or the configuration, by key
+#: (:attr:`AttackParams.sources`).
+SOURCE_KEYS = ("A", "B", "sigma_w2", "sigma_x2", "sigma_u2", "upsilon", "tau_c", "gamma_c")
+
+
 def _choice(name: str, value: Any, options: tuple[str, ...]) -> str:
-    if value not in options:
-        raise ParameterError(f"unknown {name} {value!r}; choose one of {', '.join(options)}")
+    if not isinstance(value, str) or value not in options:
+        raise ParameterError(f"unknown {name} {format_value(value)}; choose one of {', '.join(options)}")
     return value
 
 
 def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> AttackParams:
     """Merge ``config`` and ``kwargs`` over :func:`default_config` and validate everything.
 
+    A plant given by ``A`` and ``B`` without a ``preset`` key is not completed from the default
+    preset: then every variance and design value must be given (all missing ones are named at
+    once). With an explicit preset and ``A``/``B``, the other values come from the preset and a
+    warning says which. :attr:`AttackParams.sources` records where each value came from.
+
     Raises
     ------
     ParameterError
         Unknown keys, schemes, backends, rewards or presets; non-positive Upsilon, tau_c or
-        variances; an unstable A (UnstableSystemError); mismatched shapes (ShapeError).
+        variances; an unstable A (UnstableSystemError); mismatched shapes (ShapeError); a flag
+        that is not a bool; missing values without a preset.
+    ConfigError
+        A configuration that is not a mapping.
     BudgetError
         A budget too small to identify anything (fewer than n + m + 1 samples).
     """
+    if config is not None and not isinstance(config, Mapping):
+        raise ConfigError(f"config must be a mapping of configuration keys to values, got {config!r}")
     cfg = default_config()
     merged = dict(config or {})
     merged.update(kwargs)
-    unknown = sorted(set(merged) - set(cfg))
+    unknown = sorted(set(merged) - set(cfg), key=str)
     if unknown:
         raise ParameterError(f"unknown configuration key(s) {unknown}; known keys: {sorted(cfg)}")
     cfg.update(merged)
-
-    preset = get_preset(cfg["preset"]) if cfg["preset"] is not None else None
+    if ("A" in merged or "B" in merged) and "preset" not in merged:
+        cfg["preset"] = None  # a plant of the user's is not silently completed from the default preset
+    name = cfg["preset"]
+    if name is not None and not isinstance(name, str):
+        raise ParameterError(f"preset must be a preset name or None, got {name!r}")
+    preset = get_preset(name) if name is not None else None
     if preset is None and (cfg["A"] is None or cfg["B"] is None):
         raise ParameterError("without a preset, both A and B must be given")
-    A, B = check_system(
-        cfg["A"] if cfg["A"] is not None else preset.A,
-        cfg["B"] if cfg["B"] is not None else preset.B,
-    )
+    sources: dict[str, str] = {}
+    missing: list[str] = []
+
+    def pick(key: str, default: Any = None) -> Any:
+        if cfg[key] is not None:
+            sources[key] = "config"
+            return cfg[key]
+        if preset is not None:
+            sources[key] = f"preset {preset.name}"
+            return getattr(preset, key)
+        if default is not None:
+            sources[key] = "default"
+            return default
+        missing.append(key)
+        return None
+
+    A, B = check_system(pick("A"), pick("B"))
     check_schur_stable(A)
+    raw = {key: pick(key, 1.0 if key == "sigma_x2" else None) for key in SOURCE_KEYS[2:]}
+    if missing:
+        raise ParameterError(f"without a preset these values must be given too: {', '.join(missing)}")
+    if preset is not None and {"A", "B"} & set(merged):
+        inherited = [k for k in SOURCE_KEYS if sources[k].startswith("preset")]
+        warnings.warn(
+            f"A/B are given and the other values come from preset {preset.name!r}: {', '.join(inherited)}; "
+            "pass preset=None to give them all yourself",
+            UserWarning,
+            stacklevel=3,
+        )
 
-    def pick(key: str, default: float | None) -> Any:
-        value = cfg[key] if cfg[key] is not None else (getattr(preset, key) if preset is not None else default)
-        if value is None:
-            raise ParameterError(f"{key} must be given when no preset is used")
-        return value
-
-    sigma_w2 = check_positive("sigma_w2", pick("sigma_w2", None))
-    sigma_x2 = check_nonnegative("sigma_x2", pick("sigma_x2", 1.0))
-    sigma_u2 = check_positive("sigma_u2", pick("sigma_u2", None))
-    upsilon = check_positive("upsilon", pick("upsilon", None))
-    tau_c = check_positive("tau_c", pick("tau_c", None))
-    gamma_c = check_positive("gamma_c", pick("gamma_c", None))
+    sigma_w2 = check_positive("sigma_w2", raw["sigma_w2"])
+    sigma_x2 = check_nonnegative("sigma_x2", raw["sigma_x2"])
+    sigma_u2 = check_positive("sigma_u2", raw["sigma_u2"])
+    upsilon = check_positive("upsilon", raw["upsilon"])
+    tau_c = parse_duration(raw["tau_c"], "tau_c")
+    gamma_c = check_positive("gamma_c", raw["gamma_c"])
     scheme = _choice("scheme", cfg["scheme"], SCHEMES)
     adversary = _choice("adversary", cfg["adversary"], ADVERSARIES)
     reward = _choice("reward", cfg["reward"], REWARDS)
@@ -217,23 +306,30 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     lam_cfg, k_cfg = cfg["security_parameter"], cfg["key_length"]
     if lam_cfg is not None and k_cfg is not None:
         raise ParameterError("give either security_parameter or key_length, not both")
+    model_name = _choice("deciphering_model", cfg["deciphering_model"], tuple(DECIPHERING_MODELS))
+    correction = cfg["gnfs_correction"]
+    if correction == "guillevic":
+        correction = GUILLEVIC_CORRECTION
+    correction = check_gnfs_correction(correction)
+    model = deciphering_model(model_name, **({"gnfs_correction": correction} if model_name != "generic" else {}))
+    paper = PaperModel(correction)  # eq:opt_key: lambda <-> key length
     if k_cfg is not None:
-        key_length = check_int("key_length", k_cfg, minimum=16)
-        lam = bit_security_of_key_length(key_length)
+        key_length = check_int("key_length", k_cfg, minimum=GENERIC_MIN_KEY_LENGTH)
+        cost = model.break_cost(key_length)
+        lam = cost.security_parameter if model_name == "paper" else paper.security_parameter_of_key_length(key_length)
     else:
         if lam_cfg is not None:
-            lam = check_positive("security_parameter", lam_cfg)
-            if float(lam).is_integer():
-                lam = int(lam)
+            lam = check_security_parameter(lam_cfg)
         else:
             design = design_from_traces(
                 tr_psi_u, tr_psi_w, m, n, sigma_u2=sigma_u2, sigma_w2=sigma_w2, sigma_x2=sigma_x2,
                 gamma_c=gamma_c, tau_c=tau_c, upsilon=upsilon,
             )
             lam = design.lam_star  # Theorem thm:opt_sec
-        key_length = minimum_key_length(lam)
+        key_length = paper.key_length_for_security_parameter(lam)  # eq:opt_key
+        cost = paper.cost_of_security_parameter(lam) if model_name == "paper" else model.break_cost(key_length)
 
-    budget = max_affordable_samples(tau_c, lam, upsilon, scheme=scheme, adversary=adversary)
+    budget = max_affordable_samples(tau_c, cost, upsilon, scheme=scheme, adversary=adversary)
     max_samples = cfg["max_samples"]
     if max_samples is not None:
         max_samples = check_int("max_samples", max_samples, minimum=1)
@@ -249,17 +345,20 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     if horizon < n + m + 1:
         raise BudgetError(
             f"the attack can collect only N = {horizon} samples (budget {budget} within tau_c = {tau_c:g} s at "
-            f"lambda = {lam}, Upsilon = {upsilon:g}; max_samples = {max_samples}); identification needs "
-            f"N >= n + m + 1 = {n + m + 1}"
+            f"lambda = {format_value(lam)}, k = {key_length} bits, {model_name} model, Upsilon = {upsilon:g}; "
+            f"max_samples = {max_samples}); identification needs N >= n + m + 1 = {n + m + 1}"
         )
 
     delay = cfg["decipher_delay"]
-    if delay == "end":
+    if isinstance(delay, str):
+        if delay != "end":
+            raise ParameterError(f"decipher_delay must be a non-negative integer or 'end', got {delay!r}")
         delay_v: int | None = None
-    elif isinstance(delay, str):
-        raise ParameterError(f"decipher_delay must be a non-negative integer or 'end', got {delay!r}")
     else:
         delay_v = check_int("decipher_delay", delay, minimum=0)
+    warmup = check_int("warmup_steps", cfg["warmup_steps"], minimum=0)
+    if warmup > MAX_WARMUP_STEPS:
+        raise ParameterError(f"warmup_steps must be <= {MAX_WARMUP_STEPS} (MAX_WARMUP_STEPS), got {warmup}")
 
     delta = check_int("delta", cfg["delta"], minimum=2)
     action_scale = check_positive("action_scale", cfg["action_scale"])
@@ -269,15 +368,16 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     return AttackParams(
         A=A, B=B, sigma_w2=sigma_w2, sigma_x2=sigma_x2, sigma_u2=sigma_u2,
         scheme=scheme, adversary=adversary, security_parameter=lam, key_length=key_length,
-        upsilon=upsilon, tau_c=tau_c, gamma_c=gamma_c,
-        sample_cost=per_sample_cost(lam, upsilon), budget_samples=budget,
-        horizon=horizon, independent_keys=keys_to_break(2, scheme, adversary) == 2, budget_limited=budget_limited, decipher_delay=delay_v,
-        warmup_steps=check_int("warmup_steps", cfg["warmup_steps"], minimum=0),
+        upsilon=upsilon, tau_c=tau_c, gamma_c=gamma_c, deciphering_model=model_name, cost=cost,
+        sample_cost=per_sample_cost(cost, upsilon), next_sample_cost=float(cost.next / decimal_fraction("upsilon", upsilon)),
+        budget_samples=budget, horizon=horizon, independent_keys=independent_keys(scheme, adversary),
+        budget_limited=budget_limited, decipher_delay=delay_v,
+        warmup_steps=warmup,
         reward=reward,
         logdet_regularization=check_positive("logdet_regularization", cfg["logdet_regularization"]),
         crypto=crypto, delta=delta, x_bound=check_positive("x_bound", cfg["x_bound"]),
         u_max=action_scale * math.sqrt(sigma_u2),
         input_history=check_int("input_history", cfg["input_history"], minimum=0),
-        gamma_opt=bool(cfg["gamma_opt"]), crypto_seed=crypto_seed,
-        tr_psi_u=tr_psi_u, tr_psi_w=tr_psi_w,
+        gamma_opt=check_bool("gamma_opt", cfg["gamma_opt"]), crypto_seed=crypto_seed,
+        tr_psi_u=tr_psi_u, tr_psi_w=tr_psi_w, sources=sources,
     )

@@ -9,11 +9,41 @@ import numpy as np
 from gymnasium import spaces
 
 from ..errors import ParameterError
-from ..loop import make_loop
+from ..loop import LoopBackend, make_loop
 from .config import AttackParams, default_config, resolve_params
-from .episode import EpisodeCore, attack_design_for
+from .episode import EpisodeCore, EpisodeSchedule, attack_design_for, check_episode_memory
 
-__all__ = ["EncryptedLTIAttackEnv"]
+__all__ = ["EncryptedLTIAttackEnv", "reset_options", "check_seed"]
+
+#: The keys ``reset(options=...)`` accepts (see :meth:`EpisodeCore.reset`).
+RESET_OPTIONS = ("x0", "noise")
+
+
+def check_seed(seed: Any) -> int | None:
+    """A reset seed: ``None`` or a non-negative integer (not a bool)."""
+    if seed is None:
+        return None
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ParameterError(f"seed must be None or a non-negative integer, got {seed!r}")
+    return int(seed)
+
+
+def reset_options(options: dict[str, Any] | None) -> dict[str, Any]:
+    """The ``options`` of ``reset`` as keyword arguments of :meth:`EpisodeCore.reset`.
+
+    Raises
+    ------
+    ParameterError
+        For options that are not a dict or have keys other than ``x0`` and ``noise``.
+    """
+    if options is None:
+        return {}
+    if not isinstance(options, dict):
+        raise ParameterError(f"reset options must be a dict, got {options!r}")
+    unknown = sorted(set(options) - set(RESET_OPTIONS))
+    if unknown:
+        raise ParameterError(f"unknown reset option(s) {unknown}; known: {list(RESET_OPTIONS)}")
+    return dict(options)
 
 
 class EncryptedLTIAttackEnv(gym.Env):
@@ -74,7 +104,9 @@ class EncryptedLTIAttackEnv(gym.Env):
 
     Nothing not yet paid for and delivered ever enters the observation: with
     ``decipher_delay = d`` the state ``x_j`` appears at step ``j + d``; with ``"end"`` nothing
-    is delivered before the attack ends (the agent knows only its own inputs).
+    is delivered before the attack ends (the agent knows only its own inputs). The layout is
+    :class:`~encctl_gym.envs.layout.ObservationLayout` (slices, bounds, training modes). The
+    same data in float64: ``env.unwrapped.episode.delivered_data()``.
 
     ## Rewards
 
@@ -83,7 +115,11 @@ class EncryptedLTIAttackEnv(gym.Env):
       ``n + m`` regression columns the estimate is ``[A B] = 0``. The return telescopes to
       ``log epsilon_0 - log epsilon_final``.
     * ``reward="logdet"``: the increase of ``log det(G + delta I)`` of the regressor Gram
-      matrix ``G`` of the delivered data, which an attacker can compute without ``(A, B)``.
+      matrix ``G`` of the delivered data, which an attacker can compute without ``(A, B)``
+      (D-optimality).
+    * ``reward="a_optimality"``: the decrease of ``log tr((G + delta I)^-1)`` (A-optimality):
+      the log of the expected error of the current least-squares estimate given the delivered
+      regressors, ``sigma_w2 tr(G^-1) / (n + m)``; low variance, computable without ``(A, B)``.
 
     ## Starting State
 
@@ -105,11 +141,29 @@ class EncryptedLTIAttackEnv(gym.Env):
     **overrides)``. See :func:`encctl_gym.envs.config.default_config` for every key
     (preset, A, B, variances, scheme, adversary, security_parameter or key_length, upsilon,
     tau_c, max_samples, decipher_delay, warmup_steps, reward, crypto, delta, ...).
+    ``schedule`` (:class:`~encctl_gym.envs.episode.EpisodeSchedule`) sets how the work is
+    batched (noise chunks, exact-refresh period); the default is what the benchmarks measure.
 
-    ``info``: ``epsilon`` (least squares error on all delivered data, ``nan`` until
-    identifiable), ``gamma`` (eq:sic at the delivered N), ``gamma_opt`` (optimal attack design,
-    when computed), ``samples_collected``, ``samples_delivered``, ``deciphering_time``,
-    ``input_energy``, ``average_power``.
+    ``reset(seed=..., options={"x0": x0, "noise": w})`` replays a given initial state
+    ``x0`` (n,) and process noise ``w`` (warmup_steps + horizon, n) instead of drawing them:
+    the same disturbance for two attackers (common random numbers).
+
+    ## Info
+
+    | key                 | meaning                                                          |
+    |---------------------|------------------------------------------------------------------|
+    | ``epsilon``         | error (Definition def:error) of the least-squares estimate on the delivered data; before ``n + m`` regression columns that of the estimate ``[A B] = 0`` |
+    | ``gamma``           | gamma(N) of eq:sic at the delivered N (``inf`` for N < 2)        |
+    | ``gamma_opt``       | the optimal attack design's gamma at N (when ``gamma_opt=True``) |
+    | ``samples_collected``, ``samples_delivered`` | N paid for, N delivered                 |
+    | ``deciphering_time``| seconds of attacker computation spent (Definition def:sdt)       |
+    | ``input_energy``, ``average_power`` | energy spent, and per input channel and step     |
+
+    **Privileged**: ``epsilon``, ``gamma`` and ``gamma_opt`` are functions of the true plant
+    ``(A, B)`` (``epsilon`` from the start: at reset it is ``||[A B]||_F^2 / (n (n + m))``,
+    even with ``decipher_delay="end"``), and so are ``env.unwrapped.params``, ``.design``,
+    ``.episode`` and ``.loop`` (which holds the plant's keys). They are for training and
+    evaluation, not something the attacker observes; an attacker acts on the observation only.
 
     ## Version History
 
@@ -118,17 +172,25 @@ class EncryptedLTIAttackEnv(gym.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
 
-    def __init__(self, config: dict[str, Any] | None = None, render_mode: str | None = None, **kwargs: Any) -> None:
+    def __init__(
+        self,
+        config: dict[str, Any] | None = None,
+        render_mode: str | None = None,
+        *,
+        schedule: EpisodeSchedule | None = None,
+        **kwargs: Any,
+    ) -> None:
         self.params: AttackParams = resolve_params(config, **kwargs)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ParameterError(f"unknown render_mode {render_mode!r}; choose one of {self.metadata['render_modes']}")
         self.render_mode = render_mode
         p = self.params
+        check_episode_memory(p, 1, schedule)  # before anything is sized by the parameters
         self.action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
         self.observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
         self.design = attack_design_for(p) if p.gamma_opt else None
         self._loop = make_loop(p)
-        self._core = EpisodeCore(p, self._loop, self.design)
+        self._core = EpisodeCore(p, self._loop, self.design, schedule=schedule)
 
     @staticmethod
     def default_config() -> dict[str, Any]:
@@ -136,13 +198,19 @@ class EncryptedLTIAttackEnv(gym.Env):
         return default_config()
 
     @property
-    def loop(self):
-        """The closed loop backend (ideal or ElGamal) behind the plant's input."""
+    def loop(self) -> LoopBackend:
+        """The closed loop backend (ideal or ElGamal) behind the plant's input (privileged)."""
         return self._loop
 
+    @property
+    def episode(self) -> EpisodeCore:
+        """The episode's state (privileged: the true plant and undelivered data): ``done``,
+        ``collected``, ``delivered``, ``delivered_data()``."""
+        return self._core
+
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
-        super().reset(seed=seed)
-        obs = self._core.reset(self.np_random)
+        super().reset(seed=check_seed(seed))
+        obs = self._core.reset(self.np_random, **reset_options(options))
         return obs[0], self._core.info()
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:

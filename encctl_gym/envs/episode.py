@@ -15,59 +15,108 @@ Per sampling period ``k`` of the attack (Definition def:adversary):
 2. samples whose delay has passed are delivered: state ``x_j`` with the input ``u_{j-1}``;
    each delivered state adds the regression column ``([x_{j-1}; u_{j-1}], x_j)`` of eq:data
    to recursive least squares (Sherman-Morrison), which is re-anchored to the exact solve of
-   eq:estimate from the running Gram matrices every ``_REFRESH`` columns and at the end;
+   eq:estimate from the running Gram matrices every ``schedule.refresh`` columns and at the end;
 3. the agent acts; its input is held to the energy budget, forged into the input ciphertext,
    decrypted by the plant (``u_k``) and applied: ``x_{k+1} = A x_k + B u_k + w_k``.
 
-Work that no step waits for can run on a helper thread (one per process, shared; the compiled
-kernels release the GIL): drawing the next ``_CHUNK`` periods of noise, and bringing the Gram
-matrices up to date, which the steady-state step leaves behind and only the exact refresh
-needs. It changes where that work runs, not what it computes: the numbers are the same with
-or without it (tested).
+When the loop backend exposes its arithmetic (:attr:`~encctl_gym.loop.backend.LoopBackend.quantization`,
+the ideal backend), the steady state of a ``fused`` reward runs as one compiled call per step;
+otherwise the backend is called period by period.
+
+Work that no step waits for can run on a :class:`~encctl_gym.envs.helper.HelperThread` (the
+compiled kernels release the GIL): drawing the next ``schedule.chunk`` periods of noise, and
+bringing the Gram matrices up to date, which the steady-state step leaves behind and only the
+exact refresh needs. It changes where that work runs, not what it computes: the numbers are the
+same with or without it (tested).
 """
 
 from __future__ import annotations
 
 import math
-import os
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future
+from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..errors import EncodingOverflowError, ParameterError
+from .._validation import as_finite_array, check_int, check_positive
+from ..errors import EncodingOverflowError, ParameterError, ShapeError
+from ..loop import LoopBackend
+from ..resources import check_memory
 from . import _kernels as kern
 from .config import AttackParams
+from .helper import HelperThread
+from .layout import ObservationLayout, info_buffers, info_from_buffers
+from .rewards import REWARDS
 
-__all__ = ["EpisodeCore", "attack_design_for"]
-
-#: noise is drawn from each copy's generator in chunks of this many periods
-_CHUNK = 256
-#: every copy's recursive least squares is re-anchored to the exact solve after this many columns
-_REFRESH = 1024
-#: a copy starts its recursion once the condition number of its scaled Gram matrix is below this
-_COND_LIMIT = 1e8
-#: with a helper thread, the Gram catch-up is handed over once it lags this many columns
-_GRAM_BATCH = 64
-
-_helper_pool: ThreadPoolExecutor | None = None
+__all__ = ["EpisodeCore", "EpisodeSchedule", "attack_design_for", "episode_bytes", "check_episode_memory"]
 
 
-def _helper() -> ThreadPoolExecutor:
-    """The process's helper thread: one worker, shared by every episode, started on first use."""
-    global _helper_pool
-    if _helper_pool is None:
-        _helper_pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="encctl-gym-helper")
-    return _helper_pool
+@dataclass(frozen=True)
+class EpisodeSchedule:
+    """How the episode batches its work (the numbers do not depend on ``chunk`` or
+    ``gram_batch``; ``refresh`` and ``cond_limit`` set when the exact solve re-anchors the recursion).
+
+    Attributes
+    ----------
+    chunk : int
+        Noise is drawn from each copy's generator in chunks of this many periods.
+    refresh : int
+        Every copy's recursive least squares is re-anchored to the exact solve after this many columns.
+    cond_limit : float
+        A copy starts its recursion once the condition number of its scaled Gram matrix is below this.
+    gram_batch : int
+        With a helper thread, the Gram catch-up is handed over once it lags this many columns.
+    """
+
+    chunk: int = 256
+    refresh: int = 1024
+    cond_limit: float = 1e8
+    gram_batch: int = 64
+
+    def __post_init__(self) -> None:
+        check_int("chunk", self.chunk, minimum=1)
+        check_int("refresh", self.refresh, minimum=1)
+        check_positive("cond_limit", self.cond_limit)
+        check_int("gram_batch", self.gram_batch, minimum=1)
 
 
-def _forget_helper() -> None:
-    """After a fork the child holds the pool but not its thread: start a new one on next use."""
-    global _helper_pool
-    _helper_pool = None
+def episode_bytes(params: AttackParams, num_envs: int, schedule: EpisodeSchedule | None = None) -> int:
+    """Bytes an episode of ``num_envs`` copies allocates (an estimate, within a few percent).
+
+    The data of the attack (states and inputs of the horizon), the running least squares, the
+    noise chunks, the per-copy generators and the tables over the sample size, with a margin of
+    a half for the transient arrays of the exact refresh and the buffers handed out per step.
+    """
+    sch = schedule if schedule is not None else EpisodeSchedule()
+    n, m, N, K = params.n, params.m, params.horizon, int(num_envs)
+    d, H = n + m, params.input_history
+    per_copy = (
+        N * d  # X, U
+        + 2 * d * (d + n)  # GC, Q
+        + 3 * d + 2 * n + 2  # scratch
+        + 3 * sch.chunk * n  # noise: drawn, in use, ahead
+        + H * m + 4 * m + 2 * n + 8  # history, actions and buffers, energy, eps, reward
+        + (ObservationLayout.of(params).dim + 8 * 2) // 2  # observation (float32) and info per step
+    )
+    generators = 2048  # a numpy Generator with its bit generator, per copy
+    tables = 4 * (N + 1)
+    return int(1.5 * (8 * (K * per_copy + tables) + K * generators))
 
 
-os.register_at_fork(after_in_child=_forget_helper)
+def check_episode_memory(
+    params: AttackParams, num_envs: int, schedule: EpisodeSchedule | None = None, memory_limit: int | None = None
+) -> None:
+    """Refuse an episode whose :func:`episode_bytes` exceed ``memory_limit`` (default
+    :data:`encctl_gym.resources.MEMORY_LIMIT`), before anything is allocated."""
+    p = params
+    check_memory(
+        f"an episode of num_envs = {num_envs} copies, horizon N = {p.horizon}, n = {p.n}, m = {p.m}, "
+        f"input_history = {p.input_history}",
+        episode_bytes(p, num_envs, schedule),
+        memory_limit,
+        "use fewer copies, a shorter attack (max_samples) or a shorter input_history",
+    )
 
 
 def _condition(Gs: np.ndarray) -> np.ndarray:
@@ -104,38 +153,55 @@ class EpisodeCore:
     ----------
     params : AttackParams
         Resolved environment parameters.
-    loop : object
-        Closed-loop backend (:mod:`encctl_gym.loop`) with ``start_episode``, ``control``,
-        ``collect_state``, ``inject`` and ``tick``.
+    loop : LoopBackend
+        Closed-loop backend (:mod:`encctl_gym.loop`).
     design : AttackDesign or None
         Source of ``gamma_opt`` in the info.
     num_envs : int
         K.
     parallel : bool
         Spread the copies of a steady-state step over the cores (same numbers).
-    helper_thread : bool
-        Draw the next chunk of noise and catch up the Gram matrices on a helper thread while
-        the copies are stepped (same numbers: the same work in the same order, only elsewhere).
+    helper : HelperThread or None
+        Draw the next chunk of noise and catch up the Gram matrices on this thread while the
+        copies are stepped (same numbers: the same work in the same order, only elsewhere).
+    schedule : EpisodeSchedule, optional
+        Batching of the work (default :class:`EpisodeSchedule`).
+    memory_limit : int, optional
+        Refuse, before allocating anything, an episode whose :func:`episode_bytes` exceed this
+        many bytes (default :data:`encctl_gym.resources.MEMORY_LIMIT`).
 
-    Randomness: the noise of chunk ``c + 1`` (``_CHUNK`` periods) is drawn from every copy's
-    generator as soon as chunk ``c`` is taken into use, if the episode reaches it, with or
-    without the helper thread; so the draws, and hence the numbers, are the same either way.
+    Public state (for training, evaluation and tests; privileged where it involves the true
+    plant or undelivered data): :attr:`done`, :attr:`collected`, :attr:`delivered`,
+    :attr:`eps` (the error of every copy's current estimate, a function of the true ``(A, B)``),
+    :meth:`delivered_data` (what the attacker has deciphered and received, float64).
+
+    Randomness: the noise of chunk ``c + 1`` is drawn from every copy's generator as soon as
+    chunk ``c`` is taken into use, if the episode reaches it, with or without the helper thread;
+    so the draws, and hence the numbers, are the same either way.
     """
 
     def __init__(
         self,
         params: AttackParams,
-        loop: Any,
+        loop: LoopBackend,
         design: Any = None,
         num_envs: int = 1,
+        *,
         parallel: bool = False,
-        helper_thread: bool = False,
+        helper: HelperThread | None = None,
+        schedule: EpisodeSchedule | None = None,
+        memory_limit: int | None = None,
     ) -> None:
         p = self.p = params
         self.loop = loop
-        self.K = K = int(num_envs)
+        self.K = K = check_int("num_envs", num_envs, minimum=1)
+        if K > 1 and not loop.batched:
+            raise ParameterError(f"the {p.crypto} backend steps one copy, got num_envs = {K}")
+        self.schedule = sch = schedule if schedule is not None else EpisodeSchedule()
+        check_episode_memory(p, K, sch, memory_limit)
         n, m, N = p.n, p.m, p.horizon
         self.n, self.m, self.d = n, m, n + m
+        self.layout = ObservationLayout.of(p)
         self._A = np.ascontiguousarray(p.A)
         self._B = np.ascontiguousarray(p.B)
         self._theta_true = np.hstack([p.A, p.B])  # (n, n+m)
@@ -143,8 +209,6 @@ class EpisodeCore:
         self._eps0 = float(np.sum(self._theta_true**2)) / self._c  # error of the estimate [A B] = 0
         self._sw = math.sqrt(p.sigma_w2)
         self._sx = math.sqrt(p.sigma_x2)
-        self._logdet0 = self.d * math.log(p.logdet_regularization)
-        self._reg = p.logdet_regularization * np.eye(self.d)
         # tables over the sample size N = 0..horizon
         Ns = np.arange(N + 1)
         self.gamma_table = np.full(N + 1, np.inf)
@@ -153,8 +217,7 @@ class EpisodeCore:
         self.gamma_opt_table = np.full(N + 1, np.inf)
         if design is not None:
             self.gamma_opt_table[2:] = design.gamma(Ns[2:])
-        keys = Ns if p.independent_keys else np.minimum(Ns, 1)
-        self.time_table = keys * p.sample_cost  # Definition def:sdt
+        self.time_table = np.asarray(p.deciphering_time(Ns), dtype=np.float64)  # Definition def:sdt, under the model
         self._time_frac = self.time_table / p.tau_c
         # per-copy data: collected (deciphered) states and applied inputs
         # time-major: the data of all copies for one period are contiguous
@@ -169,7 +232,6 @@ class EpisodeCore:
         # recursive least squares [P | Theta_hat^T], P by its upper triangle; copies innermost:
         # entry (a, b) of every copy is row a (d + n) + b (see _kernels)
         self.Q = np.zeros((self.d * (self.d + n), K))
-        self._rls_scratch = np.zeros((2 * self.d + n + 2, K))
         self.ready = np.zeros(K, dtype=bool)  # recursion started (well-conditioned Gram matrix)
         self._gram_upto = 1  # G and C hold the columns j < _gram_upto (the fused step lets them lag)
         self._since_refresh = 0
@@ -178,39 +240,42 @@ class EpisodeCore:
         self._dims = kern.dims(n, m, p.input_history * m)  # the sizes, as the kernels take them
         self.energy = np.zeros(K)
         self.eps = np.full(K, self._eps0)
-        self.logdet = np.full(K, self._logdet0)
+        self.reward = REWARDS[p.reward](p, K)
         self.collected = 0  # samples collected and paid for
         self.delivered = 0  # samples delivered to the agent
         self.new = False
         self.done = False
         self._obs_out: np.ndarray | None = None  # observation written by the fused step, not yet handed out
-        self._info_out: tuple[np.ndarray, np.ndarray] | None = None  # and the info arrays (two buffers), likewise
-        self._info_in_step = K > 1
-        self._info_unread = (*self._info_buffers(), 0.0, 0.0, 1.0, 0.0, 0, 0)
+        self._info_out: tuple[np.ndarray, np.ndarray] | None = None  # and its info buffers, likewise
         self._act = np.zeros((K, m))  # the actions of the current step, float64
-        self._obs_shape = (K, p.obs_dim)
-        self._a = np.zeros((K, m))
-        self._qa = np.zeros((K, m), dtype=np.int64)
-        self._qx = np.zeros((K, n), dtype=np.int64)
-        self._theta_true_T = np.ascontiguousarray(self._theta_true.T)
-        self._cf = float(self._c)
-        self._horizon = p.horizon
-        self._reward = np.zeros(K)
+        self._obs_shape = (K, self.layout.dim)
+        self._obs_at = self.layout.offsets
+        self._reward_out = np.zeros(K)
         self._step_fused = kern.step_fused_parallel if parallel else kern.step_fused
-        self._u_max = p.u_max
         self._budget = p.energy_budget
-        self._logdet = p.reward == "logdet"
         self._all_ready = False
-        # the ideal backend's step is one fused compiled call
-        self._fused = getattr(loop, "fused_parameters", None)
-        self._noise_draws = np.zeros((K, _CHUNK, n))  # each copy's chunk, as its generator draws it
-        self._noise = np.zeros((_CHUNK, K, n))  # period-major, like X: one period's noise is contiguous
-        self._noise_next = np.zeros((_CHUNK, K, n))  # the chunk drawn ahead
-        self._noise_pos = _CHUNK
+        # what the compiled kernels take (see _kernels): built once, the arrays are never rebound
+        self._consts = (self._A, self._B, np.ascontiguousarray(self._theta_true.T), float(self._c), p.u_max, self._budget)
+        self._arrays = (
+            self.x, self.energy, self.X, self.U, self.hist, self.Q, self.eps, self._reward_out,
+            np.zeros((K, m)), np.zeros((K, m), dtype=np.int64), np.zeros((K, n), dtype=np.int64),
+            np.zeros((2 * self.d + n + 2, K)),
+        )
+        self._a = self._arrays[8]  # the energy-limited input of the current step (a_buf)
+        # the ideal backend's steady-state step is one compiled call, on the loop's arithmetic
+        q = loop.quantization
+        self._quant = tuple(q) if q is not None else None
+        self._fused = self._quant is not None and self.reward.fused
+        C = sch.chunk
+        self._noise_draws = np.zeros((K, C, n))  # each copy's chunk, as its generator draws it
+        self._noise = np.zeros((C, K, n))  # period-major, like X: one period's noise is contiguous
+        self._noise_next = np.zeros((C, K, n))  # the chunk drawn ahead
+        self._noise_pos = C
         self._noise_ahead = False  # _noise_next holds (or is being filled with) the next chunk
         self._chunks = 0  # chunks taken into use this episode
         self._periods = p.warmup_steps + p.horizon  # noise samples an episode uses
-        self._use_helper = bool(helper_thread)
+        self._given_noise: np.ndarray | None = None  # (K, periods, n) from reset(noise=...)
+        self.helper = helper
         self._noise_future: Future | None = None
         self._gram_future: Future | None = None
         self._rngs: list[np.random.Generator] = []
@@ -219,8 +284,8 @@ class EpisodeCore:
     # ----------------------------------------------------------------- helper thread
     def _run(self, fn: Callable[..., Any], *args: Any) -> Future | None:
         """``fn(*args)`` on the helper thread (returns its future) or, without one, now."""
-        if self._use_helper:
-            return _helper().submit(fn, *args)
+        if self.helper is not None:
+            return self.helper.submit(fn, *args)
         fn(*args)
         return None
 
@@ -245,8 +310,16 @@ class EpisodeCore:
         return self.__dict__.copy()
 
     # ----------------------------------------------------------------- randomness
-    def _fill_noise(self, dst: np.ndarray) -> None:
-        """Draw the next ``_CHUNK`` periods of noise of every copy, into ``dst`` (C, K, n)."""
+    def _fill_noise(self, dst: np.ndarray, chunk: int) -> None:
+        """Noise chunk ``chunk`` (``schedule.chunk`` periods) of every copy, into ``dst`` (C, K, n):
+        drawn from each copy's generator (chunks are drawn in order), or read from the noise
+        given to :meth:`reset`."""
+        if self._given_noise is not None:
+            C = dst.shape[0]
+            part = self._given_noise[:, chunk * C : (chunk + 1) * C]
+            dst[: part.shape[1]] = part.transpose(1, 0, 2)
+            dst[part.shape[1] :] = 0.0  # past the episode's last period: never read
+            return
         for i, rng in enumerate(self._rngs):
             rng.standard_normal(out=self._noise_draws[i])
         kern.interleave_noise(self._noise_draws, self._sw, dst)
@@ -258,36 +331,65 @@ class EpisodeCore:
             self._wait_noise()
             self._noise, self._noise_next = self._noise_next, self._noise
         else:
-            self._fill_noise(self._noise)
+            self._fill_noise(self._noise, self._chunks)
         self._chunks += 1
         self._noise_pos = 0
-        self._noise_ahead = self._chunks * _CHUNK < self._periods
+        self._noise_ahead = self._chunks * self.schedule.chunk < self._periods
         if self._noise_ahead:
-            self._noise_future = self._run(self._fill_noise, self._noise_next)
+            self._noise_future = self._run(self._fill_noise, self._noise_next, self._chunks)
 
     def _draw_noise(self) -> np.ndarray:
-        if self._noise_pos >= _CHUNK:
+        if self._noise_pos >= self.schedule.chunk:
             self._take_chunk()
         w = self._noise[self._noise_pos]
         self._noise_pos += 1
         return w
 
     # ----------------------------------------------------------------- reset
-    def reset(self, rng: np.random.Generator | Sequence[np.random.Generator]) -> np.ndarray:
+    def _given(self, name: str, value: Any, shape: tuple[int, ...]) -> np.ndarray:
+        """A user-given array (``x0`` or ``noise``) of shape ``shape``, or ``shape[1:]`` for K = 1."""
+        arr = as_finite_array(name, value)
+        if self.K == 1 and arr.shape == shape[1:]:
+            arr = arr[None]
+        if arr.shape != shape:
+            want = shape[1:] if self.K == 1 else shape
+            raise ShapeError(f"{name} must have shape {want}, got {arr.shape}")
+        return np.array(arr, dtype=np.float64)
+
+    def reset(
+        self,
+        rng: np.random.Generator | Sequence[np.random.Generator],
+        *,
+        x0: Any = None,
+        noise: Any = None,
+    ) -> np.ndarray:
         """Start new episodes for all copies; return the observations, shape (K, obs_dim).
 
         ``rng`` is one generator (K = 1) or one per copy; all draws of copy ``i`` come from
         ``rng[i]`` in a fixed order (x_0, then the noise of every period).
+
+        Parameters
+        ----------
+        x0 : array_like, shape (K, n) (or (n,) for K = 1), optional
+            The initial states instead of draws from ``N(0, sigma_x2 I)``.
+        noise : array_like, shape (K, T, n) (or (T, n) for K = 1), optional
+            The process noise ``w_0 .. w_{T-1}`` of the episode (warm-up periods first), instead
+            of draws from ``N(0, sigma_w2 I)``; ``T = warmup_steps + horizon``. Replaying the
+            same disturbance for two attackers gives paired comparisons (common random numbers).
         """
         rngs = [rng] if isinstance(rng, np.random.Generator) else list(rng)
         if len(rngs) != self.K:
             raise ParameterError(f"expected {self.K} random generators, got {len(rngs)}")
+        x0_arr = None if x0 is None else self._given("x0", x0, (self.K, self.n))
+        given = None if noise is None else self._given("noise", noise, (self.K, self._periods, self.n))
         self.wait()  # the helper may still be drawing from the old generators or adding to G
         self._rngs = rngs
+        self._given_noise = given
         self._obs_out = self._info_out = None
         for i, g in enumerate(rngs):
-            self.x[i] = g.standard_normal(self.n) * self._sx
-        self._noise_pos = _CHUNK
+            draw = g.standard_normal(self.n) * self._sx
+            self.x[i] = draw if x0_arr is None else x0_arr[i]
+        self._noise_pos = self.schedule.chunk
         self._noise_ahead = False
         self._chunks = 0
         self.loop.start_episode()
@@ -303,13 +405,28 @@ class EpisodeCore:
         self.hist[:] = 0.0
         self.energy[:] = 0.0
         self.eps[:] = self._eps0
-        self.logdet[:] = self._logdet0
+        self.reward.reset(self)
         self.collected = self.delivered = 0
         self.done = False
         self.history = []
         self._collect()
         self.new = self._deliver(final=False)
         return self.observation()
+
+    # ----------------------------------------------------------------- data
+    def delivered_data(self) -> tuple[np.ndarray, np.ndarray]:
+        """What the attacker has deciphered and received so far, in float64.
+
+        Returns
+        -------
+        states : numpy.ndarray, shape (K, N, n)
+            The delivered states ``x_0 .. x_{N-1}`` (``N`` = :attr:`delivered`).
+        inputs : numpy.ndarray, shape (K, max(N - 1, 0), m)
+            The inputs ``u_0 .. u_{N-2}`` that led to them (the attacker's own, as the plant
+            decoded them): with the states, the data matrices of eq:data.
+        """
+        N = self.delivered
+        return self.X[:N].transpose(1, 0, 2).copy(), self.U[: max(N - 1, 0)].transpose(1, 0, 2).copy()
 
     # ----------------------------------------------------------------- step
     def _collect(self) -> None:
@@ -328,12 +445,13 @@ class EpisodeCore:
         """Hand the Gram catch-up of the columns j < ``upto`` to the helper thread, unless it
         is still busy with the previous one. The columns are final: rows of X and U only ever
         get written once, ahead of the columns that read them."""
+        assert self.helper is not None
         if self._gram_future is not None:
             if not self._gram_future.done():
                 return
             self._wait_gram()
         first, self._gram_upto = self._gram_upto, upto
-        self._gram_future = _helper().submit(
+        self._gram_future = self.helper.submit(
             kern.add_gram, self._dims, self.X, self.U, first, upto, self._GC, self._gram_scratch
         )
 
@@ -358,13 +476,13 @@ class EpisodeCore:
         if (
             self._all_ready
             and not final
-            and self.p.reward != "logdet"
-            and self._since_refresh + target - first < _REFRESH
+            and not self.reward.needs_gram
+            and self._since_refresh + target - first < self.schedule.refresh
         ):  # steady state: columns, recursive least squares and error in one compiled call
             self._sync_gram(first)
             kern.add_columns(self._dims, self.X, self.U, first, target, self._GC, self.Q, self.ready)
             self._gram_upto = target
-            kern.estimation_error(self._dims, self.Q, self._theta_true_T, self._cf, self.ready, self.eps)
+            kern.estimation_error(self._dims, self.Q, self._consts[2], self._consts[3], self.ready, self.eps)
             self._since_refresh += target - first
             self.delivered = target
             self.history.append((target, float(self.eps[0])))
@@ -374,11 +492,10 @@ class EpisodeCore:
             kern.add_columns(self._dims, self.X, self.U, first, target, self._GC, self.Q, self.ready)
             self._gram_upto = target
         self.delivered = target
-        if self.p.reward == "logdet":
-            self.logdet = np.linalg.slogdet(self.G + self._reg)[1]
+        self.reward.on_delivery(self)
         if self.delivered - 1 >= self.d:
             self._since_refresh += target - first
-            if final or self._since_refresh >= _REFRESH:  # exact solve: bounds drift; final = eq:estimate
+            if final or self._since_refresh >= self.schedule.refresh:  # exact solve: bounds drift; final = eq:estimate
                 stale = np.ones(self.K, dtype=bool)
                 self._since_refresh = 0
             else:
@@ -386,8 +503,8 @@ class EpisodeCore:
             if stale.any():
                 rows = np.nonzero(stale)[0]
                 theta_hat_T = self._refresh(rows)
-                self.eps[rows] = ((theta_hat_T - self._theta_true_T) ** 2).sum(axis=(1, 2)) / self._c
-            kern.estimation_error(self._dims, self.Q, self._theta_true_T, self._cf, self.ready & ~stale, self.eps)
+                self.eps[rows] = ((theta_hat_T - self._consts[2]) ** 2).sum(axis=(1, 2)) / self._c
+            kern.estimation_error(self._dims, self.Q, self._consts[2], self._consts[3], self.ready & ~stale, self.eps)
             self._all_ready = bool(self.ready.all())
         self.history.append((self.delivered, float(self.eps[0])))
         return True
@@ -396,13 +513,13 @@ class EpisodeCore:
         """Exact least squares (eq:estimate) for the copies ``rows`` from the running Gram matrices.
 
         A copy whose Jacobi-scaled Gram matrix is well conditioned (condition number below
-        ``_COND_LIMIT``) solves ``G [P | Theta_hat^T] = [I | C]`` and (re)starts its recursion
-        from the solution; any other copy gets the minimum-norm least-squares solution
+        ``schedule.cond_limit``) solves ``G [P | Theta_hat^T] = [I | C]`` and (re)starts its
+        recursion from the solution; any other copy gets the minimum-norm least-squares solution
         ``pinv(G) C`` of eq:estimate and stays non-recursive. A started recursion is re-anchored
         without a new check: G only grows, by positive semidefinite terms, so its smallest
         eigenvalue never falls. Called for copies that are not yet recursive, and for every copy
-        each ``_REFRESH`` columns to bound rounding drift. Returns Theta_hat^T of those copies,
-        shape (len(rows), n + m, n).
+        each ``schedule.refresh`` columns to bound rounding drift. Returns Theta_hat^T of those
+        copies, shape (len(rows), n + m, n).
         """
         d = self.d
         G, C = self.G[rows], self.C[rows]
@@ -411,7 +528,7 @@ class EpisodeCore:
             fresh = ~ok
             g = G[fresh]
             s = 1.0 / np.sqrt(np.maximum(np.einsum("kii->ki", g), 1e-300))
-            ok[fresh] = _condition(g * s[:, :, None] * s[:, None, :]) < _COND_LIMIT
+            ok[fresh] = _condition(g * s[:, :, None] * s[:, None, :]) < self.schedule.cond_limit
         sol = np.zeros((len(rows), d, d + self.n))
         if ok.any():
             g, c = G[ok], C[ok]
@@ -433,7 +550,13 @@ class EpisodeCore:
         them in float64, in a buffer of the episode's own (the caller's array is never changed)."""
         a = action
         if not (isinstance(a, np.ndarray) and a.dtype.char in "fd"):  # float32 and float64 are read as they are
-            a = np.asarray(a, dtype=np.float64)
+            try:
+                a = np.asarray(a)
+                if a.dtype.kind not in "biuf":
+                    raise TypeError(a.dtype)
+                a = a.astype(np.float64)
+            except (TypeError, ValueError):
+                raise ParameterError(f"action must be a real numeric array, got {action!r}") from None
         if a.ndim < 2:
             a = a.reshape(1, -1)
         if a.shape != (self.K, self.m):
@@ -447,32 +570,28 @@ class EpisodeCore:
 
     def step(self, action: Any) -> tuple[np.ndarray, bool, bool]:
         """Apply the actions of all copies. Returns (rewards (K,), terminated, truncated)."""
+        if not self._rngs:
+            raise ParameterError("step() called before reset(); call reset() first")
         if self.done:
             raise ParameterError("step() called after the episode ended; call reset() first")
         p = self.p
         act = self.check_actions(action)
         w = self._draw_noise()
-        ended = self.collected >= self._horizon
-        if self._fused is not None and self._all_ready and not ended and not self._logdet:
-            # steady state of the ideal backend: period, delivery, recursive LS and error in one call
+        ended = self.collected >= p.horizon
+        if self._fused and self._all_ready and not ended:
+            # steady state of the ideal backend: period, delivery, recursive LS, error, reward,
+            # observation and info in one compiled call
             first = max(self.delivered, 1)
             target = self._target(self.collected + 1)
-            if self._since_refresh + target - first < _REFRESH:
+            if self._since_refresh + target - first < self.schedule.refresh:
                 new = target > self.delivered
                 obs = np.empty(self._obs_shape, dtype=np.float32)
                 N, collected = (target if new else self.delivered), self.collected + 1
-                # the vector env's info arrays are written by the same call; a single env, whose
-                # info is Python scalars, gives it buffers it does not read
-                info_args = self._info_unread
-                if self._info_in_step:
-                    info_args = (*self._info_buffers(), *self._info_scalars(collected, N))
+                info = info_buffers(self.K, self.has_gamma_opt)
                 status = self._step_fused(
-                    self._dims, act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
-                    self.X, self.U, self.collected - 1, self.collected, self.hist,
-                    self._a, self._qa, self._qx,
-                    first, target, self.Q, self._rls_scratch, self._theta_true_T, self._cf, self.eps,
-                    self._reward, obs, N - 1, float(new), float(self._time_frac[collected]),
-                    *info_args,
+                    self._dims, self._consts, self._arrays, self._quant, act, w, self.collected - 1, self.collected,
+                    first, target, obs, self._obs_at, N - 1, float(new), float(self._time_frac[collected]),
+                    info, self._info_scalars(collected, N),
                 )
                 if status == kern.STATE_OVERFLOW:
                     self._overflow()
@@ -482,25 +601,22 @@ class EpisodeCore:
                     self._since_refresh += target - first
                     self.delivered = target
                     self.history.append((target, float(self.eps[0])))
-                    if self._use_helper and target - self._gram_upto >= _GRAM_BATCH:
+                    if self.helper is not None and target - self._gram_upto >= self.schedule.gram_batch:
                         self._gram_behind(target)
                 self._obs_out = obs
-                if self._info_in_step:
-                    self._info_out = (info_args[0], info_args[1])
-                return self._reward.copy(), False, False
+                self._info_out = info
+                return self._reward_out.copy(), False, False
         self._obs_out = self._info_out = None
-        if self._fused is not None:  # ideal backend: one compiled call
+        if self._quant is not None:  # ideal backend: the period in one compiled call
             status = kern.step_ideal(
-                self._dims, act, self._u_max, self.energy, self._budget, *self._fused, self.x, self._A, self._B, w,
-                self.X, self.U, self.collected - 1, -1 if ended else self.collected, self.hist,
-                self._a, self._qa, self._qx,
+                self._dims, self._consts, self._arrays, self._quant, act, w, self.collected - 1, -1 if ended else self.collected
             )
             if status == kern.STATE_OVERFLOW:
                 self._overflow()
             if not ended:
                 self.collected += 1
         else:
-            kern.energy_budget(self._dims, act, self._u_max, self.energy, self._budget, self._a)
+            kern.energy_budget(self._dims, act, p.u_max, self.energy, self._budget, self._a)
             u = self.loop.inject(self._a)
             self.U[self.collected - 1] = u
             kern.plant_step(self._dims, self.x, u, w, self._A, self._B)
@@ -509,61 +625,44 @@ class EpisodeCore:
             self.loop.tick()
             if not ended:
                 self._collect()
-        if p.reward == "logdet":
-            before = self.logdet.copy()
-            self.new = self._deliver(final=ended)
-            reward = self.logdet - before
-        else:  # decrease of log epsilon
-            before = self.eps.copy()
-            self.new = self._deliver(final=ended)
-            reward = np.empty(self.K)
-            kern.log_ratio(before, self.eps, reward)
+        self.reward.begin(self)
+        self.new = self._deliver(final=ended)
+        reward = self.reward.end(self)
         self.done = ended
         return reward, ended and p.budget_limited, ended and not p.budget_limited
 
     # ----------------------------------------------------------------- observation and info
     def observation(self) -> np.ndarray:
-        """Observations of all copies, shape (K, obs_dim), float32 (see the class docstring), in
-        a new array: the one the fused step wrote, if not yet handed out, else filled now."""
+        """Observations of all copies, shape (K, obs_dim), float32 (layout:
+        :class:`~encctl_gym.envs.layout.ObservationLayout`), in a new array: the one the fused
+        step wrote, if not yet handed out, else filled now."""
         obs, self._obs_out = self._obs_out, None
         if obs is None:
             obs = np.empty(self._obs_shape, dtype=np.float32)
             kern.fill_observation(
-                self._dims, obs, self.X, self.U, self.delivered - 1, float(self.new), self.hist,
+                self._dims, obs, self._obs_at, self.X, self.U, self.delivered - 1, float(self.new), self.hist,
                 float(self._time_frac[self.collected]), self.energy, self._budget,
             )
         return obs
 
-    def _info_buffers(self) -> tuple[np.ndarray, np.ndarray]:
-        return np.empty((6 if self.has_gamma_opt else 5, self.K)), np.empty((2, self.K), dtype=np.int64)
-
     def _info_scalars(self, collected: int, N: int) -> tuple[float, float, float, float, int, int]:
-        """The info entries shared by all copies, as :func:`kern.fill_info` takes them."""
+        """The info entries shared by all copies, as the kernels' ``_info`` stage takes them."""
         return (
             float(self.gamma_table[N]), float(self.time_table[collected]), float(max(collected, 1) * self.m),
             float(self.gamma_opt_table[N]), collected, N,
         )
 
-    def info_arrays(self) -> dict[str, np.ndarray]:
-        """Info of every copy as arrays of shape (K,) (keys as in :meth:`info`): rows of two new
-        buffers, one float and one integer, filled by the fused step or, if it did not run, now."""
+    def _info_filled(self) -> tuple[np.ndarray, np.ndarray]:
+        """The info buffers of this step: the fused step's, if not yet handed out, else filled now."""
         bufs, self._info_out = self._info_out, None
         if bufs is None:
-            bufs = self._info_buffers()
-            kern.fill_info(*bufs, self.eps, self.energy, *self._info_scalars(self.collected, self.delivered))
-        f, counts = bufs
-        info = {
-            "epsilon": f[0],
-            "gamma": f[1],
-            "samples_collected": counts[0],
-            "samples_delivered": counts[1],
-            "deciphering_time": f[2],
-            "input_energy": f[3],
-            "average_power": f[4],
-        }
-        if self.has_gamma_opt:
-            info["gamma_opt"] = f[5]
-        return info
+            bufs = info_buffers(self.K, self.has_gamma_opt)
+            kern.fill_info(*bufs, self.eps, self.energy, self._info_scalars(self.collected, self.delivered))
+        return bufs
+
+    def info_arrays(self) -> dict[str, np.ndarray]:
+        """Info of every copy as new arrays of shape (K,) (keys: :data:`~encctl_gym.envs.layout.INFO_FIELDS`)."""
+        return info_from_buffers(*self._info_filled())
 
     def info(self) -> dict[str, Any]:
         """Info of copy 0 as Python scalars (single environment).
@@ -571,16 +670,4 @@ class EpisodeCore:
         ``epsilon`` is the error (Definition def:error) of the attacker's current estimate: the
         least squares estimate once ``n + m`` columns are delivered, ``[A B] = 0`` before.
         """
-        N = self.delivered
-        info = {
-            "epsilon": float(self.eps[0]),
-            "gamma": float(self.gamma_table[N]),
-            "samples_collected": self.collected,
-            "samples_delivered": N,
-            "deciphering_time": float(self.time_table[self.collected]),
-            "input_energy": float(self.energy[0]),
-            "average_power": float(self.energy[0]) / (max(self.collected, 1) * self.m),
-        }
-        if self.has_gamma_opt:
-            info["gamma_opt"] = float(self.gamma_opt_table[N])
-        return info
+        return info_from_buffers(*self._info_filled(), copy=0)

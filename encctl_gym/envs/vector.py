@@ -1,7 +1,7 @@
 """Native batched vector environment for ``EncryptedLTIAttack-v0`` (ideal backend).
 
-Steps ``num_envs`` copies at once in numpy through the same :class:`EpisodeCore` as the single
-environment. Copy ``i`` seeded by ``reset(seed=s)`` draws from ``np_random(s + i)``, as
+Steps ``num_envs`` copies at once through the same :class:`EpisodeCore` as the single
+environment, in the compiled kernels of :mod:`encctl_gym.envs._kernels`. Copy ``i`` seeded by ``reset(seed=s)`` draws from ``np_random(s + i)``, as
 gymnasium's ``SyncVectorEnv`` would seed it, so it reproduces a single environment reset with
 ``seed = s + i`` bit for bit. All copies share the horizon, so their episodes end together;
 autoreset follows gymnasium's default next-step mode (the step after an episode ends resets
@@ -22,13 +22,15 @@ from .._validation import check_int
 from ..errors import ParameterError
 from ..loop import make_loop
 from .config import AttackParams, resolve_params
-from .episode import EpisodeCore, attack_design_for
+from .encrypted_lti_attack import check_seed, reset_options
+from .episode import EpisodeCore, EpisodeSchedule, attack_design_for, check_episode_memory
+from .helper import HelperThread
 
 __all__ = ["EncryptedLTIAttackVectorEnv"]
 
 
 class EncryptedLTIAttackVectorEnv(VectorEnv):
-    """``num_envs`` copies of :class:`~encctl_gym.envs.EncryptedLTIAttackEnv` stepped in numpy.
+    """``num_envs`` copies of :class:`~encctl_gym.envs.EncryptedLTIAttackEnv` stepped at once.
 
     Parameters
     ----------
@@ -43,12 +45,21 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         machine: on the 2-core development machine it was slower than the default (which
         leaves the second core to the helper thread) in every run of
         ``benchmarks/bench_env.py``, hence off by default.
-    helper_thread : bool, default True
-        Draw the next 256 periods of noise and catch up the Gram matrices of the exact refresh
-        on a helper thread while the copies are stepped (the compiled kernels release the GIL).
-        The numbers are identical; ``False`` keeps all the work on the calling thread.
+    helper_thread : bool or HelperThread, default True
+        Draw the next chunk of noise and catch up the Gram matrices of the exact refresh on a
+        helper thread while the copies are stepped (the compiled kernels release the GIL). The
+        numbers are identical; ``False`` keeps all the work on the calling thread. A
+        :class:`~encctl_gym.envs.helper.HelperThread` given here is used (and closed by
+        :meth:`close`); ``True`` makes one of the environment's own.
+    schedule : EpisodeSchedule, optional
+        How the work is batched (see the single environment).
+    memory_limit : int, optional
+        Bytes the copies may allocate (default :data:`encctl_gym.resources.MEMORY_LIMIT`,
+        8 GiB); a larger batch is refused before anything is allocated.
 
-    ``info`` holds one array of shape ``(num_envs,)`` per key of the single environment's info.
+    ``info`` holds one array of shape ``(num_envs,)`` per key of the single environment's info
+    (privileged keys as documented there). ``reset(options={"x0": (K, n), "noise": (K, T, n)})``
+    replays given initial states and noise.
     """
 
     metadata = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
@@ -59,7 +70,9 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         config: dict[str, Any] | None = None,
         max_episode_steps: int | None = None,
         parallel: bool = False,
-        helper_thread: bool = True,
+        helper_thread: bool | HelperThread = True,
+        schedule: EpisodeSchedule | None = None,
+        memory_limit: int | None = None,
         **kwargs: Any,
     ) -> None:
         self.num_envs = check_int("num_envs", num_envs, minimum=1)
@@ -69,13 +82,23 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         if max_episode_steps is not None:
             raise ParameterError("the attack length is set by tau_c or max_samples, not max_episode_steps")
         p = self.params
+        check_episode_memory(p, self.num_envs, schedule, memory_limit)  # before anything is sized by the parameters
         self.single_action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
         self.single_observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.design = attack_design_for(p) if p.gamma_opt else None
+        if isinstance(helper_thread, HelperThread):
+            self.helper: HelperThread | None = helper_thread
+        elif isinstance(helper_thread, bool):
+            self.helper = HelperThread() if helper_thread else None
+        else:
+            raise ParameterError(f"helper_thread must be a bool or a HelperThread, got {helper_thread!r}")
+        if not isinstance(parallel, bool):
+            raise ParameterError(f"parallel must be a bool, got {parallel!r}")
         self._core = EpisodeCore(
-            p, make_loop(p), self.design, num_envs=self.num_envs, parallel=bool(parallel), helper_thread=bool(helper_thread)
+            p, make_loop(p), self.design, num_envs=self.num_envs, parallel=parallel, helper=self.helper, schedule=schedule,
+            memory_limit=memory_limit,
         )
         self._rngs: list[np.random.Generator] | None = None
         self._needs_reset = False
@@ -85,14 +108,20 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
             if isinstance(seed, (list, tuple)):
                 if len(seed) != self.num_envs:
                     raise ParameterError(f"expected {self.num_envs} seeds, got {len(seed)}")
-                seeds = list(seed)
+                seeds = [check_seed(s) for s in seed]
             else:
-                seeds = [None if seed is None else seed + i for i in range(self.num_envs)]
+                first = check_seed(seed)
+                seeds = [None if first is None else first + i for i in range(self.num_envs)]
             self._rngs = [seeding.np_random(s)[0] for s in seeds]
             self._np_random, self._np_random_seed = seeding.np_random(seed if isinstance(seed, int) else None)
-        obs = self._core.reset(self._rngs)
+        obs = self._core.reset(self._rngs, **reset_options(options))
         self._needs_reset = False
         return obs, self._core.info_arrays()
+
+    @property
+    def episode(self) -> EpisodeCore:
+        """The batched episode's state (privileged; see the single environment's ``episode``)."""
+        return self._core
 
     def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         if self._rngs is None:
@@ -110,3 +139,5 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
 
     def close_extras(self, **kwargs: Any) -> None:
         self._core.wait()
+        if self.helper is not None:
+            self.helper.close()

@@ -7,10 +7,27 @@ gramians
 complexity
     Estimation error (Definition def:error), sample identifying complexity eq:sic and eq:sic2,
     upper bounds eq:bound.
+exact
+    Exact rational arithmetic: the decimal rule (typed numbers) and the binary rule (computed
+    numbers), ``floor_log2``, ``pow2``.
+sample_size
+    The minimum sample size N* of Theorem thm:opt_sec for eq:sic2, eq:sic, ``c / (N - 1)`` and any
+    nonincreasing complexity.
+records
+    Published attack costs (NFS records), the NIST SP 800-57 table and GNFS corrections
+    (package data ``security/data/deciphering_records.json``).
+cost_models
+    Deciphering-cost models ``paper`` (def:sdt, eq:opt_key), ``precomputation`` (index calculus:
+    one precomputation per group, then a cheap descent per key) and ``generic`` (Pollard rho),
+    one protocol and one registry; the GNFS formula with its optional o(1) correction.
 deciphering
-    Sample deciphering time (Definition def:sdt) for the modified, token and static schemes.
+    Sample deciphering time (Definition def:sdt) for the modified, token and static schemes,
+    under a security parameter or any cost model; the largest affordable sample size.
 design
-    Definition def:security (``is_secure``), Theorem thm:opt_sec, eq:opt_key (GNFS key length).
+    Definition def:security (``is_secure``), Theorem thm:opt_sec, eq:opt_key (``SecurityDesign``).
+key_length
+    eq:opt_key generalised: the smallest safe key length under each cost model, and what a key
+    is worth under each.
 attack_design
     A-optimal attack inputs (closed and open loop), ``gamma_opt`` and robust designs (needs
     cvxpy; imported on use).
@@ -29,7 +46,18 @@ from .complexity import (
     sic_asymptotic_from_traces,
     sic_from_traces,
 )
-from .deciphering import max_affordable_samples, per_sample_cost, sample_deciphering_time
+from .cost_models import (
+    DECIPHERING_MODELS,
+    GUILLEVIC_CORRECTION,
+    DecipheringModel,
+    GenericModel,
+    KeyBreakCost,
+    PaperModel,
+    PrecomputationModel,
+    deciphering_model,
+    pollard_rho_log2_operations,
+)
+from .deciphering import break_cost, max_affordable_samples, per_sample_cost, sample_deciphering_time
 from .design import (
     SecurityDesign,
     bit_security_of_key_length,
@@ -44,6 +72,7 @@ from .design import (
     paper_design_example,
 )
 from .gramians import controllability_gramian, noise_gramian
+from .key_length import KeyLengthDesign, KeyValue, design_key_length, key_length_value
 
 __all__ = [
     "controllability_gramian",
@@ -58,6 +87,20 @@ __all__ = [
     "sample_deciphering_time",
     "per_sample_cost",
     "max_affordable_samples",
+    "break_cost",
+    "KeyBreakCost",
+    "DecipheringModel",
+    "PaperModel",
+    "PrecomputationModel",
+    "GenericModel",
+    "DECIPHERING_MODELS",
+    "deciphering_model",
+    "GUILLEVIC_CORRECTION",
+    "pollard_rho_log2_operations",
+    "KeyLengthDesign",
+    "KeyValue",
+    "design_key_length",
+    "key_length_value",
     "SecurityDesign",
     "is_secure",
     "optimal_sample_size",

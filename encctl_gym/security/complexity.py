@@ -1,9 +1,9 @@
 """Sample identifying complexity (Definition def:sic) of the plant eq:system.
 
-Implements
+Implements (the estimation error of Definition def:error that these bound,
+``epsilon = ||[A B] - [A_hat B_hat]||_F^2 / (n (n + m))``, lives in :mod:`encctl_gym.ident.error`
+and is re-exported here)
 
-* the estimation error of Definition def:error,
-  ``epsilon = ||[A B] - [A_hat B_hat]||_F^2 / (n (n + m))``;
 * Theorem thm:sic (eq:sic), the complexity for i.i.d. Gaussian attack inputs,
 
   ``gamma(N) = (m+n) sigma_w2 / (sigma_x2 tr Psi_w + (N-1) [sigma_u2 (tr Psi_u + m) + sigma_w2 tr Psi_w])``;
@@ -34,8 +34,10 @@ from .._validation import (
     check_nonnegative,
     check_positive,
     check_system,
+    format_value,
 )
 from ..errors import ParameterError, ShapeError
+from ..ident.error import estimation_error  # Definition def:error; its home is the identification layer
 from .gramians import controllability_gramian, noise_gramian
 
 __all__ = [
@@ -76,7 +78,7 @@ def check_sample_size(N: Any, name: str = "N") -> tuple[np.ndarray, bool]:
         return np.asarray(float(check_int(name, N if not isinstance(N, np.ndarray) else N.item(), 2))), True
     arr = as_finite_array(name, N)
     if not np.all(arr == np.round(arr)):
-        raise ParameterError(f"{name} must contain integers, got {np.asarray(N)!r}")
+        raise ParameterError(f"{name} must contain integers, got {format_value(np.asarray(N))}")
     if np.any(arr < 2):
         raise ParameterError(f"{name} must be >= 2 (N - 1 regression columns), got min {arr.min():g}")
     return arr, False
@@ -84,51 +86,6 @@ def check_sample_size(N: Any, name: str = "N") -> tuple[np.ndarray, bool]:
 
 def _out(value: np.ndarray, scalar: bool) -> float | np.ndarray:
     return float(value) if scalar else value
-
-
-def estimation_error(A: Any, B: Any, A_hat: Any, B_hat: Any) -> float | np.ndarray:
-    """Estimation error of Definition def:error.
-
-    ``epsilon = ||[A B] - [A_hat B_hat]||_F^2 / (n (n + m))``.
-
-    Parameters
-    ----------
-    A, B : array_like, shapes (n, n) and (n, m)
-        True plant matrices of eq:system.
-    A_hat, B_hat : array_like, shapes (..., n, n) and (..., n, m)
-        Estimates (e.g. from eq:estimate); leading batch dimensions broadcast against each
-        other.
-
-    Returns
-    -------
-    float or ndarray
-        A float for unbatched estimates, else an array of the broadcast batch shape.
-
-    Raises
-    ------
-    ShapeError
-        If the trailing shapes of the estimates do not match ``A`` and ``B``.
-    """
-    A, B = check_system(A, B)
-    n, m = B.shape
-    A_hat = as_finite_array("A_hat", A_hat)
-    B_hat = as_finite_array("B_hat", B_hat)
-    if B_hat.ndim == 1 and m == 1 and B_hat.shape[0] == n:
-        B_hat = B_hat.reshape(n, 1)
-    if A_hat.ndim < 2 or A_hat.shape[-2:] != (n, n):
-        raise ShapeError(f"A_hat must have shape (..., {n}, {n}), got {A_hat.shape}")
-    if B_hat.ndim < 2 or B_hat.shape[-2:] != (n, m):
-        raise ShapeError(f"B_hat must have shape (..., {n}, {m}), got {B_hat.shape}")
-    try:
-        batch = np.broadcast_shapes(A_hat.shape[:-2], B_hat.shape[:-2])
-    except ValueError as exc:
-        raise ShapeError(
-            f"batch shapes of A_hat {A_hat.shape[:-2]} and B_hat {B_hat.shape[:-2]} do not broadcast"
-        ) from exc
-    ea = np.sum((A_hat - A) ** 2, axis=(-2, -1))
-    eb = np.sum((B_hat - B) ** 2, axis=(-2, -1))
-    err = np.broadcast_to(ea + eb, batch) / (n * (n + m))
-    return float(err) if batch == () else np.array(err)
 
 
 def _check_dims(m: Any, n: Any) -> tuple[int, int]:

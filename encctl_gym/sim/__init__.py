@@ -1,13 +1,15 @@
-"""Numerical engine: the plant of eq:system, least-squares identification (eq:estimate) and
-its error (Definition def:error) on grids of sample sizes, and seeded parallel sweeps.
+"""Numerical engine: the plant of eq:system and batched Monte Carlo sweeps of the paper's
+Gaussian attack, identified by least squares (eq:estimate, :mod:`encctl_gym.ident`) and scored
+by Definition def:error on grids of sample sizes.
 
-Modules import downward only: ``plant -> identification -> montecarlo``; sweeps run on
-:func:`encctl_gym.parallel.run_tasks`.
+Modules import downward only: ``plant -> montecarlo``, on :mod:`encctl_gym.ident` and
+:func:`encctl_gym.parallel.run_tasks`. The least-squares names are re-exported here for one
+version (their home is :mod:`encctl_gym.ident`).
 """
 
 from __future__ import annotations
 
-from .identification import (
+from ..ident.least_squares import (
     RecursiveLeastSquares,
     data_matrices,
     identification_errors,

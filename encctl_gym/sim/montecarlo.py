@@ -2,7 +2,7 @@
 
 One task = one system: ``runs`` trajectories of length ``N_max`` under i.i.d. Gaussian attack
 inputs (Theorem thm:sic), and the error ``epsilon(N)`` of Definition def:error on a whole grid
-of sample sizes from each trajectory (:func:`~encctl_gym.sim.identification.identification_errors`).
+of sample sizes from each trajectory (:func:`~encctl_gym.ident.least_squares.identification_errors`).
 A sweep spreads systems over workers with :func:`~encctl_gym.parallel.run_tasks`, one
 child seed per system.
 """
@@ -16,8 +16,8 @@ import numpy as np
 
 from .._validation import check_int, check_nonnegative
 from ..errors import ParameterError
+from ..ident.least_squares import check_sample_sizes, identification_errors
 from ..parallel import SeedLike, run_tasks
-from .identification import check_sample_sizes, identification_errors
 from .plant import LinearPlant, simulate_gaussian_attack
 
 __all__ = ["AttackSpec", "gaussian_attack_errors", "sweep_gaussian_attack", "log_grid"]
@@ -93,7 +93,7 @@ def gaussian_attack_errors(
     seed
         Integer or SeedSequence (see :func:`~encctl_gym.sim.plant.simulate_gaussian_attack`).
     method
-        Solver for the prefix estimates (see :func:`~encctl_gym.sim.identification.prefix_estimates`).
+        Solver for the prefix estimates (see :func:`~encctl_gym.ident.least_squares.prefix_estimates`).
 
     Returns
     -------

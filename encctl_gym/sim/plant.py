@@ -6,7 +6,7 @@ thm:sic) injects i.i.d. Gaussian inputs ``u_t ~ N(0, sigma_u2 I)`` and records `
 ``(u_t, x_t)`` for ``t = t_s, ..., t_f`` (``N = t_f - t_s + 1``).
 
 Arrays are laid out ``(runs, time, dim)``: ``states[r, k]`` is ``x_{t_s + k}`` of run ``r``.
-(:mod:`encctl_gym.sim.identification` turns them into the paper's column-per-time data
+(:mod:`encctl_gym.ident.least_squares` turns them into the paper's column-per-time data
 matrices.)
 
 Randomness: every simulation is driven by a :class:`numpy.random.SeedSequence`; run ``r`` uses

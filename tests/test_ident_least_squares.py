@@ -1,4 +1,4 @@
-"""Tests of encctl_gym.sim.identification: eq:data, eq:estimate, Definition def:error on grids."""
+"""Tests of encctl_gym.ident.least_squares: eq:data, eq:estimate, Definition def:error on grids."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from encctl_gym.errors import EncctlError, ParameterError, ShapeError
-from encctl_gym.security.complexity import estimation_error
-from encctl_gym.sim.identification import (
+from encctl_gym.ident.error import estimation_error
+from encctl_gym.ident.least_squares import (
     GRAM_COND_LIMIT,
     RecursiveLeastSquares,
     check_sample_sizes,

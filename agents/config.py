@@ -1,0 +1,438 @@
+"""Training configurations: the schema, the default per algorithm, the per-system files, overrides.
+
+A configuration is one mapping (in the spirit of rl-zoo3's YAML files) that holds everything a
+training run needs. It is built in layers, each merged over the previous one:
+
+1. :data:`COMMON`: the algorithm-independent entries and their defaults (the schema below);
+2. ``agents/configs/defaults/{algo}.yaml``: the algorithm's policy, hyperparameters and budget;
+3. ``agents/configs/{algo}_{preset}.yaml`` when that file exists (tuned for one system), or the
+   file given with ``--config``;
+4. ``--preset NAME`` (the system) and ``--system FILE`` (a plant file's ``A`` and ``B``);
+5. the ``quick:`` sections of the files above, with ``--quick`` (a smoke test);
+6. ``--set key.sub=value`` overrides, in order.
+
+================  ==========================================================================
+key               meaning
+================  ==========================================================================
+``algo``          learning algorithm (a key of :data:`agents.sb3.ALGORITHMS`)
+``env``           environment configuration (keys of ``encctl_gym.envs.default_config()``)
+``horizon``       attack length N of the training episodes, set through the deciphering
+                  budget (:func:`agents.evaluate.budget_config`); ``null``: the preset's own
+``observation``   what the policy sees: ``full``, ``no_budget``, ``blind``
+``reward_scaling`` ``none`` or ``samples`` (:class:`agents.sb3.SB3VecEnv`)
+``n_envs``        parallel copies of the native vector environment
+``n_timesteps``   training budget in environment steps (summed over the copies)
+``seed``          training seed
+``normalize``     ``norm_obs``, ``norm_reward`` of ``VecNormalize``
+``policy``        policy name of the algorithm (``MlpPolicy``, ``MlpLstmPolicy``, ...)
+``hyperparams``   keyword arguments of the algorithm class, checked against its signature
+                  (:mod:`agents.hyperparams`); ``policy_kwargs`` against the policy's
+``eval``          ``freq`` (steps between evaluations), ``episodes`` (per evaluation, on the
+                  same seeds every time: ``seed``), ``final_episodes``, ``final_horizon``,
+                  ``elgamal`` (``episodes``, ``max_samples``, ``key_length``) of the final
+                  evaluation
+================  ==========================================================================
+
+Every entry is checked (:func:`validate_config`): an unknown key, a value of the wrong type or
+outside its range is a one-line :class:`~encctl_gym.errors.ConfigError`, whether it comes from
+a file or from ``--set``. Files are read with YAML's safe loader, at most 1 MiB, without
+aliases (nested aliases can expand a small file into gigabytes).
+"""
+
+from __future__ import annotations
+
+import copy
+import numbers
+from pathlib import Path
+from typing import Any, Callable
+
+import yaml
+
+from encctl_gym.envs.config import default_config as env_default_config
+from encctl_gym.envs.config import resolve_params
+from encctl_gym.errors import ConfigError, ParameterError
+
+from .base import OBSERVATION_MODES
+
+__all__ = [
+    "CONFIG_DIR",
+    "DEFAULTS_DIR",
+    "COMMON",
+    "REWARD_SCALINGS",
+    "MAX_CONFIG_BYTES",
+    "read_yaml",
+    "default_config",
+    "load_config",
+    "apply_override",
+    "validate_config",
+    "env_config",
+    "plant_config",
+    "run_name",
+]
+
+CONFIG_DIR = Path(__file__).resolve().parent / "configs"
+DEFAULTS_DIR = CONFIG_DIR / "defaults"
+#: Largest config file read (bytes).
+MAX_CONFIG_BYTES = 1 << 20
+#: Choices of ``reward_scaling`` (:class:`agents.sb3.SB3VecEnv`).
+REWARD_SCALINGS = ("none", "samples")
+
+#: The algorithm-independent entries and their defaults.
+COMMON: dict[str, Any] = {
+    "env": {"preset": "paper-example", "reward": "log_error", "decipher_delay": 0},
+    "horizon": None,
+    "observation": "full",
+    "reward_scaling": "none",
+    "n_envs": 16,
+    "n_timesteps": 100_000,
+    "seed": 0,
+    "normalize": {"norm_obs": True, "norm_reward": False},
+    "policy": "MlpPolicy",
+    "hyperparams": {},
+    "eval": {
+        "freq": 50_000,
+        "episodes": 16,
+        "seed": 1_000_000,
+        "final_episodes": 50,
+        "final_horizon": None,
+        "elgamal": {"episodes": 2, "max_samples": 40, "key_length": 64},
+    },
+}
+
+
+# --------------------------------------------------------------------------- reading
+def read_yaml(path: str | Path) -> dict[str, Any]:
+    """Read one config file: a YAML mapping, safe tags only, no aliases, at most 1 MiB.
+
+    Raises
+    ------
+    ConfigError
+        Missing or unreadable file, a YAML error (including ``!!python/...`` tags), an alias,
+        or a top level that is not a mapping.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError(f"config file {str(p)!r} does not exist")
+    if p.stat().st_size > MAX_CONFIG_BYTES:
+        raise ConfigError(f"config file {str(p)!r} is larger than {MAX_CONFIG_BYTES} bytes")
+    try:
+        text = p.read_text()
+        if any(isinstance(tok, yaml.AliasToken) for tok in yaml.scan(text)):
+            raise ConfigError(f"config file {str(p)!r} uses a YAML alias (*name); write the values out")
+        data = yaml.safe_load(text)
+    except ConfigError:
+        raise
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        first = str(exc).strip().splitlines()
+        raise ConfigError(f"cannot read config file {str(p)!r}: {' '.join(first[:2]) if first else type(exc).__name__}") from exc
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"config file {str(p)!r} must hold a mapping at the top level, got a {type(data).__name__}")
+    return data
+
+
+def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
+    """``over`` merged into a copy of ``base`` (mappings recursively, everything else replaced)."""
+    out = copy.deepcopy(base)
+    for k, v in over.items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = _merge(out[k], v)
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
+
+
+def _algorithms() -> dict[str, type]:
+    from .sb3 import ALGORITHMS
+
+    return ALGORITHMS
+
+
+def _split_quick(raw: dict[str, Any], where: str) -> tuple[dict[str, Any], dict[str, Any]]:
+    raw = dict(raw)
+    quick = raw.pop("quick", None) or {}
+    if not isinstance(quick, dict):
+        raise ConfigError(f"{where}: 'quick' must be a mapping, got {quick!r}")
+    return raw, quick
+
+
+def _defaults_file(algo: str) -> tuple[dict[str, Any], dict[str, Any]]:
+    return _split_quick(read_yaml(DEFAULTS_DIR / f"{algo}.yaml"), f"defaults/{algo}.yaml")
+
+
+def default_config(algo: str) -> dict[str, Any]:
+    """:data:`COMMON` merged with ``agents/configs/defaults/{algo}.yaml`` (without its quick part)."""
+    _check_algo(algo)
+    raw, _ = _defaults_file(algo)
+    return _merge(_merge(COMMON, raw), {"algo": algo})
+
+
+def _check_algo(algo: Any) -> None:
+    algos = _algorithms()
+    if algo not in algos:
+        raise ConfigError(f"unknown algorithm {algo!r}; choose one of {', '.join(algos)}")
+
+
+def plant_config(path: str | Path) -> dict[str, Any]:
+    """The environment entries read from a plant file (``A``, ``B``; JSON, YAML or NPZ).
+
+    The one place ``train --system FILE`` reads a plant; it uses the ``design`` command's
+    reader, so both accept the same files. A YAML plant file first passes :func:`read_yaml`'s
+    guards (size, no aliases), which that reader does not have.
+    """
+    from encctl_gym.security.design_cli import load_system
+
+    if Path(path).suffix.lower() in (".yaml", ".yml") and Path(path).is_file():
+        read_yaml(path)
+    A, B = load_system(path)
+    return {"A": A.tolist(), "B": B.tolist()}
+
+
+def load_config(
+    algo: str,
+    preset: str | None = None,
+    *,
+    path: str | Path | None = None,
+    system: str | Path | None = None,
+    quick: bool = False,
+) -> dict[str, Any]:
+    """The configuration of one training run, merged in the layers of the module docstring.
+
+    Parameters
+    ----------
+    algo : str
+        A key of :data:`agents.sb3.ALGORITHMS`.
+    preset : str, optional
+        The system preset (``env.preset``); its tuned file ``{algo}_{preset}.yaml`` is merged
+        when it exists and no ``path`` is given.
+    path : path, optional
+        An explicit config file (instead of the preset's tuned file).
+    system : path, optional
+        A plant file whose ``A`` and ``B`` replace the preset's (:func:`plant_config`); the
+        other design parameters (noise variances, ``gamma_c``, ``tau_c``, Upsilon) stay the
+        preset's unless set in ``env``.
+    quick : bool
+        Apply the ``quick:`` sections (a smoke test of a few thousand steps).
+
+    Returns
+    -------
+    dict
+        The validated configuration, with ``algo``, ``system`` (the label of the plant),
+        ``config_files`` (the files merged) and ``quick``.
+
+    Raises
+    ------
+    ConfigError
+        For anything :func:`read_yaml` or :func:`validate_config` rejects.
+    """
+    _check_algo(algo)
+    base, quick_parts = _defaults_file(algo)
+    quick_layers = [quick_parts]
+    cfg = _merge(COMMON, base)
+    files = [str(DEFAULTS_DIR / f"{algo}.yaml")]
+    if path is None and preset is not None and (CONFIG_DIR / f"{algo}_{preset}.yaml").is_file():
+        path = CONFIG_DIR / f"{algo}_{preset}.yaml"
+    if path is not None:
+        raw, q = _split_quick(read_yaml(path), str(path))
+        if raw.get("algo", algo) != algo:
+            raise ConfigError(f"{Path(path).name} is a config for {raw['algo']!r}, not {algo!r}")
+        cfg = _merge(cfg, raw)
+        quick_layers.append(q)
+        files.append(str(path))
+    if not isinstance(cfg.get("env"), dict):
+        raise ConfigError(f"env must be a mapping, got {cfg.get('env')!r}")
+    if preset is not None:
+        cfg["env"]["preset"] = preset
+    if quick:
+        for q in quick_layers:
+            cfg = _merge(cfg, q)
+        if not isinstance(cfg.get("env"), dict):
+            raise ConfigError(f"env must be a mapping, got {cfg.get('env')!r}")
+    if system is not None:
+        cfg["env"].update(plant_config(system))
+        cfg["system"] = Path(system).stem
+    else:
+        cfg["system"] = str(cfg["env"].get("preset"))
+    cfg.update(algo=algo, config_files=files, quick=bool(quick))
+    validate_config(cfg)
+    return cfg
+
+
+# --------------------------------------------------------------------------- schema
+Check = Callable[[str, Any], Any]
+
+
+def _int(minimum: int, optional: bool = False) -> Check:
+    def check(name: str, v: Any) -> Any:
+        if v is None and optional:
+            return v
+        if isinstance(v, bool) or not isinstance(v, numbers.Integral):
+            raise ConfigError(f"{name} must be an integer{' or null' if optional else ''}, got {v!r}")
+        if v < minimum:
+            raise ConfigError(f"{name} must be >= {minimum}, got {v!r}")
+        return int(v)
+
+    return check
+
+
+def _choice(options: tuple[str, ...]) -> Check:
+    def check(name: str, v: Any) -> Any:
+        if not isinstance(v, str) or v not in options:
+            raise ConfigError(f"{name} must be one of {', '.join(options)}, got {v!r}")
+        return v
+
+    return check
+
+
+def _typed(typ: type | tuple[type, ...], label: str) -> Check:
+    def check(name: str, v: Any) -> Any:
+        if not isinstance(v, typ):
+            raise ConfigError(f"{name} must be {label}, got {v!r}")
+        return v
+
+    return check
+
+
+_bool = _typed(bool, "true or false")
+_str = _typed(str, "a string")
+
+#: Checks of every entry but ``env`` and ``hyperparams`` (checked against the environment and
+#: the algorithm). A nested mapping is a nested schema.
+SCHEMA: dict[str, Any] = {
+    "algo": _str,
+    "system": _str,
+    "config_files": _typed(list, "a list of paths"),
+    "quick": _bool,
+    "horizon": _int(2, optional=True),
+    "observation": _choice(OBSERVATION_MODES),
+    "reward_scaling": _choice(REWARD_SCALINGS),
+    "n_envs": _int(1),
+    "n_timesteps": _int(1),
+    "seed": _int(0),
+    "normalize": {"norm_obs": _bool, "norm_reward": _bool},
+    "policy": _str,
+    "eval": {
+        "freq": _int(1),
+        "episodes": _int(1),
+        "seed": _int(0),
+        "final_episodes": _int(1),
+        "final_horizon": _int(2, optional=True),
+        "elgamal": {"episodes": _int(0), "max_samples": _int(2), "key_length": _int(16)},
+    },
+}
+
+
+def _check_tree(prefix: str, node: Any, schema: dict[str, Any]) -> None:
+    if not isinstance(node, dict):
+        raise ConfigError(f"{prefix or 'config'} must be a mapping, got {node!r}")
+    for key, value in node.items():
+        name = f"{prefix}.{key}" if prefix else str(key)
+        if key not in schema:
+            raise ConfigError(f"unknown config key {name!r}; known here: {', '.join(schema)}")
+        rule = schema[key]
+        if isinstance(rule, dict):
+            _check_tree(name, value, rule)
+        else:
+            rule(name, value)
+
+
+def validate_config(cfg: dict[str, Any]) -> None:
+    """Check a whole configuration; raise :class:`ConfigError` naming the first bad entry.
+
+    ``env`` is resolved by the environment's own checks (every key of
+    ``encctl_gym.envs.default_config()``, at the training attack length); ``hyperparams`` and
+    ``hyperparams.policy_kwargs`` are checked against the algorithm's and the policy's
+    constructors (:mod:`agents.hyperparams`).
+    """
+    if not isinstance(cfg, dict):
+        raise ConfigError(f"a config must be a mapping, got {cfg!r}")
+    rest = {k: v for k, v in cfg.items() if k not in ("env", "hyperparams")}
+    _check_tree("", rest, SCHEMA)
+    _check_algo(cfg.get("algo"))
+    env = cfg.get("env")
+    if not isinstance(env, dict):
+        raise ConfigError(f"env must be a mapping, got {env!r}")
+    unknown = sorted(set(env) - set(env_default_config()))
+    if unknown:
+        raise ConfigError(f"unknown config key(s) env.{unknown[0]}; known: {', '.join(sorted(env_default_config()))}")
+    try:
+        resolve_params(env_config(cfg))
+    except ParameterError as exc:
+        raise ConfigError(f"env: {exc}") from exc
+    from .hyperparams import RESERVED, check_kwargs, policy_kwargs
+
+    algo_cls = _algorithms()[cfg["algo"]]
+    hp = cfg.get("hyperparams", {})
+    if not isinstance(hp, dict):
+        raise ConfigError(f"hyperparams must be a mapping, got {hp!r}")
+    check_kwargs("hyperparams", {k: v for k, v in hp.items() if k != "policy_kwargs"}, algo_cls.__init__, RESERVED - {"policy_kwargs"})
+    policy_kwargs(algo_cls, cfg.get("policy", "MlpPolicy"), hp.get("policy_kwargs"))
+
+
+# --------------------------------------------------------------------------- overrides
+def _yaml_value(text: str) -> Any:
+    """A YAML value, with ``1e-3``-style floats (strings to YAML 1.1) read as floats."""
+    try:
+        if any(isinstance(tok, yaml.AliasToken) for tok in yaml.scan(text)):
+            raise ConfigError(f"override value {text!r} uses a YAML alias")
+        v = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"override value {text!r} is not valid YAML: {str(exc).splitlines()[0]}") from exc
+    if isinstance(v, str):
+        try:
+            return float(v)
+        except ValueError:
+            return v
+    return v
+
+
+def apply_override(cfg: dict[str, Any], item: str) -> None:
+    """Apply one ``key.sub=value`` override (value read as YAML) to ``cfg`` in place, then check
+    the whole configuration (:func:`validate_config`).
+
+    Raises
+    ------
+    ConfigError
+        ``item`` is not ``KEY=VALUE``, the key is unknown (in the schema, the environment, the
+        algorithm's or the policy's signature), a level above it is not a mapping, or the value
+        is rejected.
+    """
+    if "=" not in item:
+        raise ConfigError(f"override {item!r} is not KEY=VALUE")
+    key, value = item.split("=", 1)
+    parts = key.strip().split(".")
+    if not all(parts):
+        raise ConfigError(f"override key {key!r} has an empty part")
+    trial = copy.deepcopy(cfg)
+    nested = {"policy_kwargs", *(k for k, v in SCHEMA.items() if isinstance(v, dict))}
+    node = trial
+    for i, p in enumerate(parts[:-1]):
+        if node.get(p) is None and p in nested:
+            node[p] = {}
+        if not isinstance(node.get(p), dict):
+            raise ConfigError(f"override {key!r}: {'.'.join(parts[: i + 1])!r} is not a mapping of the config")
+        node = node[p]
+    node[parts[-1]] = _yaml_value(value)
+    validate_config(trial)
+    cfg.clear()
+    cfg.update(trial)
+
+
+# --------------------------------------------------------------------------- derived
+def env_config(cfg: dict[str, Any], **over: Any) -> dict[str, Any]:
+    """The training environment's configuration (``horizon`` applied through the budget)."""
+    from .evaluate import budget_config
+
+    env = {"gamma_opt": False, **cfg["env"]}
+    env.update(over)
+    if cfg.get("horizon"):
+        env = budget_config(env, int(cfg["horizon"]))
+    return env
+
+
+def run_name(cfg: dict[str, Any], seed: int) -> str:
+    """``{algo}_{system}_d{delay}_{observation}_s{seed}`` (``-quick`` for smoke tests)."""
+    delay = cfg["env"].get("decipher_delay", 0)
+    name = f"{cfg['algo']}_{cfg.get('system', cfg['env'].get('preset', 'custom'))}_d{delay}_{cfg['observation']}_s{seed}"
+    return name + ("-quick" if cfg.get("quick") else "")

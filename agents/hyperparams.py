@@ -1,0 +1,193 @@
+"""Hyperparameters of a learning algorithm checked against its constructor before training.
+
+A config's ``hyperparams`` are keyword arguments of the algorithm class (``PPO(...)``,
+``SAC(...)``, ...) and its ``hyperparams.policy_kwargs`` keyword arguments of the policy class
+(``ActorCriticPolicy(...)``, ...). Both are checked here against the constructors' signatures
+and type hints, so an unknown name or a value of the wrong type is a one-line
+:class:`~encctl_gym.errors.ConfigError` before anything is built, not a traceback from deep
+inside stable-baselines3 or a keyword silently ignored.
+
+What a YAML file can express is checked: numbers, booleans, strings, ``null``, lists, tuples
+and mappings, by the annotation's structure (``int | None``, ``list[int] | dict[str,
+list[int]]``, ...). Parameters whose type is a class or a callable (schedules, buffer or
+optimizer classes, action noise) cannot be given in a config, except ``activation_fn``, given by
+name (:data:`ACTIVATIONS`).
+"""
+
+from __future__ import annotations
+
+import collections.abc
+import inspect
+import numbers
+import types
+import typing
+from typing import Any
+
+from encctl_gym.errors import ConfigError
+
+__all__ = ["ACTIVATIONS", "RESERVED", "type_hints", "check_value", "check_kwargs", "policy_kwargs"]
+
+#: ``activation_fn`` names accepted in configs -> ``torch.nn`` class names.
+ACTIVATIONS = {"tanh": "Tanh", "relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "silu": "SiLU", "gelu": "GELU"}
+
+#: Constructor arguments that ``train`` sets itself (never from ``hyperparams``).
+RESERVED = frozenset({"policy", "env", "seed", "verbose", "device", "tensorboard_log", "_init_setup_model", "policy_kwargs"})
+#: Policy constructor arguments set by the algorithm.
+_POLICY_RESERVED = frozenset({"observation_space", "action_space", "lr_schedule", "use_sde"})
+
+#: Hyperparameters that must be positive integers (or floats in (0, 1]) whatever the algorithm.
+_POSITIVE_INT = frozenset({"n_steps", "batch_size", "n_epochs", "buffer_size", "stats_window_size",
+                           "target_update_interval", "policy_delay", "lstm_hidden_size", "n_lstm_layers"})
+_UNIT_INTERVAL = frozenset({"gamma", "gae_lambda", "tau"})
+
+
+def type_hints(fn: Any) -> tuple[list[str], dict[str, Any]]:
+    """Keyword names and resolved type hints of ``fn`` (a constructor).
+
+    stable-baselines3 annotates some arguments with names imported only for type checkers
+    (``VecEnv``); they are supplied here. A hint that still cannot be resolved is left out (the
+    name is still known, its value is then not type-checked).
+    """
+    params = [p.name for p in inspect.signature(fn).parameters.values()
+              if p.name != "self" and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+    try:
+        from stable_baselines3.common.vec_env import VecEnv
+
+        hints = typing.get_type_hints(fn, localns={"VecEnv": VecEnv})
+    except (NameError, TypeError, AttributeError):  # a forward reference we cannot resolve: names only
+        hints = {}
+    return params, hints
+
+
+def _describe(annotation: Any) -> str:
+    return str(annotation).replace("typing.", "").replace("<class '", "").replace("'>", "")
+
+
+def _matches(value: Any, ann: Any) -> bool:
+    """Whether a YAML value fits the annotation ``ann`` (structurally)."""
+    if ann is Any or ann is inspect.Parameter.empty:
+        return True
+    if ann is type(None) or ann is None:
+        return value is None
+    origin = typing.get_origin(ann)
+    if origin in (typing.Union, types.UnionType):
+        return any(_matches(value, a) for a in typing.get_args(ann))
+    if ann is bool:
+        return isinstance(value, bool)
+    if ann is int:
+        return isinstance(value, numbers.Integral) and not isinstance(value, bool)
+    if ann is float:
+        return isinstance(value, numbers.Real) and not isinstance(value, bool)
+    if ann is str:
+        return isinstance(value, str)
+    if origin in (list, collections.abc.Sequence):
+        (item,) = typing.get_args(ann) or (Any,)
+        return isinstance(value, list) and all(_matches(v, item) for v in value)
+    if origin is tuple:
+        args = typing.get_args(ann)
+        if not isinstance(value, (list, tuple)):
+            return False
+        if len(args) == 2 and args[1] is Ellipsis:
+            return all(_matches(v, args[0]) for v in value)
+        return len(value) == len(args) and all(_matches(v, a) for v, a in zip(value, args))
+    if origin in (dict, collections.abc.Mapping):
+        k_ann, v_ann = typing.get_args(ann) or (Any, Any)
+        return isinstance(value, dict) and all(_matches(k, k_ann) and _matches(v, v_ann) for k, v in value.items())
+    if ann in (list, tuple, dict):
+        return isinstance(value, ann if ann is not tuple else (list, tuple))
+    return False  # classes, callables, objects: not expressible in a config
+
+
+def check_value(name: str, value: Any, annotation: Any) -> Any:
+    """Check one value against its annotation and the domain rules; return it (tuples from lists).
+
+    Raises
+    ------
+    ConfigError
+        Naming ``name``, the value and the expected type.
+    """
+    if not _matches(value, annotation):
+        raise ConfigError(f"{name}={value!r} does not fit its type {_describe(annotation)}")
+    leaf = name.rsplit(".", 1)[-1]
+    if leaf in _POSITIVE_INT and value is not None and value < 1:
+        raise ConfigError(f"{name} must be >= 1, got {value!r}")
+    if leaf in _UNIT_INTERVAL and not 0.0 < float(value) <= 1.0:
+        raise ConfigError(f"{name} must lie in (0, 1], got {value!r}")
+    if leaf in ("learning_rate", "clip_range") and isinstance(value, numbers.Real) and not float(value) > 0.0:
+        raise ConfigError(f"{name} must be > 0, got {value!r}")
+    if leaf == "net_arch" and value is not None:
+        sizes = value if isinstance(value, list) else [v for layer in value.values() for v in layer]
+        if any(v < 1 for v in sizes):
+            raise ConfigError(f"{name} layer sizes must be >= 1, got {value!r}")
+    if isinstance(value, list):
+        union = typing.get_origin(annotation) in (typing.Union, types.UnionType)
+        members = typing.get_args(annotation) if union else (annotation,)
+        as_list = any(a is list or typing.get_origin(a) in (list, collections.abc.Sequence) for a in members)
+        if not as_list and any(a is tuple or typing.get_origin(a) is tuple for a in members):
+            return tuple(value)  # e.g. train_freq: [1, "episode"]
+    return value
+
+
+def check_kwargs(where: str, kwargs: dict[str, Any], fn: Any, reserved: frozenset[str] = frozenset()) -> dict[str, Any]:
+    """Check keyword arguments for ``fn`` (unknown names, reserved names, types).
+
+    Parameters
+    ----------
+    where : str
+        Prefix of the names in messages (``"hyperparams"``, ``"hyperparams.policy_kwargs"``).
+    kwargs : dict
+        The arguments.
+    fn : callable
+        The constructor they are for.
+    reserved : set of str
+        Names that exist but are set by the caller.
+
+    Returns
+    -------
+    dict
+        The checked arguments (lists converted to tuples where a tuple is expected).
+    """
+    if not isinstance(kwargs, dict):
+        raise ConfigError(f"{where} must be a mapping, got {kwargs!r}")
+    names, hints = type_hints(fn)
+    owner = getattr(fn, "__qualname__", str(fn)).split(".")[0]
+    out = {}
+    for key, value in kwargs.items():
+        if key in reserved:
+            raise ConfigError(f"{where}.{key} is set by encctl-gym train itself and cannot be configured")
+        if key not in names:
+            known = ", ".join(n for n in names if n not in reserved and not n.startswith("_"))
+            raise ConfigError(f"unknown {where} key {key!r} for {owner}; known: {known}")
+        out[key] = check_value(f"{where}.{key}", value, hints.get(key, Any))
+    return out
+
+
+def policy_kwargs(algo_cls: type, policy: str, kwargs: dict[str, Any] | None) -> dict[str, Any]:
+    """``policy_kwargs`` checked against the policy class and made ready for the constructor.
+
+    ``activation_fn`` is given by name (:data:`ACTIVATIONS`) and replaced by the ``torch.nn``
+    class here.
+
+    Parameters
+    ----------
+    algo_cls : type
+        The algorithm class (its ``policy_aliases`` name the policy classes).
+    policy : str
+        The policy name (``MlpPolicy``, ``MlpLstmPolicy``, ...).
+    kwargs : dict or None
+        The config's ``hyperparams.policy_kwargs``.
+    """
+    aliases = getattr(algo_cls, "policy_aliases", {})
+    if policy not in aliases:
+        raise ConfigError(f"unknown policy {policy!r} for {algo_cls.__name__}; choose one of {', '.join(aliases)}")
+    where = "hyperparams.policy_kwargs"
+    pk = dict(kwargs or {})
+    act = pk.pop("activation_fn", None)
+    out = check_kwargs(where, pk, aliases[policy].__init__, _POLICY_RESERVED)
+    if act is not None:
+        if not isinstance(act, str) or act.lower() not in ACTIVATIONS:
+            raise ConfigError(f"unknown {where}.activation_fn {act!r}; choose one of {', '.join(ACTIVATIONS)}")
+        import torch.nn as nn
+
+        out["activation_fn"] = getattr(nn, ACTIVATIONS[act.lower()])
+    return out

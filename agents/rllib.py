@@ -1,0 +1,153 @@
+"""Training on a cluster with Ray RLlib (the optional ``[ray]`` extra).
+
+RLlib runs a Gymnasium environment unchanged: :func:`register` registers a creator
+(:func:`make_env`, which builds ``encctl_gym/EncryptedLTIAttack-v0`` through
+``gymnasium.make``) under :data:`ENV_NAME` with ``ray.tune.registry.register_env``, and every
+env runner of the cluster builds its own copies from the same configuration mapping. The
+learned policy sees the environment's full observation and its reward (``reward`` in the
+configuration), exactly as the single environment defines them.
+
+:func:`ppo_config` returns an RLlib ``PPOConfig`` for that environment; :func:`train_ppo`
+connects to a cluster (``address="auto"`` for a running one; ``None`` starts a local Ray
+instance), trains for some iterations and returns one summary per iteration. For example::
+
+    from agents.rllib import train_ppo
+    rows = train_ppo({"preset": "paper-example", "gamma_opt": False}, iterations=50,
+                     address="auto", num_env_runners=32)
+
+The stable-baselines3 path (:mod:`agents.train`) stays the one the package's results come from:
+on one machine its native vector environment steps all copies in one compiled call, which an
+RLlib env runner (one Python ``step`` per copy) does not.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+from encctl_gym.errors import EncctlError
+
+__all__ = ["ENV_NAME", "make_env", "register", "ppo_config", "train_ppo"]
+
+#: The name the environment is registered under in RLlib.
+ENV_NAME = "encctl_gym/EncryptedLTIAttack-v0"
+
+
+def _require_rllib() -> Any:
+    try:
+        import ray
+        from ray.rllib.algorithms.ppo import PPOConfig  # noqa: F401
+    except ModuleNotFoundError as exc:
+        raise EncctlError(f"agents.rllib needs Ray RLlib (module {exc.name!r} is missing); "
+                          "install the extra: pip install 'encctl-gym[ray]'") from exc
+    return ray
+
+
+def make_env(env_config: Mapping[str, Any]) -> Any:
+    """The environment for one RLlib env runner: ``gymnasium.make`` of the registered id with
+    ``env_config`` (any mapping, such as RLlib's ``EnvContext``) as its configuration."""
+    import gymnasium as gym
+
+    from encctl_gym.envs import ENV_ID
+
+    return gym.make(ENV_ID, config=dict(env_config))
+
+
+def register(name: str = ENV_NAME) -> str:
+    """Register :func:`make_env` with RLlib under ``name``; return the name."""
+    _require_rllib()
+    from ray.tune.registry import register_env
+
+    register_env(name, make_env)
+    return name
+
+
+def ppo_config(
+    env_config: Mapping[str, Any],
+    *,
+    num_env_runners: int = 0,
+    num_envs_per_env_runner: int = 1,
+    train_batch_size: int = 4096,
+    minibatch_size: int = 256,
+    num_epochs: int = 10,
+    gamma: float = 0.999,
+    lr: float = 3e-4,
+    seed: int | None = 0,
+) -> Any:
+    """An RLlib ``PPOConfig`` for the attack environment (registered by :func:`register`).
+
+    Parameters
+    ----------
+    env_config : mapping
+        The environment configuration (``encctl_gym.envs.default_config()`` keys), checked here
+        before any worker starts.
+    num_env_runners, num_envs_per_env_runner : int
+        Sampling workers (0: sample in the driver) and environment copies per worker.
+    train_batch_size, minibatch_size, num_epochs, gamma, lr : number
+        PPO's batch, minibatch, epochs per batch, discount and learning rate.
+    seed : int, optional
+        RLlib's seed of the workers' environments and the learner.
+    """
+    _require_rllib()
+    from ray.rllib.algorithms.ppo import PPOConfig
+
+    from encctl_gym.envs.config import resolve_params
+
+    resolve_params(dict(env_config))  # a bad configuration fails here, not in a remote worker
+    cfg = (
+        PPOConfig()
+        .environment(register(), env_config=dict(env_config))
+        .env_runners(num_env_runners=int(num_env_runners), num_envs_per_env_runner=int(num_envs_per_env_runner))
+        .training(train_batch_size=int(train_batch_size), minibatch_size=int(minibatch_size), num_epochs=int(num_epochs),
+                  gamma=float(gamma), lr=float(lr))
+        .framework("torch")
+    )
+    if seed is not None:
+        cfg = cfg.debugging(seed=int(seed))
+    return cfg
+
+
+def train_ppo(env_config: Mapping[str, Any], *, iterations: int, address: str | None = None, **kwargs: Any) -> list[dict[str, Any]]:
+    """Train PPO with RLlib for ``iterations`` iterations; one summary per iteration.
+
+    Parameters
+    ----------
+    env_config : mapping
+        The environment configuration.
+    iterations : int
+        Training iterations (each samples ``train_batch_size`` steps).
+    address : str, optional
+        A Ray cluster to join (``"auto"``: the running one); ``None`` starts a local instance,
+        stopped at the end.
+    **kwargs
+        Passed to :func:`ppo_config`.
+
+    Returns
+    -------
+    list of dict
+        ``iteration``, ``env_steps`` (lifetime), ``episode_return_mean`` (the mean telescoped
+        ``log eps_0 - log eps_N`` of the episodes finished in that iteration, ``None`` if none)
+        and ``seconds``.
+    """
+    ray = _require_rllib()
+    from encctl_gym._validation import check_int
+
+    iterations = check_int("iterations", iterations, minimum=1)
+    started = not ray.is_initialized()
+    if started:
+        ray.init(address=address, include_dashboard=False, log_to_driver=False)
+    algo = ppo_config(env_config, **kwargs).build_algo()
+    rows = []
+    try:
+        for i in range(iterations):
+            r = algo.train()
+            rows.append({
+                "iteration": i + 1,
+                "env_steps": int(r.get("num_env_steps_sampled_lifetime", 0)),
+                "episode_return_mean": r.get("env_runners", {}).get("episode_return_mean"),
+                "seconds": float(r.get("time_this_iter_s", float("nan"))),
+            })
+    finally:
+        algo.stop()
+        if started:
+            ray.shutdown()
+    return rows

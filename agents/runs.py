@@ -1,0 +1,205 @@
+"""Training run directories: where a run goes, what its ``run.json`` holds, and finding runs.
+
+A run directory is written by :func:`agents.train.train` and read by
+:func:`agents.sb3.load_attacker`, ``encctl-gym evaluate`` and ``encctl-gym compare``; this
+module is the one place that knows its layout:
+
+=======================  ==================================================================
+file                     content
+=======================  ==================================================================
+``run.json``             :class:`RunInfo`: algorithm, observation mode, environment
+                         configuration, system label, seed, the resolved training
+                         configuration, timing, and (after it ran) the final evaluation
+``model.zip``            the model at the end of training
+``best_model.zip``       the best model of the evaluation callback
+``vecnormalize.pkl``     observation statistics (when observations are normalised)
+``learning_curve.npz``   the evaluation callback's record (:mod:`agents.curves`)
+``learning_curve.png``   its plot
+``evaluations.npz``      stable-baselines3's own evaluation log (returns, lengths)
+``tb/``                  TensorBoard logs
+=======================  ==================================================================
+
+``model.zip`` and ``vecnormalize.pkl`` are unpickled when loaded: load only runs you trust.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Sequence
+
+from encctl_gym.errors import ConfigError
+
+__all__ = ["RUN_FILE", "RunInfo", "read_run", "find_runs", "new_run_dir"]
+
+#: The metadata file that makes a directory a training run.
+RUN_FILE = "run.json"
+
+#: Model files by the name ``which`` selects them with.
+MODEL_FILES = {"final": "model.zip", "best": "best_model.zip"}
+
+
+@dataclass(frozen=True)
+class RunInfo:
+    """The metadata of one training run (the content of its ``run.json``).
+
+    Attributes
+    ----------
+    path : Path
+        The run directory.
+    algo : str
+        Algorithm name (a key of :data:`agents.sb3.ALGORITHMS`).
+    observation : str
+        Observation mode the policy was trained with (``full``, ``no_budget``, ``blind``).
+    env : dict
+        The training environment's configuration (attack length set through the budget).
+    system : str
+        The system's label: a preset name, or the stem of the plant file given to ``--system``.
+    seed : int
+        Training seed.
+    quick : bool
+        A smoke-test run (``--quick``).
+    meta : dict
+        Everything in ``run.json``.
+    """
+
+    path: Path
+    algo: str
+    observation: str
+    env: dict[str, Any]
+    system: str
+    seed: int
+    quick: bool
+    meta: dict[str, Any] = field(repr=False)
+
+    @property
+    def custom_plant(self) -> bool:
+        """True if the plant matrices were given explicitly (``--system FILE``), not by a preset."""
+        return self.env.get("A") is not None or self.env.get("B") is not None
+
+    def model_path(self, which: str = "final") -> Path:
+        """The model file of ``which`` (``"final"`` or ``"best"``); :class:`ConfigError` if absent."""
+        if which not in MODEL_FILES:
+            raise ConfigError(f"which must be one of {', '.join(MODEL_FILES)}, got {which!r}")
+        p = self.path / MODEL_FILES[which]
+        if not p.is_file():
+            raise ConfigError(f"no {MODEL_FILES[which]} in {self.path}")
+        return p
+
+
+def read_run(run_dir: str | Path) -> RunInfo:
+    """Read and check a run directory's ``run.json``.
+
+    Parameters
+    ----------
+    run_dir : path
+        A directory written by ``encctl-gym train``.
+
+    Returns
+    -------
+    RunInfo
+
+    Raises
+    ------
+    ConfigError
+        If the directory or its ``run.json`` is missing, is not valid JSON, or lacks a field
+        (``algo``, ``observation``, ``env``) or has one of the wrong type.
+    """
+    path = Path(run_dir)
+    meta_path = path / RUN_FILE
+    if not meta_path.is_file():
+        raise ConfigError(f"{str(path)!r} is not a training run (no {RUN_FILE})")
+    try:
+        meta = json.loads(meta_path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ConfigError(f"cannot read {meta_path}: {exc}") from exc
+    if not isinstance(meta, dict):
+        raise ConfigError(f"{meta_path} must hold a JSON object, got {type(meta).__name__}")
+    for key, typ in (("algo", str), ("observation", str), ("env", dict)):
+        if not isinstance(meta.get(key), typ):
+            raise ConfigError(f"{meta_path}: field {key!r} must be a {typ.__name__}, got {meta.get(key)!r}")
+    config = meta.get("config", {})
+    if not isinstance(config, dict):
+        raise ConfigError(f"{meta_path}: field 'config' must be an object, got {config!r}")
+    env = meta["env"]
+    system = meta.get("system") or config.get("system") or env.get("preset") or "custom"
+    seed = meta.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int):
+        raise ConfigError(f"{meta_path}: field 'seed' must be an integer, got {seed!r}")
+    return RunInfo(path=path, algo=meta["algo"], observation=meta["observation"], env=env, system=str(system),
+                   seed=seed, quick=bool(config.get("quick", False)), meta=meta)
+
+
+def find_runs(roots: Sequence[str | Path], *, include_quick: bool = False) -> list[RunInfo]:
+    """The training runs (a ``run.json`` and a ``model.zip``) under ``roots``.
+
+    A root that is itself a run is taken as given; under any other root every direct
+    subdirectory that is a run counts, quick (smoke-test) runs only with ``include_quick``.
+
+    Raises
+    ------
+    ConfigError
+        If a root does not exist, or a run's ``run.json`` is broken (:func:`read_run`).
+    """
+    out: list[RunInfo] = []
+    for root in roots:
+        root = Path(root)
+        if (root / RUN_FILE).exists():
+            out.append(read_run(root))
+            continue
+        if not root.is_dir():
+            raise ConfigError(f"runs directory {str(root)!r} does not exist")
+        for meta in sorted(root.glob(f"*/{RUN_FILE}")):
+            if not (meta.parent / MODEL_FILES["final"]).exists():
+                continue
+            info = read_run(meta.parent)
+            if include_quick or not info.quick:
+                out.append(info)
+    return out
+
+
+def new_run_dir(parent: str | Path, name: str, *, overwrite: bool = False) -> Path:
+    """Create the directory of a new run and return it; an earlier run is never silently replaced.
+
+    Parameters
+    ----------
+    parent : path
+        Where runs are kept.
+    name : str
+        The wanted directory name.
+    overwrite : bool
+        Replace an earlier run of that name (its files are deleted first, so nothing of it, such
+        as an old ``best_model.zip``, survives into the new run).
+
+    Returns
+    -------
+    Path
+        ``parent / name`` if it is free (or ``overwrite``), else the first free
+        ``parent / f"{name}-{i}"``, ``i = 2, 3, ...``.
+
+    Raises
+    ------
+    ConfigError
+        If ``name`` is not a plain directory name, or ``overwrite`` is asked for a directory
+        that holds files but no run (it is not deleted).
+    """
+    if not name or Path(name).name != name or name in (".", ".."):
+        raise ConfigError(f"run name must be a plain directory name, got {name!r}")
+    parent = Path(parent)
+    target = parent / name
+    if target.exists() and overwrite:
+        if not target.is_dir():
+            raise ConfigError(f"{str(target)!r} exists and is not a directory")
+        if any(target.iterdir()):
+            if not (target / RUN_FILE).exists():
+                raise ConfigError(f"--overwrite refuses to delete {str(target)!r}: it holds files but no {RUN_FILE}")
+            shutil.rmtree(target)
+    elif target.exists() and (not target.is_dir() or any(target.iterdir())):
+        i = 2
+        while (parent / f"{name}-{i}").exists():
+            i += 1
+        target = parent / f"{name}-{i}"
+    target.mkdir(parents=True, exist_ok=True)
+    return target

@@ -1,0 +1,75 @@
+"""The key-handling schemes of the encrypted controller, by name: which plant party, which server.
+
+==============  ===================  =========================  ==============================
+scheme          plant party          server                     keys
+==============  ===================  =========================  ==============================
+``modified``    :class:`ModifiedPlant` :class:`ControllerServer`  updated every period; no token
+                                                                 leaves the plant (Definition
+                                                                 def:modification, eq:ec)
+``token``       :class:`TokenPlant`  :class:`TokenControllerServer` updated every period; the
+                                                                 server receives every token
+                                                                 (Definition def:ec, Example
+                                                                 ex:dyn_elgamal)
+``static``      :class:`StaticPlant` :class:`StaticControllerServer` one fixed key pair
+==============  ===================  =========================  ==============================
+
+A new scheme is a row of :data:`SCHEMES`; the encrypted controller, the environment's ElGamal
+backend and the forging of injected inputs (:mod:`encctl_gym.attacks.forgery`) all pick their
+parts from it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable
+
+from ..errors import ParameterError
+from .arith import RandomSource
+from .plant_side import ModifiedPlant, PlantParty, StaticPlant, TokenPlant
+from .quantized import QuantizedLinearController
+from .servers import ControllerServer, StaticControllerServer, TokenControllerServer
+
+__all__ = ["Scheme", "SCHEMES", "get_scheme"]
+
+
+@dataclass(frozen=True)
+class Scheme:
+    """One key-handling scheme: its plant party and the server that goes with it.
+
+    Attributes
+    ----------
+    name : str
+        The scheme's name (the ``scheme`` of the environment and of the controller).
+    plant : type
+        The plant party (:mod:`.plant_side`).
+    make_server : callable
+        ``(plant, ct_phi, rng) -> server``: the server for that plant's parameter ciphertexts,
+        with its own randomness ``rng`` where it needs any.
+    token_to_server : bool
+        The plant sends every update token to the server (the server then CtUpds Phi).
+    """
+
+    name: str
+    plant: type[PlantParty]
+    make_server: Callable[[PlantParty, Any, RandomSource], Any]
+    token_to_server: bool
+
+    def parties(self, quantization: QuantizedLinearController, plant_rng: Any, server_rng: Any) -> tuple[PlantParty, Any]:
+        """A new plant party (fresh keys) and its server, each with its own randomness."""
+        plant = self.plant(quantization, plant_rng)
+        return plant, self.make_server(plant, plant.encrypt_parameter(), server_rng)
+
+
+#: The schemes by name.
+SCHEMES: dict[str, Scheme] = {
+    "modified": Scheme("modified", ModifiedPlant, lambda plant, ct, rng: ControllerServer(plant.pk0, ct), False),
+    "token": Scheme("token", TokenPlant, lambda plant, ct, rng: TokenControllerServer(plant.pk0, ct, rng), True),
+    "static": Scheme("static", StaticPlant, lambda plant, ct, rng: StaticControllerServer(plant.pk0, ct), False),
+}
+
+
+def get_scheme(name: Any) -> Scheme:
+    """The scheme ``name`` of :data:`SCHEMES`; an unknown name raises :class:`ParameterError`."""
+    if not isinstance(name, str) or name not in SCHEMES:
+        raise ParameterError(f"unknown scheme {name!r}; choose one of {', '.join(SCHEMES)}")
+    return SCHEMES[name]

@@ -1,0 +1,200 @@
+"""What the attacker of ``EncryptedLTIAttack-v0`` observes, and what ``info`` reports, defined once.
+
+:class:`ObservationLayout` is the one definition of the flat observation vector: its slices
+(used by the attackers in :mod:`agents`), its bounds (the observation space), the offsets the
+compiled kernels write at (:mod:`encctl_gym.envs._kernels`), and the column subsets (*modes*)
+that learned attackers are trained on. :data:`INFO_FIELDS` is the one definition of the info
+entries: their names and order, and the rows of the two buffers (floats, counts) that the
+kernels fill for every copy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+
+__all__ = [
+    "ObservationLayout",
+    "OBSERVATION_MODES",
+    "INFO_FIELDS",
+    "F_EPSILON",
+    "F_GAMMA",
+    "F_TIME",
+    "F_ENERGY",
+    "F_POWER",
+    "F_GAMMA_OPT",
+    "C_COLLECTED",
+    "C_DELIVERED",
+    "INFO_FLOAT_ROWS",
+    "INFO_COUNT_ROWS",
+    "PRIVILEGED_INFO",
+    "info_buffers",
+    "info_from_buffers",
+]
+
+#: Column subsets of the observation for learned attackers (:meth:`ObservationLayout.columns`).
+OBSERVATION_MODES = ("full", "no_budget", "blind")
+
+#: Largest distance of the encoder's chosen group element from ``round(Delta x)`` that the
+#: observation bounds allow for (the residue table's search pad: :mod:`encctl_gym.crypto.residue_table`).
+_SHIFT_PAD = 65.0
+
+
+@dataclass(frozen=True)
+class ObservationLayout:
+    """The flat ``float32`` observation for ``n`` states, ``m`` inputs and ``H`` own past inputs.
+
+    ====================  =====================================================================
+    slice                 content
+    ====================  =====================================================================
+    :attr:`state`         latest delivered deciphered state ``x_j`` (zeros before any)
+    :attr:`input`         delivered input ``u_{j-1}`` that led to ``x_j`` (zeros if none)
+    :attr:`flag`          1.0 if a sample was delivered at this step, else 0.0
+    :attr:`history`       the agent's own last ``H`` actions, newest first (action units)
+    :attr:`time_fraction` fraction of the deciphering budget ``tau_c`` spent
+    :attr:`energy_fraction` fraction of the input energy budget spent
+    ====================  =====================================================================
+    """
+
+    n: int
+    m: int
+    H: int
+
+    @classmethod
+    def of(cls, params: Any) -> "ObservationLayout":
+        """The layout of an environment's resolved parameters (:class:`~encctl_gym.envs.config.AttackParams`)."""
+        return cls(int(params.n), int(params.m), int(params.input_history))
+
+    @property
+    def dim(self) -> int:
+        """Length of the observation vector: ``n + m + 1 + H m + 2``."""
+        return self.n + self.m + 1 + self.H * self.m + 2
+
+    @property
+    def state(self) -> slice:
+        """Latest delivered deciphered state ``x_j``."""
+        return slice(0, self.n)
+
+    @property
+    def input(self) -> slice:
+        """Delivered input ``u_{j-1}``."""
+        return slice(self.n, self.n + self.m)
+
+    @property
+    def flag(self) -> int:
+        """1.0 when a sample was delivered at this step."""
+        return self.n + self.m
+
+    @property
+    def history(self) -> slice:
+        """Own last ``H`` actions, newest first (action units)."""
+        start = self.n + self.m + 1
+        return slice(start, start + self.H * self.m)
+
+    @property
+    def time_fraction(self) -> int:
+        """Fraction of the deciphering budget spent."""
+        return self.dim - 2
+
+    @property
+    def energy_fraction(self) -> int:
+        """Fraction of the input energy budget spent."""
+        return self.dim - 1
+
+    @property
+    def offsets(self) -> tuple[int, int, int, int, int, int]:
+        """``(state, input, flag, history, time_fraction, energy_fraction)`` start indices, as the
+        compiled kernels take them."""
+        return (0, self.input.start, self.flag, self.history.start, self.time_fraction, self.energy_fraction)
+
+    def bounds(self, *, x_bound: float, u_max: float, delta: float) -> tuple[np.ndarray, np.ndarray]:
+        """Finite bounds ``(low, high)`` of the observation (float32).
+
+        States lie within the encoder's declared range ``x_bound`` (encoding beyond it raises)
+        plus the encoder's largest shift to the group (65 / Delta); inputs within the actuator
+        bound plus the forged input's quantisation (``Ecd(a) Ecd(1) / Delta^2`` with both
+        factors shifted, plus ``(n - 1) Ecd(0)^2 / Delta^2``, see
+        :func:`encctl_gym.attacks.forgery.injection_value`); flag, history and fractions within
+        their ranges.
+        """
+        n, m, H = self.n, self.m, self.H
+        x_hi = x_bound + _SHIFT_PAD / delta
+        u_hi = (u_max + _SHIFT_PAD / delta) * (1.0 + _SHIFT_PAD / delta) + n / delta**2
+        high = np.concatenate([np.full(n, x_hi), np.full(m, u_hi), [1.0], np.ones(H * m), [1.0, 1.0]])
+        low = np.concatenate([-high[: n + m], [0.0], -np.ones(H * m), [0.0, 0.0]])
+        return low.astype(np.float32), high.astype(np.float32)
+
+    def columns(self, mode: str) -> np.ndarray:
+        """Columns of the observation a learned attacker sees in ``mode``.
+
+        * ``"full"``: everything.
+        * ``"no_budget"``: without the two budget fractions. Their scale depends on the episode
+          length (``max_samples``, ``tau_c``), so a stationary policy trained on short episodes
+          transfers to the full attack only if it does not see them.
+        * ``"blind"``: the attacker's own past actions and the two budget fractions, i.e. what
+          the paper's attacker knows before the attack ends (``decipher_delay="end"``); no
+          delivered data. Use with a recurrent policy.
+
+        The budget fractions let a policy pace its input energy; they mean "fraction of the
+        attack elapsed" only when the horizon is set by ``tau_c``, not by ``max_samples``.
+
+        Raises
+        ------
+        ParameterError
+            For an unknown mode, or ``"blind"`` without an input history.
+        """
+        if mode == "full":
+            return np.arange(self.dim)
+        if mode == "no_budget":
+            return np.arange(self.dim - 2)
+        if mode == "blind":
+            if self.H == 0:
+                raise ParameterError("observation mode 'blind' needs input_history >= 1")
+            return np.concatenate(
+                [np.arange(self.history.start, self.history.stop), [self.time_fraction, self.energy_fraction]]
+            )
+        raise ParameterError(f"unknown observation mode {mode!r}; choose one of {', '.join(OBSERVATION_MODES)}")
+
+
+# ----------------------------------------------------------------------------- info
+# Rows of the two info buffers (floats; counts), as the kernels' ``_info`` stage writes them.
+F_EPSILON, F_GAMMA, F_TIME, F_ENERGY, F_POWER, F_GAMMA_OPT = range(6)
+C_COLLECTED, C_DELIVERED = range(2)
+
+#: The info entries, in the order of the info dict, each with its buffer ("f": floats, "c":
+#: counts) and row there.
+INFO_FIELDS: tuple[tuple[str, str, int], ...] = (
+    ("epsilon", "f", F_EPSILON),
+    ("gamma", "f", F_GAMMA),
+    ("samples_collected", "c", C_COLLECTED),
+    ("samples_delivered", "c", C_DELIVERED),
+    ("deciphering_time", "f", F_TIME),
+    ("input_energy", "f", F_ENERGY),
+    ("average_power", "f", F_POWER),
+    ("gamma_opt", "f", F_GAMMA_OPT),
+)
+INFO_FLOAT_ROWS = tuple(name for name, kind, _ in sorted(INFO_FIELDS, key=lambda f: f[2]) if kind == "f")
+INFO_COUNT_ROWS = tuple(name for name, kind, _ in sorted(INFO_FIELDS, key=lambda f: f[2]) if kind == "c")
+
+#: Info entries that are functions of the true plant (A, B): for training and evaluation only,
+#: not something the attacker observes (see the environment's docstring, section Info).
+PRIVILEGED_INFO = ("epsilon", "gamma", "gamma_opt")
+
+
+def info_buffers(K: int, gamma_opt: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Empty float and count buffers for the info of ``K`` copies (``gamma_opt`` row only if computed)."""
+    rows = len(INFO_FLOAT_ROWS) if gamma_opt else len(INFO_FLOAT_ROWS) - 1
+    return np.empty((rows, K)), np.empty((len(INFO_COUNT_ROWS), K), dtype=np.int64)
+
+
+def info_from_buffers(f: np.ndarray, counts: np.ndarray, copy: int | None = None) -> dict[str, Any]:
+    """The info dict from filled buffers: arrays of shape (K,) per key, or with ``copy`` the
+    Python scalars of that copy (the single environment's info)."""
+    bufs: dict[str, Any] = {"f": f, "c": counts}
+    if copy is not None:
+        bufs = {"f": f[:, copy].tolist(), "c": counts[:, copy].tolist()}
+    return {name: bufs[kind][row] for name, kind, row in INFO_FIELDS if row < len(bufs[kind])}

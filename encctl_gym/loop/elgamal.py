@@ -1,0 +1,128 @@
+"""The ElGamal backend (``crypto="elgamal"``): real dynamic-key ElGamal ciphertexts through the loop.
+
+Keys are updated every period, with the modified evaluation/decryption of Definition
+def:modification (``scheme="modified"``), the conventional token-based dynamic key
+(``"token"``) or one fixed key pair (``"static"``). One copy.
+
+The parties hold their own randomness and nothing of each other's: the plant (keys, state
+encryptions), the controller server (the token scheme's CtUpd re-randomisation) and the
+adversary (the randomness of its forged ciphertexts). With ``crypto_seed`` the three streams are
+derived from it independently (``numpy.random.SeedSequence`` children), so a run is
+reproducible and still no party can recompute another's draws from its own.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from .backend import lqr_gain
+
+__all__ = ["ElGamalLoop", "party_random_sources"]
+
+#: The parties of the loop that draw randomness, in the order their seeded streams are spawned.
+PARTIES = ("plant", "server", "adversary")
+
+
+def party_random_sources(crypto_seed: int | None) -> dict[str, Any]:
+    """One random source per party of :data:`PARTIES`: secure ones, or independent seeded streams.
+
+    Parameters
+    ----------
+    crypto_seed : int or None
+        ``None``: a cryptographically secure source each. An integer: reproducible, unsafe for
+        deployment; child ``i`` of ``SeedSequence(crypto_seed)`` seeds party ``i``.
+    """
+    from ..crypto.arith import SecureRandom, seeded_random
+
+    if crypto_seed is None:
+        return {name: SecureRandom() for name in PARTIES}
+    children = np.random.SeedSequence(crypto_seed).spawn(len(PARTIES))
+    return {name: seeded_random(int(c.generate_state(1, np.uint64)[0])) for name, c in zip(PARTIES, children)}
+
+
+class ElGamalLoop:
+    """Real dynamic-key ElGamal ciphertexts through the loop (one copy).
+
+    The parties come from the scheme (:data:`encctl_gym.crypto.schemes.SCHEMES`): the plant
+    side (:mod:`encctl_gym.crypto.plant_side`) holds the keys, encrypts the state under
+    ``pk_t``, decrypts (two-key ``Dec_bar(sk_0, sk_t, .)`` in the modified scheme, ``Dec(sk_t,
+    .)`` otherwise), sums and decodes; the controller server (:mod:`encctl_gym.crypto.servers`)
+    holds public keys and ciphertexts only; the forged input comes from
+    :func:`encctl_gym.attacks.forgery.forge`. ``"modified"``: Phi encrypted once under ``pk_0``, keys
+    updated every period, no token leaves the plant. ``"token"``: the server receives every
+    update token and CtUpds Phi's ciphertexts. ``"static"``: one key pair, never updated.
+
+    The adversary's break of a state ciphertext (paid for in time by the environment) is
+    simulated by decrypting with the plant's key of that period.
+    """
+
+    batched = False
+    quantization = None
+
+    def __init__(self, params: Any, group: Any) -> None:
+        from ..crypto.encoding import Encoder
+        from ..crypto.schemes import get_scheme
+
+        self.params = params
+        self.group = group
+        self.n, self.m = params.n, params.m
+        self.scheme = params.scheme
+        self._scheme = get_scheme(params.scheme)
+        self.encoder = Encoder(group, float(params.delta))
+        self.Phi = -lqr_gain(params.A, params.B)
+        #: each party's random source (privileged: who holds which randomness), see :func:`party_random_sources`
+        self.random_sources = party_random_sources(params.crypto_seed)
+        self.plant: Any = None
+        self.server: Any = None
+        self.last_state_ciphertexts: list[Any] | None = None
+        self.last_output_ciphertexts: list[list[Any]] | None = None
+
+    def start_episode(self) -> None:
+        """Fresh keys (KeyGen) and Phi encrypted under ``pk_0``; the server of the scheme is set up."""
+        from ..crypto.quantized import QuantizedLinearController
+
+        quant = QuantizedLinearController(self.Phi, self.encoder, self.params.x_bound)
+        self.plant, self.server = self._scheme.parties(quant, self.random_sources["plant"], self.random_sources["server"])
+
+    @staticmethod
+    def _single(v: np.ndarray) -> np.ndarray:
+        if v.shape[0] != 1:
+            raise ParameterError(f"the elgamal backend runs one copy, got a batch of {v.shape[0]}")
+        return v[0]
+
+    def collect_state(self, x: np.ndarray) -> np.ndarray:
+        """Encrypt ``x_t`` under ``pk_t`` (what the server and an eavesdropper receive) and
+        return what breaking those ciphertexts reveals: ``Dcd(Dec(sk_t, ct))``."""
+        from ..crypto.elgamal import decrypt
+
+        self.last_state_ciphertexts = self.plant.encrypt_state(self._single(x))
+        sk_t = self.plant.secret_key
+        return np.array([[self.encoder.decode(decrypt(sk_t, ct)) for ct in self.last_state_ciphertexts]])
+
+    def control(self, x: np.ndarray) -> np.ndarray:
+        """A full period of normal operation: encrypt, server evaluation (eq:ec), decrypt, Sum,
+        decode, key update."""
+        ct_x = self.plant.encrypt_state(self._single(x))
+        out = self.server.evaluate(ct_x)
+        u = self.plant.decrypt_output(out)
+        self.tick()
+        return u[None]
+
+    def inject(self, a: np.ndarray) -> np.ndarray:
+        """The adversary forges the input ciphertexts from public keys only; the plant decrypts."""
+        from ..attacks.forgery import forge
+
+        a0 = self._single(a)
+        out = forge(self.scheme, self.plant.pk0, self.plant.pk, a0, self.encoder, self.n, self.random_sources["adversary"])
+        self.last_output_ciphertexts = out
+        return self.plant.decrypt_output(out)[None]
+
+    def tick(self) -> None:
+        """KeyUpd at the end of the period (none for static keys); the token scheme sends the
+        token to the server, which CtUpds Phi's ciphertexts."""
+        token = self.plant.update_keys()
+        if self._scheme.token_to_server:
+            self.server.receive_token(token)

@@ -1,0 +1,100 @@
+"""The ideal backend (``crypto="ideal"``): the encrypted loop's exact arithmetic without ciphertexts.
+
+The encode / quantise / multiply / sum / decode arithmetic of the encrypted controller
+(Definition def:ec, eq:ec) without big integers. Quantisation uses the same group and the same
+nearest-member rule as the encoder (through
+:class:`~encctl_gym.crypto.residue_table.ResidueTable`), so it is bit-identical to decrypting
+real ciphertexts (:class:`~encctl_gym.loop.elgamal.ElGamalLoop`). Batched over any number of
+copies; the environment's compiled step runs its per-period arithmetic itself from
+:attr:`IdealLoop.quantization`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import EncodingOverflowError, ResourceLimitError
+from .backend import lqr_gain, table_limit
+from .quantize import OK, Quantization, collect_states, forge_inputs
+
+__all__ = ["IdealLoop"]
+
+
+class IdealLoop:
+    """Exact fixed-point arithmetic of the encrypted loop without ciphertexts (batched).
+
+    Parameters
+    ----------
+    params : AttackParams
+        The environment's resolved parameters (A, B, Delta, x_bound, u_max).
+    group : GroupParams
+        The group whose order-q subgroup the encoder maps to (:func:`~encctl_gym.loop.backend.loop_group`).
+    """
+
+    batched = True
+
+    def __init__(self, params: Any, group: Any) -> None:
+        from ..crypto.residue_table import residue_table
+
+        self.delta = float(params.delta)
+        self.x_bound = float(params.x_bound)
+        self.n, self.m = params.n, params.m
+        self.Phi = -lqr_gain(params.A, params.B)
+        limit = table_limit(params, self.Phi)
+        try:
+            self.table = residue_table(group, limit)
+        except ResourceLimitError as exc:
+            raise ResourceLimitError(
+                f"the quantisation table for x_bound = {params.x_bound}, Delta = {params.delta}, u_max = "
+                f"{params.u_max:.4g} is too large ({exc}); use a smaller x_bound or delta"
+            ) from None
+        self.Phi_int = self.encode_int(self.Phi)
+        self.quantization = Quantization(
+            delta=self.delta,
+            offsets=self.table.offsets,
+            limit=self.table.limit,
+            one=int(self.encode_int(np.array(1.0))),
+            zero2=int(self.encode_int(np.array(0.0))) ** 2,
+            n_cols=self.n,
+            x_bound=self.x_bound,
+        )
+        self._quant = tuple(self.quantization)
+
+    def encode_int(self, v: np.ndarray) -> np.ndarray:
+        """Signed integer of the subgroup element that encodes ``v`` (Definition def:ec).
+
+        Raises EncodingOverflowError for a value outside the declared range."""
+        return self.table.nearest(np.rint(np.asarray(v, dtype=np.float64) * self.delta).astype(np.int64))
+
+    def start_episode(self) -> None:
+        pass
+
+    def _overflow(self, x: np.ndarray) -> EncodingOverflowError:
+        return EncodingOverflowError(f"state {np.asarray(x).tolist()} leaves the declared range |x| <= {self.x_bound} (x_bound)")
+
+    def collect_state(self, x: np.ndarray) -> np.ndarray:
+        """``Dcd(Ecd(x))``; raises EncodingOverflowError outside ``|x| <= x_bound`` (as the encoder does)."""
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        out = np.empty_like(x)
+        if collect_states(self._quant, x, np.empty(x.shape, dtype=np.int64), out) != OK:
+            raise self._overflow(x)
+        return out
+
+    def control(self, x: np.ndarray) -> np.ndarray:
+        """The quantised controller ``Dcd(Sum(Ecd(Phi) Ecd(x)); Delta^2)`` (eq:ec), products and sums in Z."""
+        if not (np.abs(x) <= self.x_bound).all():  # the encoder's declared range (crypto raises alike)
+            raise self._overflow(x)
+        xi = self.encode_int(x)  # (K, n)
+        return (self.Phi_int[None] * xi[:, None, :]).sum(-1) / (self.delta * self.delta)
+
+    def inject(self, a: np.ndarray) -> np.ndarray:
+        """The forged input as the plant decodes it (``|a| <= u_max``: inside the table)."""
+        a = np.array(a, dtype=np.float64, order="C")
+        out = np.empty_like(a)
+        forge_inputs(self._quant, a, np.empty(a.shape, dtype=np.int64), out)
+        return out
+
+    def tick(self) -> None:
+        pass

@@ -1,0 +1,362 @@
+"""Plant files: the one schema and the one bounded reader for a plant of eq:system and its design values.
+
+A plant file is JSON, YAML or NPZ with these fields (nothing else):
+
+===========  ========  ============================================================
+field        required  meaning
+===========  ========  ============================================================
+``A``        yes       n x n system matrix (Schur stable for a design)
+``B``        yes       n x m input matrix (a flat list of n numbers is one column)
+``sigma_u2`` no        attack input power per channel (variance, > 0)
+``sigma_w2`` no        process noise variance (> 0)
+``sigma_x2`` no        variance of x_0 (>= 0)
+``gamma_c``  no        acceptable estimation error (> 0)
+``tau_c``    no        defense period: seconds or a duration such as ``"10y"``
+                       (:func:`encctl_gym.units.parse_duration`)
+``upsilon``  no        adversary computing speed in FLOPS (> 0)
+===========  ========  ============================================================
+
+A missing optional field takes its default (the paper's design example unless the caller passes
+others), and :class:`PlantSpec` records which values came from the file and which from the
+defaults. Unknown fields are an error naming them.
+
+Reading is bounded: files over :data:`MAX_FILE_BYTES` are refused before they are read; YAML
+aliases are expanded in a node count (:data:`MAX_YAML_NODES`) before any Python object is built
+(a few hundred bytes of nested aliases would otherwise take gigabytes); NPZ members are checked
+for their uncompressed size and loaded without pickles. Numbers must be real and finite in
+float64: booleans, strings, complex data and integers beyond the float range (``10**400``) are
+refused, naming the field.
+"""
+
+from __future__ import annotations
+
+import json
+import numbers
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from ._validation import as_finite_array, check_nonnegative, check_positive, check_system, format_value
+from .errors import ConfigError, ParameterError, ResourceLimitError
+from .presets import DESIGN_FIELDS, SystemPreset, design_defaults
+from .units import parse_duration
+
+__all__ = [
+    "PlantSpec",
+    "load_plant_file",
+    "load_system",
+    "PLANT_FIELDS",
+    "MAX_FILE_BYTES",
+    "MAX_YAML_NODES",
+    "SUFFIXES",
+]
+
+#: Every field a plant file may hold.
+PLANT_FIELDS: tuple[str, ...] = ("A", "B", *DESIGN_FIELDS)
+#: Largest plant file read (bytes): room for matrices of about 1000 x 1000 in text.
+MAX_FILE_BYTES: int = 64 * 2**20
+#: Largest number of YAML nodes after alias expansion.
+MAX_YAML_NODES: int = 4_000_000
+#: Accepted file name endings.
+SUFFIXES: tuple[str, ...] = (".json", ".yaml", ".yml", ".npz")
+_MAX_NPZ_MEMBERS = len(PLANT_FIELDS)
+
+
+@dataclass(frozen=True)
+class PlantSpec:
+    """A plant read from a file, with its design values and where each came from.
+
+    Attributes
+    ----------
+    path : str
+        The file.
+    preset : SystemPreset
+        ``A``, ``B`` and the design values (file values, else defaults), named ``file:<path>``.
+    from_file : tuple of str
+        Fields given in the file.
+    from_defaults : tuple of str
+        Fields taken from the defaults.
+    """
+
+    path: str
+    preset: SystemPreset
+    from_file: tuple[str, ...]
+    from_defaults: tuple[str, ...]
+
+    @property
+    def A(self) -> np.ndarray:
+        """System matrix."""
+        return self.preset.A
+
+    @property
+    def B(self) -> np.ndarray:
+        """Input matrix."""
+        return self.preset.B
+
+    def values(self) -> dict[str, float]:
+        """The design values by :data:`~encctl_gym.presets.DESIGN_FIELDS`."""
+        return {key: getattr(self.preset, key) for key in DESIGN_FIELDS}
+
+    def describe_sources(self) -> str:
+        """One line: which values came from the file and which from the defaults."""
+        text = f"from {self.path}: {', '.join(self.from_file)}"
+        if self.from_defaults:
+            text += f"; defaults: {', '.join(self.from_defaults)}"
+        return text
+
+
+def _fail(path: Path, msg: str) -> ConfigError:
+    return ConfigError(f"system file {str(path)!r}: {msg}")
+
+
+# --------------------------------------------------------------------------- bounded decoding
+def _yaml_loader_class() -> Any:
+    import yaml
+
+    return getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+def _expanded_yaml_nodes(root: Any, limit: int) -> int:
+    """Number of nodes of ``root`` with every alias expanded, counted without expanding (memoised
+    on node identity; a recursive alias, which would expand forever, raises ValueError)."""
+    import yaml
+
+    sizes: dict[int, int] = {}
+    on_path: set[int] = set()
+    stack: list[tuple[Any, bool]] = [(root, False)]
+    while stack:
+        node, done = stack.pop()
+        key = id(node)
+        if done:
+            on_path.discard(key)
+            if isinstance(node, yaml.SequenceNode):
+                children = node.value
+            elif isinstance(node, yaml.MappingNode):
+                children = [c for pair in node.value for c in pair]
+            else:
+                children = []
+            total = 1 + sum(sizes[id(c)] for c in children)
+            sizes[key] = min(total, limit + 1)
+            continue
+        if key in sizes:
+            continue
+        if key in on_path:
+            raise ValueError("a YAML alias refers to a node that contains it (recursive alias)")
+        on_path.add(key)
+        stack.append((node, True))
+        if isinstance(node, yaml.SequenceNode):
+            stack.extend((c, False) for c in node.value)
+        elif isinstance(node, yaml.MappingNode):
+            stack.extend((c, False) for pair in node.value for c in pair)
+    return sizes[id(root)]
+
+
+def _load_yaml(path: Path, text: str) -> Any:
+    loader = _yaml_loader_class()(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        try:
+            count = _expanded_yaml_nodes(node, MAX_YAML_NODES)
+        except ValueError as exc:
+            raise _fail(path, str(exc)) from None
+        if count > MAX_YAML_NODES:
+            raise ResourceLimitError(
+                f"system file {str(path)!r}: its YAML aliases expand to more than {MAX_YAML_NODES} nodes; "
+                "write the matrices out instead of nesting aliases"
+            )
+        return loader.construct_document(node)
+    finally:
+        loader.dispose()
+
+
+def _load_npz(path: Path) -> dict[str, Any]:
+    try:
+        with zipfile.ZipFile(path) as zf:
+            infos = zf.infolist()
+    except (zipfile.BadZipFile, OSError) as exc:
+        raise _fail(path, f"not a readable NPZ archive ({format_value(str(exc))})") from None
+    if len(infos) > _MAX_NPZ_MEMBERS:
+        raise _fail(path, f"holds {len(infos)} arrays; a plant file has at most {_MAX_NPZ_MEMBERS}")
+    total = sum(i.file_size for i in infos)
+    if total > MAX_FILE_BYTES:
+        raise ResourceLimitError(
+            f"system file {str(path)!r}: its arrays take {total} bytes uncompressed; the limit is {MAX_FILE_BYTES}"
+        )
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return {k: z[k] for k in z.files}
+    except ValueError as exc:
+        raise _fail(path, f"cannot load its arrays without pickles ({format_value(str(exc))})") from None
+
+
+def _decode(path: Path) -> Any:
+    suffix = path.suffix.lower()
+    if suffix not in SUFFIXES:
+        raise ConfigError(f"system file {str(path)!r} must end in .json, .yaml, .yml or .npz")
+    size = path.stat().st_size
+    if size > MAX_FILE_BYTES:
+        raise ResourceLimitError(f"system file {str(path)!r} has {size} bytes; the limit is {MAX_FILE_BYTES}")
+    if suffix == ".npz":
+        return _load_npz(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+        if suffix == ".json":
+            return json.loads(text)
+        return _load_yaml(path, text)
+    except (ConfigError, ResourceLimitError):
+        raise
+    except Exception as exc:  # noqa: BLE001 - any parse failure (syntax, tags, depth, digits) is one ConfigError
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ConfigError(f"cannot read system file {str(path)!r}: {format_value(first)}") from None
+
+
+# --------------------------------------------------------------------------- field checks
+def _check_leaves(path: Path, key: str, value: Any) -> None:
+    """Walk nested lists (iteratively) and refuse anything but real numbers within float64."""
+    stack = [value]
+    while stack:
+        v = stack.pop()
+        if isinstance(v, (list, tuple)):
+            stack.extend(v)
+        elif isinstance(v, bool) or v is None or isinstance(v, (str, bytes, dict, complex)):
+            raise _fail(path, f"{key} must hold real numbers, got {format_value(v)}")
+        elif isinstance(v, numbers.Integral):
+            try:
+                float(v)
+            except OverflowError:
+                raise _fail(path, f"{key} holds a number beyond the float64 range: {format_value(v)}") from None
+        elif not isinstance(v, numbers.Real):
+            raise _fail(path, f"{key} must hold real numbers, got {format_value(v)}")
+
+
+def _matrix(path: Path, key: str, value: Any) -> np.ndarray:
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind == "c":
+            raise _fail(path, f"{key} must be real, got a complex array {format_value(value)}")
+        if value.dtype.kind not in "iuf":
+            raise _fail(path, f"{key} must be a numeric matrix, got an array of dtype {value.dtype}")
+    else:
+        if not isinstance(value, (list, tuple)):
+            raise _fail(path, f"{key} must be a matrix (a list of rows), got {format_value(value)}")
+        _check_leaves(path, key, value)
+    try:
+        return as_finite_array(key, value)
+    except ParameterError as exc:
+        raise _fail(path, f"{key} is not a numeric matrix ({exc})") from None
+
+
+def _scalar(path: Path, key: str, value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        if value.ndim != 0 and value.size != 1:
+            raise _fail(path, f"{key} must be a single value, got an array of shape {value.shape}")
+        if value.dtype.kind == "c":
+            raise _fail(path, f"{key} must be real, got {format_value(value)}")
+        if value.dtype.kind == "U" and key == "tau_c":
+            return str(value.reshape(()))
+        if value.dtype.kind not in "iuf":
+            raise _fail(path, f"{key} must be a number, got an array of dtype {value.dtype}")
+        value = value.reshape(()).item()
+    if key == "tau_c" and isinstance(value, str):
+        return value
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise _fail(path, f"{key} must be a number, got {format_value(value)}")
+    return value
+
+
+def _design_value(key: str, value: Any) -> float:
+    if key == "tau_c":
+        return parse_duration(value, "tau_c")
+    if key == "sigma_x2":
+        return check_nonnegative(key, value)
+    return check_positive(key, value)
+
+
+def load_plant_file(path: str | Path, *, defaults: Mapping[str, Any] | SystemPreset | None = None) -> PlantSpec:
+    """Read a plant file (see the module table) into a :class:`PlantSpec`.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.json``, ``.yaml``/``.yml`` or ``.npz``.
+    defaults : mapping or SystemPreset, optional
+        Values of the optional fields the file does not give; default: the paper's design
+        example (:func:`~encctl_gym.presets.design_defaults`).
+
+    Returns
+    -------
+    PlantSpec
+
+    Raises
+    ------
+    ConfigError
+        If the file is missing, unreadable, of unknown type, lacks ``A`` or ``B``, has unknown
+        fields, or holds values that are not real numbers.
+    ResourceLimitError
+        If the file, its uncompressed arrays or its expanded YAML aliases exceed the bounds.
+    ParameterError, ShapeError
+        For values out of their domain (a negative variance) or shapes that do not fit.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError(f"system file {str(p)!r} does not exist")
+    data = _decode(p)
+    if not isinstance(data, Mapping):
+        raise _fail(p, f"must hold a mapping with 'A' and 'B', got {format_value(data)}")
+    keys = [str(k) for k in data]
+    unknown = sorted(set(keys) - set(PLANT_FIELDS))
+    if unknown:
+        raise _fail(p, f"unknown field(s) {unknown}; a plant file may hold {', '.join(PLANT_FIELDS)}")
+    if "A" not in data or "B" not in data:
+        raise ConfigError(f"system file {str(p)!r} must define 'A' and 'B'")
+    A = _matrix(p, "A", data["A"])
+    B = _matrix(p, "B", data["B"])
+    try:
+        A, B = check_system(A, B)
+    except ParameterError as exc:
+        raise type(exc)(f"system file {str(p)!r}: {exc}") from None
+    if defaults is None:
+        base: dict[str, Any] = design_defaults()
+    elif isinstance(defaults, SystemPreset):
+        base = {key: getattr(defaults, key) for key in DESIGN_FIELDS}
+    else:
+        base = dict(defaults)
+    values: dict[str, float] = {}
+    from_file: list[str] = ["A", "B"]
+    from_defaults: list[str] = []
+    for key in DESIGN_FIELDS:
+        if key in data:
+            raw, from_file_ = _scalar(p, key, data[key]), True
+        elif key in base:
+            raw, from_file_ = base[key], False
+        else:
+            raise _fail(p, f"{key} is neither in the file nor in the defaults")
+        try:
+            values[key] = _design_value(key, raw)
+        except ParameterError as exc:
+            where = f"system file {str(p)!r}" if from_file_ else "default"
+            raise type(exc)(f"{where}: {exc}") from None
+        (from_file if from_file_ else from_defaults).append(key)
+    preset = SystemPreset(
+        name=f"file:{p}", description=f"plant from {p}", A=A, B=B,
+        sigma_w2=values["sigma_w2"], sigma_u2=values["sigma_u2"], sigma_x2=values["sigma_x2"],
+        gamma_c=values["gamma_c"], tau_c=values["tau_c"], upsilon=values["upsilon"],
+    )
+    return PlantSpec(str(p), preset, tuple(from_file), tuple(from_defaults))
+
+
+def load_system(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
+    """``A`` and ``B`` of a plant file (:func:`load_plant_file` without the design values).
+
+    Returns
+    -------
+    (ndarray, ndarray)
+        ``A`` (n x n) and ``B`` (n x m), validated by ``check_system``.
+    """
+    spec = load_plant_file(path)
+    return spec.A, spec.B
+

@@ -1,0 +1,135 @@
+"""``encctl-gym evaluate RUN_DIR``: one training run against the baselines, on paired seeds.
+
+The run's learned attacker plays with the Gaussian (the paper's), AR(1) and optimal-design
+(oracle) attackers of the registry, under the protocol of ``compare``
+(:mod:`~experiments.compare.protocol`: the same environment seeds for every attacker, the same
+energy budget at every attack length), and the same table is printed: the error at the horizon
+with its 95 % interval, the error over gamma_opt(N), the paired ratios to the Gaussian attacker
+and to the oracle with 95 % intervals, and the security consequence.
+
+Defaults: the run's own system and decipher delay (a blind policy also with ``"end"``), the
+training attack length (``--samples N``: another; ``--full-budget``: the tau_c budget at the
+system's lambda), 100
+episodes per attack length, the best model, and the *stochastic* policy: its noise is its
+excitation, and the mean action of a state-feedback policy leaves the regressor ``[x; u]``
+nearly rank deficient, so ``--deterministic`` is allowed but warned about. ``--systems`` plays
+the run on other presets too (same observation layout needed). Outputs (CSV, PNG,
+``summary.md``) go to ``RUN_DIR/evaluation`` unless ``--out`` is given; a new evaluation
+replaces the files of the previous one there.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from agents import Attacker
+from agents.runs import RunInfo, read_run
+from agents.sb3 import load_attacker  # the [rl] extra: without it the CLI says which extra to install
+from encctl_gym.envs.config import resolve_params
+from encctl_gym.errors import ConfigError
+
+from .cli import names, positive, write_outputs
+from .protocol import compute
+from .report import comparison_table
+from .settings import Setting, make_setting, parse_delays
+
+__all__ = ["BASELINES", "EPISODES", "run_settings", "system_config", "add_arguments", "run"]
+
+#: The registered attackers a run is evaluated against.
+BASELINES = ("gaussian", "colored", "optimal")
+#: Default episodes per attacker and attack length.
+EPISODES = 100
+#: Environment keys that define the system and its budget (not carried to another system).
+_SYSTEM_KEYS = frozenset({"preset", "A", "B", "sigma_w2", "sigma_x2", "sigma_u2", "upsilon", "gamma_c"})
+#: Keys that set the attack length or the backend of the training episodes (dropped: the
+#: evaluation sets its own length).
+_LENGTH_KEYS = frozenset({"tau_c", "max_samples", "security_parameter", "key_length", "crypto", "crypto_seed", "gamma_opt"})
+
+
+def system_config(run: RunInfo, system: str | None = None) -> dict[str, Any]:
+    """The environment configuration the run is evaluated in: its own system (``system`` None or
+    the run's label), or the preset ``system`` with the run's other settings (observation
+    layout, reward, encoder) carried over."""
+    rest = {k: v for k, v in run.env.items() if k not in _LENGTH_KEYS}
+    if system is None or system == run.system:
+        return rest
+    return {**{k: v for k, v in rest.items() if k not in _SYSTEM_KEYS}, "preset": system}
+
+
+def run_settings(run: RunInfo, systems: tuple[str, ...] | None, delays: tuple[Any, ...] | None, length: int | None) -> list[Setting]:
+    """The settings of an evaluation (module docstring); ``length`` None: each system's full budget."""
+    if delays is None:
+        own = run.env.get("decipher_delay", 0)
+        delays = (own,) + (("end",) if run.observation == "blind" and own != "end" else ())
+    out = []
+    for system in systems or (run.system,):
+        for d in delays:
+            if d == "end" and run.observation != "blind":
+                raise ConfigError(f"the {run.observation!r} policy of {run.path} reads delivered states; it cannot play with "
+                                  "decipher_delay 'end' (only a blind policy can)")
+            out.append(make_setting(system, d, None, config=system_config(run, system), length=length))
+    return out
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of ``encctl-gym evaluate``."""
+    parser.add_argument("run_dir", metavar="RUN_DIR", help="a training run directory (written by encctl-gym train)")
+    parser.add_argument("--episodes", type=int, default=None, help=f"episodes per attacker and attack length (default {EPISODES})")
+    parser.add_argument("--systems", default=None, help="comma-separated presets to play on (default: the run's own system)")
+    parser.add_argument("--delays", default=None,
+                        help="comma-separated decipher delays: integers >= 0 or end (default: the run's; a blind policy also end)")
+    parser.add_argument("--deterministic", action="store_true",
+                        help="play the policy's mean action (not recommended: the policy's noise is its excitation)")
+    parser.add_argument("--which", choices=("best", "final"), default="best", help="the best model of the training's evaluations (default) or the final one")
+    parser.add_argument("--samples", type=int, default=None,
+                        help="attack length N to evaluate at, set through the deciphering budget (default: the training attack length)")
+    parser.add_argument("--full-budget", action="store_true", help="evaluate at the full tau_c budget of each system at its lambda")
+    parser.add_argument("--points", type=int, default=6, help="attack lengths N on the log grid of every curve (default 6)")
+    parser.add_argument("--seed", type=int, default=20_000, help="environment seeds seed, seed + 1, ... (default 20000)")
+    parser.add_argument("--elgamal-episodes", type=int, default=0, help="episodes of each attacker through real ElGamal ciphertexts (default 0)")
+    parser.add_argument("--out", default=None, help="output directory (default RUN_DIR/evaluation)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Evaluate, write CSV, PNG and summary.md; print the table."""
+    info = read_run(args.run_dir)
+    episodes = positive("episodes", args.episodes) or EPISODES
+    positive("points", args.points)
+    positive("elgamal-episodes", args.elgamal_episodes, 0)
+    if args.full_budget and args.samples is not None:
+        raise ConfigError("give --samples or --full-budget, not both")
+    length = None if args.full_budget else (positive("samples", args.samples, 2) or resolve_params(info.env).horizon)
+    if args.deterministic:
+        print("encctl-gym evaluate: warning: --deterministic plays the policy's mean action; its noise is its excitation, "
+              "and without it a state-feedback policy leaves [x; u] nearly rank deficient (expect a larger error)", file=sys.stderr)
+    systems = names(args.systems, "systems") if args.systems else None
+    delays = parse_delays(args.delays) if args.delays else None
+    settings = run_settings(info, systems, delays, length)
+
+    def learned(setting: Setting) -> list[Attacker]:
+        w = args.which if args.which == "final" or (info.path / "best_model.zip").exists() else "final"
+        label = info.algo + ("-blind" if info.observation == "blind" else "")
+        return [load_attacker(info.path, which=w, params=setting.params, name=label, deterministic=args.deterministic)]
+
+    result = compute(settings=settings, episodes=episodes, seed=args.seed, points=args.points, attackers=BASELINES,
+                     elgamal_episodes=args.elgamal_episodes, elgamal_N=min(40, min(s.params.horizon for s in settings)),
+                     progress=not args.no_progress, players=learned)
+    out = Path(args.out) if args.out else info.path / "evaluation"
+    cmd = [f"encctl-gym evaluate {info.path}", f"--episodes {episodes}", f"--seed {args.seed}", f"--points {args.points}",
+           f"--which {args.which}", "--full-budget" if length is None else f"--samples {length}"]
+    if systems:
+        cmd.append(f"--systems {','.join(systems)}")
+    if delays:
+        cmd.append(f"--delays {','.join(str(d) for d in delays)}")
+    if args.deterministic:
+        cmd.append("--deterministic")
+    _, paths = write_outputs(result, out, command=" ".join(cmd), title=f"{info.path.name} against the baselines (`encctl-gym evaluate`)")
+    print(comparison_table(result))
+    print(f"\n{episodes} episodes per attacker and attack length on environment seeds {args.seed}, {args.seed + 1}, ...; "
+          f"{'deterministic' if args.deterministic else 'stochastic'} policy ({args.which} model).")
+    print("wrote " + ", ".join(str(p) for p in paths))
+    return 0

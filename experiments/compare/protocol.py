@@ -1,0 +1,266 @@
+"""The protocol of the comparison: every attacker, the same seeds, the same energy, error against N.
+
+Error against N, at equal energy. The environment's energy budget ``m sigma_u2 N`` holds for
+the whole attack, not per step, so the error of the running estimate within one long attack
+(``info["epsilon"]`` along the way) compares attackers at *unequal* energy whenever one of them
+paces its energy unevenly (a learned policy may spend it early and beat gamma(N) at small N for
+that reason alone). The curves are therefore measured on a log grid of attack lengths
+(:func:`~experiments.compare.settings.length_grid`), one set of episodes of exactly N samples
+(budget ``m sigma_u2 N``) per grid point, every attacker on the same environment seeds. With
+delivered states (an integer delay) the running error and the energy spent along one
+full-length attack are also recorded (the ``along`` protocol), which shows how an attacker
+paces its energy.
+
+ElGamal. Every attacker also plays a few short episodes through real ciphertexts with a small
+key, each next to the same episode on the ideal backend (:func:`elgamal_check`).
+
+:func:`compute` runs it all and returns a :class:`Result`; every number of the tables, plots and
+reports comes from there.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Mapping, Sequence
+
+import numpy as np
+
+from agents import Attacker, GaussianAttacker, rollout
+from agents.evaluate import budget_config, elgamal_config
+from agents.runs import RunInfo, read_run
+from encctl_gym.envs.config import resolve_params
+from encctl_gym.sim.montecarlo import log_grid
+
+from .attackers import ATTACKERS, learned_attackers, make_attackers
+from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, Setting, length_grid, make_setting
+from .statistics import mean_se
+
+__all__ = ["Curve", "evaluate", "planned_steps", "elgamal_check", "Result", "compute"]
+
+#: The name the Gaussian baseline plays under (the reference of the paired ratios).
+GAUSSIAN_NAME = GaussianAttacker.name
+
+
+@dataclass
+class Curve:
+    """Mean error of one attacker against N, with the per-episode finals.
+
+    Attributes
+    ----------
+    attacker : str
+    oracle : bool
+        The attacker knows (A, B).
+    N, mean, se : ndarray (P,)
+        Grid of attack lengths, mean final error of the attacks of that length and its standard error.
+    episodes : int
+    final, power : ndarray (E,)
+        Final error and average power of each episode at the horizon (the last grid point).
+    seconds : float
+    along_N, along_mean, along_se, along_energy : ndarray, optional
+        With delivered states: the running estimate within one full-length attack and the mean
+        fraction of the episode's energy budget spent so far.
+    """
+
+    attacker: str
+    oracle: bool
+    N: np.ndarray
+    mean: np.ndarray
+    se: np.ndarray
+    episodes: int
+    final: np.ndarray
+    power: np.ndarray
+    seconds: float
+    along_N: np.ndarray | None = None
+    along_mean: np.ndarray | None = None
+    along_se: np.ndarray | None = None
+    along_energy: np.ndarray | None = None
+
+
+def evaluate(setting: Setting, attacker: Attacker, *, episodes: int, seed: int, points: int, progress: Any = None) -> Curve:
+    """The mean error curve of one attacker in one setting (see the module docstring).
+
+    Main curve ("fresh"): for every N of :func:`length_grid`, ``episodes`` attacks of exactly
+    N samples with the energy budget ``m sigma_u2 N``, so every point compares attackers at
+    equal energy. With delivered states also the error of the running estimate within one
+    full-length attack ("along", with the energy spent so far).
+    """
+    grid = length_grid(setting.params, points)
+    cols, t = [], 0.0
+    along = None
+    if setting.params.decipher_delay is not None:
+        along = rollout(attacker, setting.config, episodes=episodes, seed=seed, record=True, progress=progress)
+    final = power = None
+    for N in grid:
+        if along is not None and N == setting.params.horizon:
+            r = along  # the same attack, same seeds
+        else:
+            r = rollout(attacker, budget_config(setting.config, int(N)), episodes=episodes, seed=seed, record=False, progress=progress)
+            t += r.seconds
+        cols.append(r.final_epsilon)
+        final, power = r.final_epsilon, r.average_power
+    mean, se = mean_se(np.stack(cols, axis=1))
+    assert final is not None and power is not None
+    c = Curve(attacker.name, attacker.oracle, grid, mean, se, episodes, final, power, t)
+    if along is not None:
+        d = setting.params.n + setting.params.m
+        first = int(np.argmax(along.N >= min(2 * d + 1, int(along.N[-1]))))
+        g = log_grid(int(along.N[first]), int(along.N[-1]), 60)
+        idx = np.searchsorted(along.N, g)
+        c.along_N = along.N[idx]
+        c.along_mean, c.along_se = mean_se(along.epsilon[:, idx])
+        c.along_energy = along.energy[:, idx].mean(axis=0) / setting.params.energy_budget
+        c.seconds += along.seconds
+    return c
+
+
+def planned_steps(setting: Setting, n_attackers: int, episodes: int, points: int) -> int:
+    """Environment steps of one setting (the progress bar's total)."""
+    batch = min(episodes, 64)
+    padded = batch * math.ceil(episodes / batch)  # rollout plays whole batches
+    per = int(length_grid(setting.params, points).sum())
+    return n_attackers * per * padded
+
+
+def elgamal_check(setting: Setting, attacker: Attacker, *, episodes: int, N: int, seed: int, key_length: int = 64) -> list[dict[str, Any]]:
+    """A few short episodes through real ElGamal ciphertexts (small key), each next to the same
+    episode on the ideal backend (same environment and attacker seeds): the attacker works
+    through real ciphertexts and the ideal backend computes the same arithmetic."""
+    rows = []
+    el_cfg = elgamal_config(setting.config, N, key_length=key_length, crypto_seed=seed)
+    ideal_cfg = {k: v for k, v in el_cfg.items() if k not in ("crypto", "crypto_seed")}
+    for e in range(episodes):
+        r_el = rollout(attacker, el_cfg, episodes=1, seed=seed + e, record=False)
+        r_id = rollout(attacker, ideal_cfg, episodes=1, seed=seed + e, record=False, batch=1)
+        rows.append({
+            "system": setting.system, "delay": setting.delay, "attacker": attacker.name, "episode": e, "N": N,
+            "key_length": resolve_params(el_cfg).key_length, "error_elgamal": float(r_el.final_epsilon[0]),
+            "error_ideal_same_seed": float(r_id.final_epsilon[0]), "seconds_elgamal": round(r_el.seconds, 3),
+        })
+    return rows
+
+
+@dataclass
+class Result:
+    """Everything one comparison measured.
+
+    Attributes
+    ----------
+    settings : list of Setting
+    curves : dict
+        ``(system, delay)`` -> the curves of that setting's attackers, in play order.
+    security, bounds : list of dict
+        Rows of :func:`~experiments.compare.tables.security_row` (one per attacker and
+        setting) and :func:`~experiments.compare.tables.bound_rows` (the references).
+    seconds : float
+    elgamal : list of dict
+        Rows of :func:`elgamal_check`.
+    seed : int
+        Environment seeds ``seed, seed + 1, ...`` of every attacker.
+    """
+
+    settings: list[Setting]
+    curves: dict[tuple[str, Any], list[Curve]]
+    security: list[dict[str, Any]]
+    bounds: list[dict[str, Any]]
+    seconds: float
+    elgamal: list[dict[str, Any]] = field(default_factory=list)
+    seed: int = 0
+
+
+def compute(
+    systems: Sequence[str] = DEFAULT_SYSTEMS,
+    *,
+    delays: Sequence[Any] = DELAYS,
+    episodes: int = 50,
+    seed: int = 0,
+    cap: int | None = DEFAULT_CAP,
+    points: int = 10,
+    runs: Sequence[RunInfo | str | Path] = (),
+    which: str = "best",
+    elgamal_episodes: int = 1,
+    elgamal_N: int = 40,
+    progress: bool = False,
+    attackers: Sequence[str] = tuple(ATTACKERS),
+    configs: Mapping[str, dict[str, Any]] | None = None,
+    deterministic: bool = False,
+    settings: Sequence[Setting] | None = None,
+    players: Callable[[Setting], Sequence[Attacker]] | None = None,
+) -> Result:
+    """Run the comparison; every number of the tables and plots comes from here.
+
+    Parameters
+    ----------
+    systems : sequence of str
+        Preset names, or labels of ``configs``.
+    delays : sequence
+        Decipher delays (``0``, integers, ``"end"``); one setting per system and delay.
+    episodes, seed : int
+        Episodes per attacker, attack length and setting; environment seeds ``seed + e``.
+    cap : int, optional
+        Evaluation cap on the attack length.
+    points : int
+        Attack lengths per curve (:func:`length_grid`).
+    runs : sequence
+        Training runs (directories or :class:`agents.runs.RunInfo`) whose learned attackers play
+        where they apply.
+    which : {"best", "final"}
+        Which model of a run.
+    elgamal_episodes, elgamal_N : int
+        Short episodes of each attacker through real ElGamal ciphertexts (0: none).
+    progress : bool
+        A progress bar on stderr.
+    attackers : sequence of str
+        Names of :data:`~experiments.compare.attackers.ATTACKERS` (default all), played in this
+        order before the learned ones.
+    configs : mapping, optional
+        System label -> environment configuration, for systems that are not presets.
+    deterministic : bool
+        Learned policies play their mean action (off by default: their noise is their excitation).
+    settings : sequence of Setting, optional
+        Ready settings (then ``systems``, ``delays``, ``cap`` and ``configs`` are not used).
+    players : callable, optional
+        Further attackers for a setting (played after the learned ones of ``runs``).
+    """
+    from .tables import bound_rows, security_row
+
+    t0 = time.perf_counter()
+    infos = [r if isinstance(r, RunInfo) else read_run(r) for r in runs]
+    if settings is None:
+        cfgs = dict(configs or {})
+        settings = [make_setting(s, d, cap, config=cfgs.get(s)) for s in systems for d in delays]
+    settings = list(settings)
+    plan = [(s, [*make_attackers(s, attackers), *learned_attackers(s, infos, which, deterministic=deterministic),
+                 *(players(s) if players is not None else ())]) for s in settings]
+    total = sum(planned_steps(s, len(a), episodes, points) for s, a in plan)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        tty = sys.stderr.isatty()
+        bar = tqdm(total=total, desc="compare", unit="step", unit_scale=True, mininterval=0.5 if tty else 30.0, ascii=not tty)
+    curves: dict[tuple[str, Any], list[Curve]] = {}
+    security: list[dict[str, Any]] = []
+    bounds: list[dict[str, Any]] = []
+    elgamal: list[dict[str, Any]] = []
+    try:
+        for setting, atts in plan:
+            curves[setting.key] = []
+            for att in atts:
+                if bar is not None:
+                    bar.set_postfix_str(f"{setting.system} d={setting.delay} {att.name}")
+                curves[setting.key].append(evaluate(setting, att, episodes=episodes, seed=seed, points=points, progress=bar))
+                if elgamal_episodes > 0:
+                    elgamal.extend(elgamal_check(setting, att, episodes=elgamal_episodes, N=elgamal_N, seed=seed))
+            cs = curves[setting.key]
+            gauss = next((c for c in cs if c.attacker == GAUSSIAN_NAME), None)
+            oracle = next((c for c in cs if c.oracle), None)
+            security.extend(security_row(setting, c, gaussian=gauss, oracle=oracle) for c in cs)
+            bounds.extend(bound_rows(setting))
+    finally:
+        if bar is not None:
+            bar.close()
+    return Result(settings, curves, security, bounds, time.perf_counter() - t0, elgamal, seed)
