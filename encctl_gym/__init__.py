@@ -9,6 +9,9 @@ Systems Against Eavesdropper and Malicious Server" (arXiv 2303.13059).
 from __future__ import annotations
 
 from .errors import (
+    BreakerError,
+    BreakerLimitError,
+    BreakerTimeoutError,
     BudgetError,
     CiphertextError,
     ConfigError,
@@ -17,6 +20,7 @@ from .errors import (
     GroupError,
     KeyMismatchError,
     ModelRangeError,
+    OptionalDependencyError,
     ParameterError,
     PlaintextError,
     ResourceLimitError,
@@ -43,6 +47,10 @@ __all__ = [
     "ConfigError",
     "ModelRangeError",
     "ResourceLimitError",
+    "BreakerError",
+    "BreakerLimitError",
+    "BreakerTimeoutError",
+    "OptionalDependencyError",
 ]
 
 

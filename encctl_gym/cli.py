@@ -37,6 +37,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "experiments.compare.evaluate_run",
         "a training run against the Gaussian, AR(1) and oracle attackers on paired seeds (needs the [rl] extra)",
     ),
+    "crack": (
+        "encctl_gym.cryptanalysis.cli",
+        "break N keys of one dynamic-key sequence with a real discrete-logarithm attack and time each key",
+    ),
 }
 
 

@@ -23,6 +23,10 @@ __all__ = [
     "ConfigError",
     "ModelRangeError",
     "ResourceLimitError",
+    "BreakerError",
+    "BreakerLimitError",
+    "BreakerTimeoutError",
+    "OptionalDependencyError",
 ]
 
 
@@ -85,3 +89,19 @@ class ResourceLimitError(ParameterError):
     bound, YAML aliases expanding past the node bound, an SDP too large to solve, a safe prime
     too slow to generate, an episode or table too large to allocate); the message names the
     estimate and the bound."""
+class BreakerError(SolverError):
+    """A key breaker (:mod:`encctl_gym.cryptanalysis`) failed: no logarithm found, or a recovered
+    exponent failed the check g^s = h (a breaker never returns an unchecked key)."""
+
+
+class BreakerLimitError(ResourceLimitError):
+    """A group is too large for a breaker; refused before any work, naming the limit and the
+    expected time."""
+
+
+class BreakerTimeoutError(BreakerError, TimeoutError):
+    """A breaker call ran past its time limit and was stopped."""
+
+
+class OptionalDependencyError(ConfigError, ImportError):
+    """An optional dependency is not installed; the message names the extra that provides it."""

@@ -1,11 +1,12 @@
-"""Reproduce the paper's Figures 1 and 2 and its design example (PNG, CSV and a table).
+"""Reproduce the paper's Figures 1 and 2, its design example and the measurements beyond it (PNG, CSV, tables).
 
 The ``reproduce`` subcommand of ``encctl-gym`` (``add_arguments`` / ``run``); also
 ``python -m experiments.reproduce``. Runs :mod:`experiments.fig1_variance_ratio`
 (fig:variance_ratio), :mod:`experiments.fig2_gramian` (fig:gramian),
 :mod:`experiments.design_example` (Theorem thm:opt_sec, eq:opt_key) and
-:mod:`experiments.identification_strategies` (attackers times estimators against gamma(N)) with
-the same options.
+:mod:`experiments.identification_strategies` (attackers times estimators against gamma(N)) and
+:mod:`experiments.deciphering_time` (measured deciphering time of real discrete-logarithm
+attacks against Definition def:sdt) with the same options.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ STEPS = (
     ("fig2", "experiments.fig2_gramian"),
     ("design", "experiments.design_example"),
     ("strategies", "experiments.identification_strategies"),
+    ("deciphering", "experiments.deciphering_time"),
 )
 
 

@@ -1,0 +1,175 @@
+"""``encctl-gym crack``: break N keys of one dynamic-key sequence and time every key.
+
+Usage::
+
+    encctl-gym crack --bits 64 --keys 32 --breaker index-calculus [--json]
+                     [--group auto|shipped|fresh] [--seed S] [--time-limit T]
+                     [--scheduler local|tcp://host:port] [--n-jobs J] [--inner NAME]
+
+The group is the shipped safe-prime group of that bit length (``--group auto`` when one is
+shipped, or ``shipped``) or a fresh one from ``generate_safe_prime_group(bits, rng=seed)``
+(``fresh``, or ``auto`` for sizes not shipped). The keys are one dynamic-key sequence of
+Example ex:dyn_elgamal: KeyGen, then KeyUpd N - 1 times (seeded, so reproducible and unsafe for
+deployment; the tokens go to the ``token-chain`` breaker only). The breaker's precomputation
+runs once; the table lists each key's wall time, CPU time and operation counts, then
+``T_first`` (precomputation + first key), the mean wall time of a later key and their ratio. Every recovered key
+is checked (g^s = h) and compared with the sequence's secret key.
+
+With ``--scheduler`` (``local`` starts a Dask ``LocalCluster``; needs ``encctl-gym[dask]``) the
+keys are split into chunks that run as tasks of :func:`encctl_gym.parallel.run_tasks`, each with
+a copy of the precomputation; ``--n-jobs`` above 1 alone uses joblib processes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any, Optional
+
+from .._validation import check_int, check_positive
+from ..crypto import arith
+from ..crypto.group import SHIPPED_BITS, GroupParams, generate_safe_prime_group, shipped_group
+from ..errors import BreakerError, ParameterError
+from .base import format_seconds
+from .registry import BREAKERS, get_breaker
+from .sequence import BreakReport, break_sequence
+
+__all__ = ["add_arguments", "run", "key_sequence", "crack_group"]
+
+
+def key_sequence(group: GroupParams, n: int, rng: arith.RngLike) -> tuple[list[int], list[int], list[Any]]:
+    """One dynamic-key sequence (Example ex:dyn_elgamal): KeyGen, then KeyUpd ``n - 1`` times.
+
+    Parameters
+    ----------
+    group : GroupParams
+    n : int
+        Number of keys (>= 1).
+    rng : None, int, RandomSource or numpy.random.Generator
+        Randomness of KeyGen and KeyUpd (a seed is reproducible and unsafe for deployment).
+
+    Returns
+    -------
+    (list of int, list of int, list of UpdateToken)
+        The public-key elements h_0..h_{n-1}, the secret exponents, and the n - 1 tokens.
+    """
+    from ..crypto.dyn_elgamal import key_update
+    from ..crypto.elgamal import keygen
+
+    n = check_int("keys", n, minimum=1)
+    src = arith.as_random_source(rng)
+    pk, sk = keygen(group, rng=src)
+    hs, secrets, tokens = [pk.h], [sk.s], []
+    for _ in range(n - 1):
+        pk, sk, token = key_update(pk, sk, rng=src)
+        hs.append(pk.h)
+        secrets.append(sk.s)
+        tokens.append(token)
+    return hs, secrets, tokens
+
+
+def crack_group(bits: int, source: str, seed: int) -> tuple[GroupParams, str]:
+    """The group of ``encctl-gym crack``: ``(group, "shipped" | "fresh")``.
+
+    Raises
+    ------
+    ParameterError
+        For ``source="shipped"`` without a shipped group of that size, or an unknown source.
+    """
+    bits = check_int("bits", bits, minimum=2)
+    if source not in ("auto", "shipped", "fresh"):
+        raise ParameterError(f"--group must be auto, shipped or fresh, got {source!r}")
+    if source == "shipped" or (source == "auto" and bits in SHIPPED_BITS):
+        return shipped_group(bits), "shipped"
+    return generate_safe_prime_group(bits, rng=arith.seeded_random(seed)), "fresh"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Register the options of ``encctl-gym crack``."""
+    parser.add_argument("--bits", type=int, default=64, help="bit length of p (default 64)")
+    parser.add_argument("--keys", type=int, default=32, help="number N of keys of the sequence (default 32)")
+    parser.add_argument("--breaker", default="index-calculus", choices=list(BREAKERS),
+                        help="key breaker (default index-calculus)")
+    parser.add_argument("--inner", default="index-calculus", choices=[b for b in BREAKERS if b != "token-chain"],
+                        help="breaker of the first key for --breaker token-chain (default index-calculus)")
+    parser.add_argument("--group", default="auto", choices=("auto", "shipped", "fresh"),
+                        help="shipped group of that size, or a fresh seeded one (default: shipped if there is one)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the group, the keys and the attack (default 0)")
+    parser.add_argument("--time-limit", dest="time_limit", type=float, default=None, metavar="T",
+                        help="seconds allowed for the precomputation and for each key (default: none)")
+    parser.add_argument("--max-bits", dest="max_bits", type=int, default=None,
+                        help="override the breaker's size limit (bits of p)")
+    parser.add_argument("--scheduler", default=None,
+                        help="run the keys as Dask tasks: 'local' or a scheduler address (needs encctl-gym[dask])")
+    parser.add_argument("--n-jobs", dest="n_jobs", type=int, default=1,
+                        help="workers of the parallel path (default 1: keys in this process; -1: all cores)")
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+
+
+def _ops(ops: dict[str, int]) -> str:
+    return " ".join(f"{k}={v}" for k, v in ops.items()) or "-"
+
+
+def summary(report: BreakReport) -> dict[str, float]:
+    """``T_first`` (precomputation + first key), the mean later key, their ratio, the total."""
+    t = report.key_seconds()
+    first = report.precomputation.seconds + float(t[0])
+    later = float(t[1:].mean()) if t.size > 1 else float("nan")
+    return {"T_first": first, "mean_later_key": later, "ratio": later / first if first > 0 else float("nan"),
+            "total": float(report.tau()[-1])}
+
+
+def run(args: argparse.Namespace) -> int:
+    """Build the group and the key sequence, break it, print the table (or JSON)."""
+    if args.time_limit is not None:
+        check_positive("--time-limit", args.time_limit)
+    n = check_int("--keys", args.keys, minimum=1)
+    seed = check_int("--seed", args.seed, minimum=0)
+    kwargs: dict[str, Any] = {"rng": arith.seeded_random(seed + 2)}
+    if args.max_bits is not None:
+        kwargs["max_bits"] = args.max_bits
+    if args.breaker == "token-chain":
+        kwargs["inner"] = args.inner
+    breaker = get_breaker(args.breaker, **kwargs)
+    group, source = crack_group(args.bits, args.group, seed)
+    breaker.check_feasible(group)  # refuse before generating keys
+    hs, secrets, tokens = key_sequence(group, n, arith.seeded_random(seed + 1))
+    report = break_sequence(
+        breaker, group, hs, tokens=tokens if args.breaker == "token-chain" else None,
+        time_limit=args.time_limit, progress=not args.no_progress and not args.json,
+        scheduler=args.scheduler, n_jobs=args.n_jobs, seed=seed,
+    )
+    if report.secrets != secrets:  # never expected: every key was checked against g^s = h
+        raise BreakerError("a recovered key differs from the sequence's secret key")
+    stats = summary(report)
+    if args.json:
+        out = report.to_dict()
+        out.update({"bits": group.bits, "group_source": source, "keys_match": True, **stats})
+        print(json.dumps(out, indent=1))
+        return 0
+    print(f"crack: {breaker.name} on a {group.bits}-bit {source} group (p = {group.p:#x}), "
+          f"{n} keys of one dynamic-key sequence")
+    pre = report.precomputation
+    print(f"precomputation: {format_seconds(pre.seconds)}  ({_ops(dict(pre.operations))})")
+    print(f"{'t':>5}  {'seconds':>12}  {'cpu seconds':>12}  {'method':<15} operations")
+    for i, key in enumerate(report.keys):
+        print(f"{i:>5}  {key.cost.seconds:12.6f}  {key.cost.cpu_seconds:12.6f}  {key.method:<15} "
+              f"{_ops(dict(key.cost.operations))}")
+    later = "n/a" if n == 1 else format_seconds(stats["mean_later_key"])
+    print(f"T_first = {format_seconds(stats['T_first'])} (precomputation + key 0), mean later key = {later}, "
+          f"T_1 / T_first = {stats['ratio']:.3g}, total = {format_seconds(stats['total'])}")
+    print(f"all {n} keys checked (g^s = h) and equal to the sequence's secret keys")
+    return 0
+
+
+def main(argv: Optional[list[str]] = None) -> int:  # pragma: no cover - use encctl-gym crack
+    """Entry point of ``python -m encctl_gym.cryptanalysis.cli``."""
+    from ..cli import main as cli_main
+
+    return cli_main(["crack", *(sys.argv[1:] if argv is None else argv)])
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

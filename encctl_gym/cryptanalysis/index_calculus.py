@@ -1,0 +1,391 @@
+"""Index calculus in a prime field, with its phases explicit (registry name ``"index-calculus"``).
+
+Which logarithms are solved for
+-------------------------------
+The keys live in the order-q subgroup G = <g> of Z_p^* (Example ex:elgamal; safe-prime groups
+p = 2q + 1 with g = 4 in this package). Small primes l are in general *not* in G (for a safe
+prime, l is in G iff it is a quadratic residue), so "log_g(l)" is undefined. Let
+``n = (p - 1) / q`` be the cofactor and define
+
+    lambda(x) = log_g(x^n)  (mod q)     for x in Z_p^*.
+
+Claim: if q is an odd prime that does not divide n, then (i) lambda is well defined and a group
+homomorphism ``Z_p^* -> Z_q``, (ii) ``lambda(-1) = 0``, and (iii) ``lambda(y) = n log_g(y)``
+for y in G.
+
+Proof. Z_p^* is cyclic of order nq, so ``x^n`` has order dividing q, hence lies in the unique
+subgroup of order q, which is G; so ``log_g(x^n)`` exists and is unique modulo q (g has order
+q). ``(xy)^n = x^n y^n`` gives ``lambda(xy) = lambda(x) + lambda(y)``. p - 1 = nq is even and
+q is odd, so n is even and ``(-1)^n = 1``: ``lambda(-1) = 0``. For ``y = g^e`` in G,
+``y^n = g^(ne)``, so ``lambda(y) = n e``. QED. (For a safe prime, n = 2 and ``x^n = x^2``: the
+unknowns are the logarithms of the squares ``l^2``, which are in G.)
+
+Hence the unknowns are ``lambda_l = lambda(l)`` for the primes l of the factor base, and since n
+is invertible modulo q, ``log_g(h) = lambda(h) / n``.
+
+The phases
+----------
+1. **Factor base** (:class:`~.smoothness.FactorBase`): the primes ``l <= B``, with B chosen by
+   the cost model :func:`choose_bound` (Dickman's rho for the smoothness probability, the
+   measured cost of a smoothness test and of the linear algebra).
+2. **Relation collection** (:func:`collect_relations`): for ``y = g^e`` write ``y = a / b
+   (mod p)`` with ``|a|, |b| < sqrt(p)`` (:func:`~.smoothness.rational_reconstruction`); if
+   both are B-smooth, ``lambda(y) = lambda(a) - lambda(|b|)`` (by (i) and (ii)) gives the
+   relation ``sum_l (alpha_l - beta_l) lambda_l = n e (mod q)`` (by (iii)).
+3. **Linear algebra modulo q** (:func:`~.linalg.solve_mod_prime`, python-flint): all the
+   ``lambda_l`` the relations determine.
+4. **Descent**, per key (:class:`FactorBaseLogs`): randomise ``z = h g^r`` until z = a / b with
+   a, b smooth over the solved primes; then ``n (log_g h + r) = lambda(a) - lambda(|b|)``.
+
+Phases 1-3 depend only on (p, q, g): they are the precomputation. Phase 4 needs about
+``1 / rho(u/2)^2`` smoothness tests per key, a small fraction of the precomputation, so after the
+first key a dynamic-key sequence (Example ex:dyn_elgamal) costs little per key.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import ClassVar, Mapping, Optional
+
+import gmpy2
+
+from .._validation import check_int, check_positive
+from ..crypto import arith
+from ..crypto.arith import RandomSource, RngLike, format_int
+from ..crypto.group import GroupParams
+from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, GroupError
+from .base import Breaker, Deadline, Precomputation
+from .linalg import flint_backend, solve_mod_prime
+from .smoothness import FactorBase, dickman_rho, rational_reconstruction
+
+__all__ = [
+    "IndexCalculus",
+    "FactorBaseLogs",
+    "Relation",
+    "collect_relations",
+    "choose_bound",
+    "cost_model",
+    "relation_probability",
+]
+
+#: Calibration of the cost model, measured on this machine (2 cores, Python 3.11, gmpy2 2.3,
+#: python-flint 0.9; ``python benchmarks/bench_cryptanalysis.py`` prints current values):
+#: seconds per smoothness trial = TRIAL_BASE + TRIAL_PER_BIT bits + TRIAL_PER_BOUND B ...
+TRIAL_BASE = 3.0e-6
+TRIAL_PER_BIT = 2.0e-8
+TRIAL_PER_BOUND = 7.0e-11
+#: ... and seconds per k^3 of the dense elimination (k unknowns), for word-size q and larger q.
+LINALG_WORD = 2.5e-10
+LINALG_MULTI = 1.5e-9
+#: Seconds per entry of building the dense matrix (Python lists into FLINT).
+MATRIX_ENTRY = 5.0e-7
+
+#: Relations collected beyond the number of unknowns (fraction, plus a constant).
+EXTRA_FRACTION = 0.05
+EXTRA_CONSTANT = 20
+#: Share of the primes occurring in the relations whose logarithm must be determined.
+SOLVED_FRACTION = 0.97
+_CHECK_EVERY = 2048
+
+
+def relation_probability(bits: int, bound: float) -> float:
+    """Probability that ``y = a / b`` (both about ``bits / 2`` bits) has a and b ``bound``-smooth:
+    ``rho(u)^2`` with ``u = (bits / 2) ln 2 / ln B`` (Dickman's rho, :func:`~.smoothness.dickman_rho`)."""
+    u = (bits / 2) * math.log(2) / math.log(bound)
+    return dickman_rho(u) ** 2
+
+
+def _prime_count(bound: float) -> float:
+    return bound / (math.log(bound) - 1.08) if bound > 10 else 4.0
+
+
+def cost_model(bits: int, bound: float) -> dict[str, float]:
+    """Expected seconds of each phase for a ``bits``-bit p and factor-base bound B.
+
+    Returns
+    -------
+    dict
+        ``factor_base`` (k, the number of unknowns), ``trials_per_relation``, ``relations``
+        (seconds of phase 2), ``linear_algebra`` (phase 3, dense elimination and the matrix
+        build), ``descent`` (phase 4, per key), ``first`` (phases 2-4) and ``per_key``.
+    """
+    bits = check_int("bits", bits, minimum=2)
+    bound = check_positive("bound", bound)
+    k = _prime_count(bound)
+    trials = 1.0 / max(relation_probability(bits, bound), 1e-300)
+    trial = TRIAL_BASE + TRIAL_PER_BIT * bits + TRIAL_PER_BOUND * bound
+    relations = (k * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT) * trials * trial
+    cube = LINALG_WORD if bits <= 64 else LINALG_MULTI
+    linear = cube * k**3 + MATRIX_ENTRY * k * k
+    descent = trials * trial
+    return {
+        "factor_base": k,
+        "trials_per_relation": trials,
+        "relations": relations,
+        "linear_algebra": linear,
+        "descent": descent,
+        "first": relations + linear + descent,
+        "per_key": descent,
+    }
+
+
+def choose_bound(bits: int) -> int:
+    """The factor-base bound B minimising the expected time of the first key (:func:`cost_model`),
+    searched over ``B = 2^(x/8)``, ``x/8`` from 5 to 22."""
+    bits = check_int("bits", bits, minimum=2)
+    best = min(range(40, 177), key=lambda x: cost_model(bits, 2 ** (x / 8))["first"])
+    return max(2, int(2 ** (best / 8)))
+
+
+class _PhaseClock:
+    """Wall and CPU seconds per named phase (``with clock("relations"): ...``), accumulated."""
+
+    def __init__(self) -> None:
+        self.wall: dict[str, float] = {"factor_base": 0.0, "relations": 0.0, "linear_algebra": 0.0}
+        self.cpu = dict(self.wall)
+        self._name = ""
+
+    def __call__(self, name: str) -> "_PhaseClock":
+        self._name = name
+        return self
+
+    def __enter__(self) -> None:
+        self._t0, self._c0 = time.perf_counter(), time.process_time()
+
+    def __exit__(self, *exc: object) -> None:
+        self.wall[self._name] += time.perf_counter() - self._t0
+        self.cpu[self._name] += time.process_time() - self._c0
+
+
+class Relation(tuple):
+    """One relation ``(row, rhs)``: ``sum_j row[j] lambda_j = rhs (mod q)``."""
+
+    __slots__ = ()
+
+    @property
+    def row(self) -> dict[int, int]:
+        return self[0]
+
+    @property
+    def rhs(self) -> int:
+        return self[1]
+
+
+def _split(fb: FactorBase, y: int, p: int, half: int) -> Optional[dict[int, int]]:
+    """The exponent vector of lambda(y) = lambda(a) - lambda(|b|), or None if a or b is not smooth."""
+    a, b = rational_reconstruction(y, p, half)
+    if not (fb.is_smooth(a) and fb.is_smooth(b)):
+        return None
+    row = dict(fb.factor(a))
+    for j, e in fb.factor(b).items():
+        row[j] = row.get(j, 0) - e
+    return {j: e for j, e in row.items() if e}
+
+
+def collect_relations(
+    group: GroupParams, fb: FactorBase, count: int, src: RandomSource, deadline: Deadline
+) -> tuple[list[Relation], int]:
+    """Phase 2: ``count`` relations ``sum (alpha_l - beta_l) lambda_l = n e (mod q)``.
+
+    Walks ``y = g^e`` with ``e = e_0 + i c`` for random e_0 and c (one multiplication by
+    ``g^c`` per trial) and keeps the y whose rational reconstruction a / b is smooth on both
+    sides. (Consecutive exponents would not do: with g = 4, ``4y`` is ``4a / b`` and repeats
+    the relation of y plus that of 4.)
+
+    Returns
+    -------
+    (list of Relation, int)
+        The relations and the number of smoothness trials.
+    """
+    p, q, n = group.p, group.q, group.cofactor
+    half = math.isqrt(p)
+    e, c = src.between(1, q), src.between(1, q)
+    y = gmpy2.powmod(group.g, e, p)
+    step = gmpy2.powmod(group.g, c, p)
+    pm = gmpy2.mpz(p)
+    relations: list[Relation] = []
+    trials = 0
+    while len(relations) < count:
+        for _ in range(_CHECK_EVERY):
+            trials += 1
+            row = _split(fb, int(y), p, half)
+            if row is not None:
+                relations.append(Relation((row, n * e % q)))
+                if len(relations) >= count:
+                    break
+            y = y * step % pm
+            e += c
+        deadline.check()
+    return relations, trials
+
+
+class FactorBaseLogs(Precomputation):
+    """The solved factor base of a group: ``lambda(l)`` for its primes; breaks keys by descent.
+
+    Attributes
+    ----------
+    bound : int
+        The factor-base bound B.
+    logs : list of int or None
+        ``lambda(l)`` per prime of the factor base (``None``: not determined by the relations).
+    phase_seconds, phase_cpu_seconds : dict
+        Wall and CPU time of the phases of the precomputation: ``factor_base``, ``relations``,
+        ``linear_algebra``.
+    backend : str
+        The FLINT matrix type of the linear algebra (``nmod_mat`` or ``fmpz_mod_mat``).
+    """
+
+    def __init__(self, group: GroupParams, bound: int, logs: list[Optional[int]],
+                 rng: Optional[RandomSource]) -> None:
+        super().__init__(IndexCalculus.name, group, rng)
+        self.bound = bound
+        self.logs = logs
+        self.phase_seconds: dict[str, float] = {}
+        self.phase_cpu_seconds: dict[str, float] = {}
+        self.backend = flint_backend(group.q)
+        self._fb: Optional[FactorBase] = None
+
+    def __getstate__(self) -> dict:
+        state = super().__getstate__()
+        state["_fb"] = None  # rebuilt from the bound where needed
+        return state
+
+    @property
+    def factor_base(self) -> FactorBase:
+        """The factor base (rebuilt from :attr:`bound` after unpickling)."""
+        if self._fb is None:
+            self._fb = FactorBase(self.bound)
+        return self._fb
+
+    @property
+    def solved(self) -> int:
+        """Number of factor-base primes whose lambda is known."""
+        return sum(v is not None for v in self.logs)
+
+    def _solve(self, h: int, deadline: Deadline, src: RandomSource) -> tuple[int, Mapping[str, int], str]:
+        # Phase 4, the descent: z = h g^r = a / b with a, b smooth over the solved primes gives
+        # n (log h + r) = lambda(a) - lambda(|b|).
+        group, fb, logs = self.group, self.factor_base, self.logs
+        p, q = group.p, group.q
+        half = math.isqrt(p)
+        n_inv = pow(group.cofactor, -1, q)
+        pm = gmpy2.mpz(p)
+        r, c = src.between(0, q), src.between(1, q)  # z = h g^r, then r += c (see collect_relations)
+        z = gmpy2.mpz(h) * gmpy2.powmod(group.g, r, p) % pm
+        step = gmpy2.powmod(group.g, c, p)
+        trials = 0
+        give_up = 1000 * relation_probability(group.bits, self.bound) ** -1 + 100_000
+        while True:
+            for _ in range(_CHECK_EVERY):
+                trials += 1
+                row = _split(fb, int(z), p, half)
+                if row is not None and all(logs[j] is not None for j in row):
+                    lam = sum(e * logs[j] for j, e in row.items())
+                    s = (lam * n_inv - r) % q
+                    return s, {"smoothness_tests": trials}, ""
+                z = z * step % pm
+                r += c
+            deadline.check()
+            if trials > give_up:
+                raise BreakerError(f"index-calculus: no smooth randomisation after {trials} trials for h = {format_int(h)}")
+
+
+class IndexCalculus(Breaker):
+    """Index calculus with a factor base, rational reconstruction and FLINT linear algebra.
+
+    See the module docstring for the logarithms solved for and the phases.
+
+    Parameters
+    ----------
+    bound : int, optional
+        The factor-base bound B (default: :func:`choose_bound` for the group's size).
+    max_bits : int, optional
+        Size limit (default 112 bits: about six minutes and a dense matrix of about 3500 x 3500
+        on this machine; at most 128, where the halves a and b still fit in 64 bits).
+    rng
+        See :class:`~encctl_gym.cryptanalysis.base.Breaker`.
+    """
+
+    name: ClassVar[str] = "index-calculus"
+    DEFAULT_MAX_BITS: ClassVar[int] = 112
+    #: Rounds of extra relations collected when the system leaves too many unknowns free.
+    MAX_ROUNDS: ClassVar[int] = 6
+
+    def __init__(self, *, bound: Optional[int] = None, max_bits: Optional[int] = None, rng: RngLike = None) -> None:
+        super().__init__(max_bits=max_bits, rng=rng)
+        if self.max_bits > 128:
+            raise BreakerLimitError(f"index-calculus supports at most 128 bits (max_bits), got {self.max_bits}")
+        self.bound = None if bound is None else check_int("bound", bound, minimum=2)
+
+    def factor_base_bound(self, group: GroupParams) -> int:
+        """B for this group: the ``bound`` given, else :func:`choose_bound` (at least 2, below p)."""
+        bound = self.bound or choose_bound(group.bits)
+        return max(2, min(bound, group.p - 1))
+
+    def expected_seconds(self, group: GroupParams) -> tuple[float, float]:
+        """``(first, per_key)`` of :func:`cost_model` at :meth:`factor_base_bound`."""
+        model = cost_model(group.bits, self.factor_base_bound(group))
+        return model["first"], model["per_key"]
+
+    def _check_group(self, group: GroupParams) -> None:
+        n = group.cofactor
+        if group.q == 2 or n % group.q == 0:
+            raise GroupError(
+                f"index-calculus needs an odd q that does not divide the cofactor (p - 1) / q; got q = {group.q}, "
+                f"cofactor = {n}"
+            )
+
+    def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[FactorBaseLogs, Mapping[str, int]]:
+        src = self.rng or arith.secure_random()
+        clock = _PhaseClock()
+        # Phase 1: the factor base.
+        with clock("factor_base"):
+            fb = FactorBase(self.factor_base_bound(group))
+        k = len(fb)
+        # Phase 2: relations; phase 3: linear algebra. More relations while a prime below
+        # sqrt(B) (and sqrt(p), for toy groups) is undetermined, or more than SOLVED_FRACTION of
+        # the primes that occur in the relations are: the descent needs those.
+        need = int(k * (1 + EXTRA_FRACTION)) + EXTRA_CONSTANT
+        relations: list[Relation] = []
+        trials = 0
+        rank = 0
+        logs: list[Optional[int]] = [None] * k
+        small = sum(1 for ell in fb.primes if ell <= max(2, math.isqrt(min(fb.bound, group.p))))
+        for _ in range(self.MAX_ROUNDS):
+            with clock("relations"):
+                more, t = collect_relations(group, fb, need - len(relations), src, deadline)
+            relations += more
+            trials += t
+            # The elimination runs inside FLINT and cannot be interrupted: refuse it up front
+            # when the cost model says it would overrun the time limit.
+            expected = cost_model(group.bits, fb.bound)["linear_algebra"]
+            if expected > deadline.remaining:
+                raise BreakerTimeoutError(
+                    f"{deadline.what} stopped before its linear algebra: expected {expected:.3g} s, but only "
+                    f"{max(deadline.remaining, 0.0):.3g} s of its time limit of {deadline.limit:g} s remain"
+                )
+            with clock("linear_algebra"):
+                logs, rank = solve_mod_prime([r.row for r in relations], [r.rhs for r in relations], k, group.q)
+            occurring = len({j for r in relations for j in r.row})
+            solved = sum(v is not None for v in logs)
+            if all(v is not None for v in logs[:small]) and solved >= SOLVED_FRACTION * occurring:
+                break
+            need = len(relations) + max(EXTRA_CONSTANT, int(EXTRA_FRACTION * k))
+            deadline.check()
+        else:
+            raise BreakerError(
+                f"index-calculus: only {sum(v is not None for v in logs)} of {k} factor-base logarithms "
+                f"determined after {len(relations)} relations (rank {rank})"
+            )
+        pre = FactorBaseLogs(group, fb.bound, logs, self.rng)
+        pre._fb = fb
+        pre.phase_seconds, pre.phase_cpu_seconds = clock.wall, clock.cpu
+        ops = {
+            "factor_base": k,
+            "smoothness_tests": trials,
+            "relations": len(relations),
+            "rank": rank,
+            "solved_logs": pre.solved,
+        }
+        return pre, ops

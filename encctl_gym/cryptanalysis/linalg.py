@@ -1,0 +1,97 @@
+"""Linear algebra modulo a prime q for the index calculus, on python-flint's matrices.
+
+The relations of :mod:`.index_calculus` form a sparse system ``R x = r (mod q)`` with small
+integer coefficients and one unknown per factor-base prime. :func:`solve_mod_prime` reduces the
+augmented matrix ``[R | r]`` to reduced row echelon form with FLINT (``nmod_mat`` when q fits in
+a machine word, ``fmpz_mod_mat`` otherwise) and reads off every unknown the system determines;
+unknowns it leaves free are reported as ``None``, never guessed.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping, Optional, Sequence
+
+from ..errors import BreakerError, OptionalDependencyError, ParameterError
+
+__all__ = ["solve_mod_prime", "flint_backend"]
+
+_WORD = 1 << 63
+
+
+def _flint():  # python-flint is a core dependency; the error is for broken installs
+    try:
+        import flint
+    except ImportError as exc:  # pragma: no cover - depends on the installation
+        raise OptionalDependencyError(
+            "the index calculus needs python-flint; install it with: pip install python-flint"
+        ) from exc
+    return flint
+
+
+def flint_backend(q: int) -> str:
+    """``"nmod_mat"`` for ``q < 2^63``, else ``"fmpz_mod_mat"``."""
+    return "nmod_mat" if q < _WORD else "fmpz_mod_mat"
+
+
+def solve_mod_prime(
+    rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols: int, q: int
+) -> tuple[list[Optional[int]], int]:
+    """Solve ``sum_j rows[i][j] x_j = rhs[i] (mod q)`` for every unknown the system determines.
+
+    Parameters
+    ----------
+    rows : sequence of mappings
+        Sparse rows ``{column: coefficient}`` (integers, any sign).
+    rhs : sequence of int
+        Right-hand sides.
+    ncols : int
+        Number of unknowns.
+    q : int
+        A prime modulus.
+
+    Returns
+    -------
+    (list of int or None, int)
+        ``x_j`` in ``[0, q)`` for every determined unknown (``None`` for a free or absent one),
+        and the rank of the system.
+
+    Raises
+    ------
+    BreakerError
+        If the system is inconsistent (a relation is wrong: never expected).
+    """
+    if len(rows) != len(rhs):
+        raise ParameterError(f"rows and rhs differ in length: {len(rows)} != {len(rhs)}")
+    flint = _flint()
+    used = sorted({j for row in rows for j, c in row.items() if c % q})
+    if not used:
+        return [None] * ncols, 0
+    pos = {j: i for i, j in enumerate(used)}
+    width = len(used) + 1
+    entries = [0] * (len(rows) * width)
+    for i, (row, r) in enumerate(zip(rows, rhs)):
+        base = i * width
+        for j, c in row.items():
+            if c % q:
+                entries[base + pos[j]] = c % q
+        entries[base + width - 1] = r % q
+    if q < _WORD:
+        mat = flint.nmod_mat(len(rows), width, entries, q)
+    else:
+        mat = flint.fmpz_mod_mat(len(rows), width, entries, flint.fmpz_mod_ctx(q))
+    reduced, rank = mat.rref()
+    values = [int(v) for v in reduced.entries()]
+    solution: list[Optional[int]] = [None] * ncols
+    pivots = []
+    for i in range(rank):
+        row = values[i * width:(i + 1) * width]
+        lead = next(k for k, v in enumerate(row) if v)
+        if lead == width - 1:
+            raise BreakerError("the relations are inconsistent modulo q (a wrong relation)")
+        pivots.append((lead, row))
+    pivot_cols = {lead for lead, _ in pivots}
+    free = [k for k in range(width - 1) if k not in pivot_cols]
+    for lead, row in pivots:
+        if all(row[k] == 0 for k in free):  # this unknown does not depend on a free one
+            solution[used[lead]] = row[width - 1]
+    return solution, rank

@@ -1,0 +1,188 @@
+"""Breaking a whole dynamic-key sequence h_1, ..., h_N, and the measured deciphering time.
+
+:func:`break_sequence` runs a breaker's precomputation once and then breaks the keys of one
+dynamic-key sequence (Example ex:dyn_elgamal: one group, N secrets) in order, serially, or
+spread over workers with :func:`encctl_gym.parallel.run_tasks` (joblib processes or a Dask
+cluster: the precomputation is shipped once per chunk of keys, each chunk gets its own child
+seed). The :class:`BreakReport` keeps the precomputation's cost apart from the per-key costs,
+so the measured sample deciphering time
+
+    tau(N) = T_pre + t_1 + ... + t_N
+
+can be set against Definition def:sdt's ``tau(N, lambda) = N 2^lambda / Upsilon``, i.e. N times
+the cost of one key broken from scratch.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from typing import Any, Iterable, Optional
+
+import numpy as np
+
+from .._validation import check_int
+from ..crypto import arith
+from ..crypto.group import GroupParams
+from ..errors import ParameterError
+from .base import Breaker, Cost, Precomputation, RecoveredKey, check_element
+from .registry import get_breaker
+
+__all__ = ["BreakReport", "break_sequence"]
+
+
+@dataclasses.dataclass
+class BreakReport:
+    """The result of :func:`break_sequence`.
+
+    Attributes
+    ----------
+    breaker : str
+        Registry name.
+    group : GroupParams
+        The group attacked.
+    precomputation : Cost
+        Cost of the precomputation (once for the sequence).
+    keys : list of RecoveredKey
+        One per public-key element, in order, each checked (g^s = h).
+    """
+
+    breaker: str
+    group: GroupParams
+    precomputation: Cost
+    keys: list[RecoveredKey]
+
+    @property
+    def secrets(self) -> list[int]:
+        """The recovered exponents s_1, ..., s_N."""
+        return [k.s for k in self.keys]
+
+    def key_seconds(self, clock: str = "wall") -> np.ndarray:
+        """Per-key times t_1, ..., t_N (precomputation excluded): ``clock="wall"`` (default) or
+        ``"cpu"`` (this process's CPU time, see :class:`~.base.Cost`)."""
+        attr = _clock(clock)
+        return np.array([getattr(k.cost, attr) for k in self.keys], dtype=float)
+
+    def tau(self, clock: str = "wall") -> np.ndarray:
+        """The measured deciphering time of the first N keys, ``T_pre + t_1 + ... + t_N``, for
+        N = 1, ..., len(keys) (``clock`` as in :meth:`key_seconds`)."""
+        return getattr(self.precomputation, _clock(clock)) + np.cumsum(self.key_seconds(clock))
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: group, breaker, precomputation cost and per-key records (exponents in hex)."""
+        return {
+            "breaker": self.breaker,
+            "group": self.group.to_dict(),
+            "precomputation": self.precomputation.to_dict(),
+            "keys": [
+                {"t": i, "h": hex(k.h), "s": hex(k.s), "method": k.method, **k.cost.to_dict()}
+                for i, k in enumerate(self.keys)
+            ],
+            "total_seconds": float(self.tau()[-1]) if self.keys else self.precomputation.seconds,
+        }
+
+
+def _clock(clock: str) -> str:
+    if clock not in ("wall", "cpu"):
+        raise ParameterError(f"clock must be 'wall' or 'cpu', got {clock!r}")
+    return "seconds" if clock == "wall" else "cpu_seconds"
+
+
+def _break_chunk(task: tuple[Precomputation, list[int], Optional[float]], seed: np.random.SeedSequence) -> list[RecoveredKey]:
+    # One task of the parallel path: a copy of the precomputation and a run of consecutive keys.
+    pre, hs, time_limit = task
+    rng = arith.seeded_random(int(seed.generate_state(1, np.uint64)[0]))
+    return [pre.break_key(h, time_limit=time_limit, rng=rng) for h in hs]
+
+
+def break_sequence(
+    breaker: Any,
+    group: GroupParams,
+    hs: Iterable[int],
+    *,
+    tokens: Optional[Iterable[Any]] = None,
+    pre: Optional[Precomputation] = None,
+    time_limit: Optional[float] = None,
+    progress: bool = False,
+    scheduler: Any = None,
+    n_jobs: int = 1,
+    chunks: Optional[int] = None,
+    seed: int = 0,
+) -> BreakReport:
+    """Break the public-key elements ``hs`` of one group with one precomputation.
+
+    Parameters
+    ----------
+    breaker : str or Breaker
+        A registry name (built with defaults) or a breaker instance.
+    group : GroupParams
+        The group of every key.
+    hs : iterable of int
+        The public-key elements h_1, ..., h_N (checked to lie in G before any work).
+    tokens : iterable, optional
+        Update tokens, for the ``token-chain`` breaker only.
+    pre : Precomputation, optional
+        A precomputation of this breaker and group to reuse (its cost is reported again).
+    time_limit : float, optional
+        Seconds allowed for the precomputation and for each key.
+    progress : bool
+        Show a tqdm progress bar (stderr).
+    scheduler : None, "local", address or distributed.Client
+        Run the per-key work through :func:`~encctl_gym.parallel.run_tasks` (with ``n_jobs``):
+        ``None`` and ``n_jobs == 1`` break the keys in this process, in order.
+    n_jobs : int
+        Workers of the parallel path (``-1``: all cores).
+    chunks : int, optional
+        Number of tasks of the parallel path (default: the number of workers); each carries a
+        copy of the precomputation and a run of consecutive keys.
+    seed : int
+        Seed of the parallel path's per-task randomness.
+
+    Returns
+    -------
+    BreakReport
+
+    Raises
+    ------
+    KeyMismatchError
+        If a key is not in G of ``group``.
+    ParameterError
+        If tokens are given to a breaker that does not use them, or on bad options.
+    """
+    from tqdm.auto import tqdm
+
+    breaker = get_breaker(breaker) if isinstance(breaker, str) else breaker
+    if not isinstance(breaker, Breaker):
+        raise ParameterError(f"breaker must be a registry name or a Breaker, got {breaker!r}")
+    if not isinstance(group, GroupParams):
+        raise ParameterError(f"group must be a GroupParams, got {group!r}")
+    hs = [check_element(group, h) for h in hs]
+    n_jobs = check_int("n_jobs", n_jobs)
+    if pre is None:
+        pre = breaker.precompute(group, time_limit=time_limit)
+    elif pre.breaker != breaker.name or pre.group != group:
+        raise ParameterError(f"pre is a precomputation of {pre.breaker!r} for another group or breaker")
+    if tokens is not None:
+        if not hasattr(pre, "add_tokens"):
+            raise ParameterError(f"update tokens are used only by the token-chain breaker, not by {breaker.name!r}")
+        pre.add_tokens(tokens)
+    if scheduler is None and n_jobs == 1:
+        keys = []
+        for h in tqdm(hs, desc=f"{breaker.name} keys", disable=not progress, leave=False):
+            keys.append(breaker.break_key(h, pre, time_limit=time_limit))
+        return BreakReport(breaker.name, group, pre.cost, keys)
+    if breaker.MAIN_THREAD_ONLY and scheduler is not None:
+        raise ParameterError(
+            f"breaker {breaker.name!r} runs only in a process's main thread and Dask runs tasks in threads: "
+            "break its keys without a scheduler"
+        )
+    workers = (os.cpu_count() or 1) if n_jobs == -1 else n_jobs
+    n_chunks = max(1, min(len(hs), check_int("chunks", chunks if chunks is not None else workers, minimum=1)))
+    bounds = np.linspace(0, len(hs), n_chunks + 1).round().astype(int)
+    tasks = [(pre, hs[a:b], time_limit) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
+    from ..parallel import run_tasks
+
+    parts = run_tasks(_break_chunk, tasks, seed=seed, n_jobs=n_jobs, scheduler=scheduler,
+                      progress=progress, desc=f"{breaker.name} keys")
+    keys = [k for part in parts for k in part]
+    return BreakReport(breaker.name, group, pre.cost, keys)

@@ -1,0 +1,375 @@
+"""Tests of the key breakers (encctl_gym.cryptanalysis): known answers, agreement with each other
+and with sympy's discrete_log, hypothesis properties, the token chain against
+crypto.dyn_elgamal.recover_next_secret_key, and every error of the interface."""
+
+from __future__ import annotations
+
+import math
+import pickle
+import random
+import sys
+from functools import lru_cache
+
+import gmpy2
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from encctl_gym.crypto import arith
+from encctl_gym.crypto.dyn_elgamal import recover_next_secret_key
+from encctl_gym.crypto.elgamal import SecretKey
+from encctl_gym.crypto.group import GroupParams, generate_safe_prime_group, shipped_group
+from encctl_gym.cryptanalysis import (
+    BREAKERS,
+    BreakReport,
+    IndexCalculus,
+    MultiLogRho,
+    PollardRho,
+    TokenChain,
+    break_sequence,
+    get_breaker,
+    pari_available,
+)
+from encctl_gym.cryptanalysis import pari as pari_mod
+from encctl_gym.cryptanalysis.base import Deadline, format_seconds
+from encctl_gym.cryptanalysis.cli import key_sequence
+from encctl_gym.errors import (
+    BreakerError,
+    BreakerLimitError,
+    BreakerTimeoutError,
+    EncctlError,
+    GroupError,
+    KeyMismatchError,
+    OptionalDependencyError,
+    ParameterError,
+)
+
+# Toy group (hand-checked): p = 23 = 2 * 11 + 1, q = 11, g = 4; powers 4^s mod 23 for s = 0..10.
+TOY = GroupParams(23, 11, 4)
+TOY_POWERS = {1: 0, 4: 1, 16: 2, 18: 3, 3: 4, 12: 5, 2: 6, 8: 7, 9: 8, 13: 9, 6: 10}
+
+needs_pari = pytest.mark.skipif(not pari_available(), reason="needs cypari (pip install 'encctl-gym[cryptanalysis]')")
+#: Every breaker that breaks a key on its own (the token chain wraps one of them).
+DIRECT = [name for name in BREAKERS if name != "token-chain"]
+
+
+def direct_breakers() -> list:
+    return [pytest.param(name, marks=needs_pari) if name == "pari" else name for name in DIRECT]
+
+
+@lru_cache(maxsize=None)
+def group(bits: int, seed: int = 11) -> GroupParams:
+    return generate_safe_prime_group(bits, rng=seed)
+
+
+@lru_cache(maxsize=None)
+def sequence(bits: int, n: int, seed: int = 5) -> tuple[tuple[int, ...], tuple[int, ...], tuple]:
+    hs, secrets, tokens = key_sequence(group(bits), n, arith.seeded_random(seed))
+    return tuple(hs), tuple(secrets), tuple(tokens)
+
+
+@lru_cache(maxsize=None)
+def precomputed(name: str, bits: int):
+    return get_breaker(name, rng=3).precompute(group(bits) if bits else TOY)
+
+
+# ----------------------------------------------------------------------------- known answers
+def test_toy_group_table_is_right() -> None:
+    assert {pow(4, s, 23): s for s in range(11)} == TOY_POWERS
+
+
+@pytest.mark.parametrize("name", direct_breakers())
+def test_every_breaker_recovers_every_key_of_the_toy_group(name: str) -> None:
+    pre = get_breaker(name, rng=1).precompute(TOY)
+    for h, s in TOY_POWERS.items():
+        key = pre.break_key(h)
+        assert key.s == s and key.h == h
+        assert key.cost.seconds >= 0 and key.method == name
+
+
+@pytest.mark.parametrize("name", direct_breakers())
+def test_breakers_agree_with_the_true_secrets_and_sympy_on_36_bits(name: str) -> None:
+    from sympy.ntheory import discrete_log
+
+    grp = group(36)
+    hs, secrets, _ = sequence(36, 4)
+    report = break_sequence(name, grp, hs)
+    assert isinstance(report, BreakReport)
+    assert report.secrets == list(secrets)
+    for h, s in zip(hs[:2], report.secrets):
+        assert discrete_log(grp.p, h, grp.g, grp.q) == s  # an independent implementation
+    tau = report.tau()
+    assert tau.shape == (4,) and all(tau[1:] >= tau[:-1])
+    assert tau[0] == pytest.approx(report.precomputation.seconds + report.keys[0].cost.seconds)
+
+
+@pytest.mark.parametrize("name", [pytest.param("pari", marks=needs_pari), "index-calculus"])
+def test_pari_and_index_calculus_agree_on_48_bits(name: str) -> None:
+    hs, secrets, _ = sequence(48, 3)
+    assert break_sequence(name, group(48), hs).secrets == list(secrets)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("bits", [64, 80])
+@pytest.mark.parametrize("name", [pytest.param("pari", marks=needs_pari), "index-calculus"])
+def test_pari_and_index_calculus_agree_on_larger_groups(name: str, bits: int) -> None:
+    hs, secrets, _ = sequence(bits, 4)
+    assert break_sequence(name, group(bits), hs).secrets == list(secrets)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["bsgs", "rho", "rho-multi"])
+def test_generic_breakers_on_48_bits(name: str) -> None:
+    hs, secrets, _ = sequence(48, 2)
+    assert break_sequence(name, group(48), hs).secrets == list(secrets)
+
+
+# ----------------------------------------------------------------------------- properties
+@pytest.mark.parametrize("name", direct_breakers())
+@settings(max_examples=25, deadline=None)
+@given(data=st.data())
+def test_any_exponent_is_recovered_and_checked(name: str, data: st.DataObject) -> None:
+    pre = precomputed(name, 24)
+    grp = pre.group
+    s = data.draw(st.integers(min_value=1, max_value=grp.q - 1))
+    h = int(gmpy2.powmod(grp.g, s, grp.p))
+    key = pre.break_key(h)
+    assert key.s == s
+    assert pow(grp.g, key.s, grp.p) == h
+
+
+def test_h_equal_to_one_gives_zero() -> None:
+    for name in ("bsgs", "rho", "rho-multi", "index-calculus"):
+        assert precomputed(name, 24).break_key(1).s == 0
+
+
+def test_same_seed_same_work() -> None:
+    hs, _, _ = sequence(32, 3)
+    runs = [break_sequence(MultiLogRho(rng=7), group(32), hs) for _ in range(2)]
+    assert [k.cost.operations for k in runs[0].keys] == [k.cost.operations for k in runs[1].keys]
+
+
+# ----------------------------------------------------------------------------- amortisation
+def test_multiple_logarithm_rho_makes_later_keys_cheaper() -> None:
+    # Kuhn-Struik: the distinguished points of solved keys stay in the table, so the walks of a
+    # later key end early. Same walk, same keys: plain rho forgets its points after every key.
+    grp = group(36)
+    hs, secrets, _ = sequence(36, 24)
+    multi = break_sequence(MultiLogRho(rng=2), grp, hs)
+    plain = break_sequence(PollardRho(rng=2), grp, hs)
+    assert multi.secrets == plain.secrets == list(secrets)
+    steps_multi = [k.cost.operations["group_operations"] for k in multi.keys]
+    steps_plain = [k.cost.operations["group_operations"] for k in plain.keys]
+    expected = math.sqrt(math.pi * grp.q / 2)
+    assert 0.5 * expected < sum(steps_plain) / len(steps_plain) < 2 * expected
+    assert sum(steps_multi[12:]) < 0.4 * sum(steps_plain[12:])
+    pre = MultiLogRho(rng=2).precompute(grp)
+    pre.break_key(hs[0])
+    table = len(pre.known)
+    pre.break_key(hs[1])
+    assert len(pre.known) > table > 0  # the table only grows
+
+
+def test_bsgs_reuses_its_table() -> None:
+    pre = precomputed("bsgs", 24)
+    assert pre.cost.operations["group_operations"] == pre.m == math.isqrt(pre.group.q - 1) + 1
+    hs, _, _ = sequence(24, 4)
+    for h in hs:
+        assert pre.break_key(h).cost.operations["group_operations"] <= -(-pre.group.q // pre.m)
+
+
+def test_index_calculus_phases_and_descent() -> None:
+    pre = precomputed("index-calculus", 48)
+    ops = pre.cost.operations
+    assert ops["relations"] >= ops["factor_base"] > 10
+    assert ops["solved_logs"] >= 0.9 * ops["factor_base"] and ops["rank"] >= ops["solved_logs"]
+    assert set(pre.phase_seconds) == set(pre.phase_cpu_seconds) == {"factor_base", "relations", "linear_algebra"}
+    assert pre.backend == "nmod_mat"
+    grp = pre.group
+    # lambda(l) = log_g(l^n): the solved logarithms are those of the squares of the small primes.
+    for ell, lam in zip(pre.factor_base.primes[:20], pre.logs[:20]):
+        assert lam is not None
+        assert pow(grp.g, lam, grp.p) == pow(ell, grp.cofactor, grp.p)
+    hs, secrets, _ = sequence(48, 3)
+    for h, s in zip(hs, secrets):
+        key = pre.break_key(h)
+        assert key.s == s and key.cost.operations["smoothness_tests"] >= 1
+
+
+def test_index_calculus_with_multiprecision_linear_algebra() -> None:
+    # q >= 2^63 takes the fmpz_mod_mat path (the 64-bit shipped group has a 63-bit q, so 66 bits).
+    grp = group(66)
+    pre = IndexCalculus(rng=4, bound=900).precompute(grp)
+    assert pre.backend == "fmpz_mod_mat"
+    hs, secrets, _ = sequence(66, 2)
+    assert [pre.break_key(h).s for h in hs] == list(secrets)
+
+
+# ----------------------------------------------------------------------------- token chain
+def test_token_chain_derives_every_later_key_like_recover_next_secret_key() -> None:
+    grp = group(40)
+    hs, secrets, tokens = sequence(40, 6)
+    chain = TokenChain("index-calculus", rng=1)
+    report = break_sequence(chain, grp, hs, tokens=tokens)
+    assert report.secrets == list(secrets)
+    assert report.keys[0].method == "index-calculus"
+    assert [k.method for k in report.keys[1:]] == ["token"] * 5
+    sk = SecretKey(grp, report.secrets[0], 0)
+    for t, token in enumerate(tokens):  # Proposition prop:vulnerability, the reference
+        sk = recover_next_secret_key(sk, token)
+        assert sk.s == report.secrets[t + 1]
+
+
+def test_token_chain_accepts_pairs_and_falls_back_to_the_inner_breaker() -> None:
+    grp = group(32)
+    hs, secrets, tokens = sequence(32, 4)
+    pre = TokenChain("rho", rng=1).precompute(grp)
+    pre.add_tokens([(tokens[1].h, tokens[1].d)])  # only sigma_1: keys 0 and 1 need the inner breaker
+    methods = [pre.break_key(h).method for h in hs]
+    assert methods == ["rho", "rho", "token", "rho"]
+    with pytest.raises(KeyMismatchError):
+        pre.add_tokens([(grp.p - 1, 1)])  # h = -1 is not in G
+    with pytest.raises(KeyMismatchError, match="outside"):
+        pre.add_tokens([(hs[0], grp.q)])
+    with pytest.raises(ParameterError, match="token"):
+        pre.add_tokens([object()])
+    with pytest.raises(ParameterError, match="itself"):
+        TokenChain("token-chain")
+
+
+def test_tokens_for_another_breaker_are_refused() -> None:
+    hs, _, tokens = sequence(24, 2)
+    with pytest.raises(ParameterError, match="token-chain"):
+        break_sequence("rho", group(24), hs, tokens=tokens)
+
+
+# ----------------------------------------------------------------------------- errors
+def test_wrong_result_is_an_error_never_a_key(monkeypatch: pytest.MonkeyPatch) -> None:
+    pre = get_breaker("rho", rng=1).precompute(TOY)
+    real = type(pre)._solve
+
+    def off_by_one(self, h, deadline, src):
+        s, ops, method = real(self, h, deadline, src)
+        return s + 1, ops, method
+
+    monkeypatch.setattr(type(pre), "_solve", off_by_one)
+    with pytest.raises(BreakerError, match="fails the check"):
+        pre.break_key(4)
+
+
+def test_keys_of_another_group_are_refused() -> None:
+    pre = precomputed("bsgs", 24)
+    with pytest.raises(KeyMismatchError, match="another group"):
+        pre.break_key(pre.group.p - 1)  # -1 is not a square modulo a safe prime p = 3 mod 4
+    with pytest.raises(KeyMismatchError):
+        pre.break_key(0)
+    with pytest.raises(KeyMismatchError):
+        pre.break_key("12")
+    hs, _, _ = sequence(32, 1)
+    with pytest.raises(KeyMismatchError):
+        break_sequence("rho", TOY, hs)
+    with pytest.raises(ParameterError, match="precomputation"):
+        get_breaker("rho").break_key(4, pre)
+
+
+def test_too_large_groups_are_refused_before_any_work(monkeypatch: pytest.MonkeyPatch) -> None:
+    for name in ("bsgs", "rho", "rho-multi", "index-calculus"):
+        cls = BREAKERS[name]
+        monkeypatch.setattr(cls, "_precompute", lambda *a, **k: pytest.fail("work started"))
+        with pytest.raises(BreakerLimitError, match="limit is") as err:
+            get_breaker(name).precompute(shipped_group(256))
+        assert "expected time" in str(err.value) and "256-bit" in str(err.value)
+    with pytest.raises(BreakerLimitError, match="max_table"):
+        BREAKERS["bsgs"](max_table=100).check_feasible(group(24))
+    with pytest.raises(BreakerLimitError):
+        TokenChain("rho", max_bits=20).precompute(group(24))
+    assert issubclass(BreakerLimitError, ParameterError)
+
+
+def test_index_calculus_needs_q_prime_to_the_cofactor() -> None:
+    # p = 19, q = 3: p - 1 = 18 = 2 * 3^2, so q divides the cofactor 6; g = 7 has order 3.
+    grp = GroupParams(19, 3, 7)
+    with pytest.raises(GroupError, match="cofactor"):
+        IndexCalculus().precompute(grp)
+    assert get_breaker("bsgs").precompute(grp).break_key(49 % 19).s == 2  # generic breakers do not care
+
+
+def test_time_limit_stops_a_breaker_with_a_clear_error() -> None:
+    grp = group(56)
+    hs, _, _ = sequence(56, 1)
+    pre = PollardRho(rng=1).precompute(grp)
+    with pytest.raises(BreakerTimeoutError, match="time limit of 0.05 s"):
+        pre.break_key(hs[0], time_limit=0.05)
+    with pytest.raises(BreakerTimeoutError, match="precomputation"):
+        IndexCalculus(rng=1).precompute(group(90), time_limit=0.05)
+    with pytest.raises(BreakerTimeoutError, match="before its linear algebra"):
+        IndexCalculus(rng=1, bound=30000).precompute(group(40), time_limit=2.0)  # 3245 unknowns: ~13 s
+    with pytest.raises(ParameterError):
+        Deadline(-1.0, "x")
+    assert issubclass(BreakerTimeoutError, (BreakerError, TimeoutError))
+
+
+@needs_pari
+def test_pari_time_limit_uses_an_alarm() -> None:
+    grp = group(104)
+    hs, _, _ = sequence(104, 1)
+    pre = get_breaker("pari").precompute(grp)
+    with pytest.raises(BreakerTimeoutError):
+        pre.break_key(hs[0], time_limit=0.5)
+    assert pre.break_key(4).s == 1  # PARI is usable after the alarm
+
+
+def test_missing_cypari_is_one_line_naming_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(pari_mod, "_PARI", None)
+    monkeypatch.setitem(sys.modules, "cypari", None)
+    with pytest.raises(OptionalDependencyError, match=r"pip install 'encctl-gym\[cryptanalysis\]'") as err:
+        get_breaker("pari").precompute(TOY)
+    assert "\n" not in str(err.value)
+    assert not pari_mod.pari_available()
+
+
+def test_unknown_breaker_and_bad_options() -> None:
+    with pytest.raises(ParameterError, match="registered"):
+        get_breaker("nfs")
+    with pytest.raises(ParameterError):
+        get_breaker("rho", max_bits=1)
+    with pytest.raises(ParameterError):
+        break_sequence("rho", "not a group", [4])
+
+
+def test_errors_belong_to_the_hierarchy() -> None:
+    for cls in (BreakerError, BreakerLimitError, BreakerTimeoutError, OptionalDependencyError):
+        assert issubclass(cls, EncctlError)
+    assert format_seconds(0.0021) == "2.1 ms" and format_seconds(86400 * 365.25 * 3) == "3 years"
+
+
+# ----------------------------------------------------------------------------- distribution
+def test_precomputations_pickle_without_their_random_source() -> None:
+    hs, secrets, _ = sequence(32, 2)
+    for name in ("bsgs", "rho-multi", "index-calculus"):
+        pre = precomputed(name, 32)
+        copy = pickle.loads(pickle.dumps(pre))
+        assert copy.rng is None
+        assert [copy.break_key(h, rng=1).s for h in hs] == list(secrets)
+
+
+def test_joblib_processes_give_the_same_keys() -> None:
+    hs, secrets, _ = sequence(32, 6)
+    report = break_sequence("index-calculus", group(32), hs, n_jobs=2)
+    assert report.secrets == list(secrets)
+
+
+def test_local_dask_cluster_gives_the_same_keys() -> None:
+    pytest.importorskip("distributed")
+    hs, secrets, _ = sequence(32, 6)
+    report = break_sequence(get_breaker("rho-multi", rng=1), group(32), hs, scheduler="local", n_jobs=2)
+    assert report.secrets == list(secrets)
+    with pytest.raises(ParameterError, match="main thread"):
+        break_sequence(BREAKERS["pari"](), group(32), hs, scheduler="local")
+
+
+def test_random_draws_cover_the_exponent_range() -> None:
+    rng = random.Random(0)
+    grp = group(24)
+    pre = precomputed("rho", 24)
+    for s in (1, 2, grp.q - 1, grp.q // 2, rng.randrange(1, grp.q)):
+        assert pre.break_key(int(gmpy2.powmod(grp.g, s, grp.p))).s == s

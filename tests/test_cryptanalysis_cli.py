@@ -1,0 +1,204 @@
+"""Tests of ``encctl-gym crack``, the deciphering-time experiment and the smoothness/linear-algebra
+helpers of the index calculus against independent computations."""
+
+from __future__ import annotations
+
+import json
+import math
+import random
+
+import mpmath
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from encctl_gym.cli import SUBCOMMANDS, main
+from encctl_gym.cryptanalysis import pari_available
+from encctl_gym.cryptanalysis.index_calculus import choose_bound, cost_model, relation_probability
+from encctl_gym.cryptanalysis.linalg import solve_mod_prime
+from encctl_gym.cryptanalysis.smoothness import FactorBase, dickman_rho, primes_up_to, rational_reconstruction
+from encctl_gym.errors import ParameterError
+from experiments import deciphering_time, reproduce
+
+
+# ----------------------------------------------------------------------------- crack
+def test_crack_is_registered() -> None:
+    assert SUBCOMMANDS["crack"][0] == "encctl_gym.cryptanalysis.cli"
+
+
+def test_crack_json_reports_checked_keys(capsys: pytest.CaptureFixture) -> None:
+    assert main(["crack", "--bits", "32", "--keys", "5", "--breaker", "index-calculus", "--json", "--seed", "3"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["breaker"] == "index-calculus" and out["bits"] == 32 and out["group_source"] == "fresh"
+    assert out["keys_match"] is True and len(out["keys"]) == 5
+    p, g = int(out["group"]["p"], 16), int(out["group"]["g"], 16)
+    for key in out["keys"]:
+        assert pow(g, int(key["s"], 16), p) == int(key["h"], 16)
+        assert key["seconds"] >= 0 and key["operations"]["smoothness_tests"] >= 1
+    assert out["T_first"] == pytest.approx(out["precomputation"]["seconds"] + out["keys"][0]["seconds"])
+
+
+def test_crack_table_on_a_shipped_group(capsys: pytest.CaptureFixture) -> None:
+    assert main(["crack", "--bits", "64", "--keys", "3", "--breaker", "token-chain", "--inner", "index-calculus",
+                 "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert "64-bit shipped group" in out and "T_first" in out and "token" in out
+    assert "all 3 keys checked" in out
+
+
+def test_crack_same_keys_on_a_local_dask_cluster(capsys: pytest.CaptureFixture) -> None:
+    pytest.importorskip("distributed")
+    args = ["crack", "--bits", "32", "--keys", "6", "--breaker", "rho-multi", "--json", "--seed", "1"]
+    assert main(args) == 0
+    serial = json.loads(capsys.readouterr().out)
+    assert main(args + ["--scheduler", "local", "--n-jobs", "2"]) == 0
+    dask = json.loads(capsys.readouterr().out)
+    assert [k["s"] for k in dask["keys"]] == [k["s"] for k in serial["keys"]]
+    assert dask["group"] == serial["group"]
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--bits", "128", "--breaker", "bsgs"], "limit is 56 bits"),
+        (["--bits", "40", "--keys", "0"], "keys"),
+        (["--bits", "40", "--time-limit", "-1"], "time-limit"),
+        (["--bits", "100", "--group", "shipped"], "no shipped group"),
+        (["--bits", "56", "--breaker", "rho", "--time-limit", "0.05", "--keys", "1"], "time limit"),
+    ],
+)
+def test_crack_errors_are_one_line_exit_2(capsys: pytest.CaptureFixture, args: list, message: str) -> None:
+    assert main(["crack", *args, "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("encctl-gym crack: error:") and message in err[0]
+
+
+# ----------------------------------------------------------------------------- experiment
+@pytest.fixture(scope="module")
+def quick_rows() -> list:
+    return deciphering_time.compute(deciphering_time.QUICK_PLAN, seed=0, n_jobs=1)
+
+
+def test_deciphering_time_rows_and_fit(quick_rows: list) -> None:
+    rows = quick_rows
+    assert all(set(r) == set(deciphering_time.COLUMNS) for r in rows)
+    breakers = {r["breaker"] for r in rows}
+    assert {"bsgs", "rho", "rho-multi", "index-calculus", "token-chain"} <= breakers
+    assert ("pari" in breakers) == pari_available()
+    for r in rows:
+        if r["kind"] == "sequence":
+            assert r["tau"] >= r["precompute"] + r["key_seconds"] - 1e-12
+    fits = deciphering_time.fit(rows)
+    assert {(f["breaker"], f["bits"]) for f in fits} == {(r["breaker"], r["bits"]) for r in rows}
+    for f in fits:
+        assert f["N_max"] == 8 and f["fresh"] == 1 and f["T_first"] > 0
+        seq = sorted((r for r in rows if r["breaker"] == f["breaker"] and r["bits"] == f["bits"]
+                      and r["kind"] == "sequence"), key=lambda r: r["N"])
+        slope, intercept = np.polyfit([r["N"] for r in seq], [r["tau"] for r in seq], 1)
+        assert f["T_1"] == pytest.approx(slope) and f["T_0"] == pytest.approx(intercept)
+        assert f["ratio"] == pytest.approx(f["T_1"] / f["T_first"])
+    assert deciphering_time.n_grid(64) == [1, 2, 4, 8, 16, 32, 64] and deciphering_time.n_grid(6) == [1, 2, 4, 6]
+
+
+def test_deciphering_time_csv_round_trip_and_plot(quick_rows: list, tmp_path) -> None:
+    path = deciphering_time.write_csv(quick_rows, tmp_path / "d.csv")
+    back = deciphering_time.read_csv(path)
+    assert [r["tau"] for r in back] == [r["tau"] for r in quick_rows]
+    assert [r["operations"] for r in back] == [r["operations"] for r in quick_rows]
+    png = deciphering_time.plot(back, tmp_path / "d.png")
+    assert png.stat().st_size > 10_000
+    assert "T_1/T_first" in deciphering_time.format_table(deciphering_time.fit(back))
+
+
+def test_deciphering_time_is_a_reproduce_step() -> None:
+    assert ("deciphering", "experiments.deciphering_time") in reproduce.STEPS
+
+
+def test_full_plan_covers_the_sizes_of_the_issue() -> None:
+    plan = deciphering_time.FULL_PLAN
+    largest = {b: max(p.bits for p in plan if p.breaker == b) for b in {p.breaker for p in plan}}
+    assert min(p.bits for p in plan) == 32
+    assert largest["pari"] >= 80 and largest["index-calculus"] >= 80
+    assert all(p.keys <= 64 for p in plan)
+
+
+# ----------------------------------------------------------------------------- helpers
+def test_dickman_rho_against_closed_forms_and_tables() -> None:
+    for u in (1.0, 1.3, 1.7, 2.0):
+        assert dickman_rho(u) == pytest.approx(1 - math.log(u), rel=1e-14)
+    for u in (2.2, 2.5, 2.9):  # rho = 1 - (1 - ln(u-1)) ln u + Li2(1 - u) + pi^2/12 on [2, 3]
+        exact = 1 - (1 - math.log(u - 1)) * math.log(u) + float(mpmath.polylog(2, 1 - u)) + math.pi**2 / 12
+        assert dickman_rho(u) == pytest.approx(exact, rel=1e-12)
+    # Tabulated values (e.g. Granville, "Smooth numbers", 2008).
+    for u, ref in ((3, 4.8608388291e-2), (4, 4.9109256477e-3), (5, 3.5472470045e-4), (10, 2.7701718377e-11)):
+        assert dickman_rho(u) == pytest.approx(ref, rel=1e-9)
+    assert dickman_rho(0.5) == 1.0
+    with pytest.raises(ParameterError):
+        dickman_rho(-1)
+    with pytest.raises(ParameterError):
+        dickman_rho(41)
+
+
+def test_dickman_rho_satisfies_its_integral_equation() -> None:
+    # u rho(u) = integral of rho over [u - 1, u]
+    for u in (3.3, 6.5, 12.0):
+        integral = float(mpmath.quad(dickman_rho, [u - 1, math.floor(u), u]))
+        assert u * dickman_rho(u) == pytest.approx(integral, rel=1e-9)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(min_value=1, max_value=2**80))
+def test_smoothness_test_agrees_with_trial_factorisation(x: int) -> None:
+    import sympy
+
+    fb = FactorBase(300)
+    factors = sympy.factorint(x)
+    smooth = all(ell <= 300 for ell in factors)
+    assert fb.is_smooth(x) == smooth == fb.is_smooth(-x)
+    if smooth:
+        assert fb.factor(x) == {fb.index[ell]: e for ell, e in factors.items()}
+    else:
+        assert fb.factor(x) is None
+
+
+def test_primes_up_to() -> None:
+    assert primes_up_to(30) == (2, 3, 5, 7, 11, 13, 17, 19, 23, 29)
+    assert len(primes_up_to(10**5)) == 9592
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.data())
+def test_rational_reconstruction_halves_the_size(data: st.DataObject) -> None:
+    p = data.draw(st.sampled_from([23, 1_000_003, 2**61 - 1, 340282366920938463463374607431768211297]))
+    y = data.draw(st.integers(min_value=1, max_value=p - 1))
+    a, b = rational_reconstruction(y, p)
+    assert b != 0 and (a - b * y) % p == 0
+    assert 0 < a <= math.isqrt(p)
+    assert abs(b) * math.isqrt(p) < p  # |b| < p / r_{i-1} with r_{i-1} > isqrt(p)
+
+
+def test_linear_algebra_solves_what_the_relations_determine() -> None:
+    q = 1_000_000_007
+    rng = random.Random(1)
+    x = [rng.randrange(q) for _ in range(6)]
+    rows = [{j: rng.randint(-3, 3) for j in range(5)} for _ in range(8)]  # x_5 never occurs
+    rows.append({4: 1, 5: 0})
+    rhs = [sum(c * x[j] for j, c in row.items()) % q for row in rows]
+    sol, rank = solve_mod_prime(rows, rhs, 7, q)
+    assert rank == 5 and sol[:5] == x[:5] and sol[5] is None and sol[6] is None
+    # x_0 + x_1 = c alone leaves both free; x_2 = d is determined
+    sol, rank = solve_mod_prime([{0: 1, 1: 1}, {2: 1}], [5, 9], 3, 11)
+    assert sol == [None, None, 9] and rank == 2
+    big = (1 << 89) - 1  # a Mersenne prime: the fmpz_mod_mat path
+    sol, _ = solve_mod_prime([{0: 2}, {0: 1, 1: 1}], [6, 10], 2, big)
+    assert sol == [3, 7]
+
+
+def test_cost_model_is_consistent() -> None:
+    for bits in (48, 80, 96):
+        bound = choose_bound(bits)
+        model = cost_model(bits, bound)
+        assert model["first"] == pytest.approx(model["relations"] + model["linear_algebra"] + model["descent"])
+        assert model["per_key"] < 0.05 * model["first"]
+        assert 1 / model["trials_per_relation"] == pytest.approx(relation_probability(bits, bound))
+    assert choose_bound(96) > choose_bound(64) > choose_bound(32)
