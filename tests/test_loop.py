@@ -86,6 +86,6 @@ def test_parties_of_the_elgamal_loop_hold_independent_randomness(scheme):
     loop.start_episode()
     sources = loop.random_sources
     draws = {name: tuple(src.below(2**62) for _ in range(4)) for name, src in sources.items()}
-    assert len(set(draws.values())) == 3
+    assert len(set(draws.values())) == len(sources) == 4  # plant, server, adversary, breaker
     assert not any(h is sources["plant"] or h is sources["adversary"] for h in _held(loop.server))
     assert not any(h is sources["server"] or h is sources["adversary"] for h in _held(loop.plant))

@@ -57,7 +57,7 @@ from ..crypto.group import GroupParams
 from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, GroupError
 from .base import Breaker, Deadline, Precomputation
 from .linalg import flint_backend, solve_mod_prime
-from .smoothness import FactorBase, dickman_rho, rational_reconstruction
+from .smoothness import RHO_MAX_U, FactorBase, dickman_rho, rational_reconstruction
 
 __all__ = [
     "IndexCalculus",
@@ -91,8 +91,12 @@ _CHECK_EVERY = 2048
 
 def relation_probability(bits: int, bound: float) -> float:
     """Probability that ``y = a / b`` (both about ``bits / 2`` bits) has a and b ``bound``-smooth:
-    ``rho(u)^2`` with ``u = (bits / 2) ln 2 / ln B`` (Dickman's rho, :func:`~.smoothness.dickman_rho`)."""
+    ``rho(u)^2`` with ``u = (bits / 2) ln 2 / ln B`` (Dickman's rho, :func:`~.smoothness.dickman_rho`);
+    0 past the range of the tabulated rho (``u > 40``, a probability below 1e-142), so that the
+    cost model of a group far beyond reach is infinite rather than an error."""
     u = (bits / 2) * math.log(2) / math.log(bound)
+    if u > RHO_MAX_U:
+        return 0.0
     return dickman_rho(u) ** 2
 
 

@@ -132,6 +132,12 @@ class PariZnlog(Breaker):
         per_key = PARI_C * math.exp(PARI_A * math.sqrt(lnp * math.log(max(lnp, 2.0))))
         return per_key, per_key
 
+    def check_feasible(self, group: GroupParams) -> None:
+        """The size limit, and the binding: a missing ``cypari`` is refused here, before any work
+        (:class:`~encctl_gym.errors.OptionalDependencyError`, one line naming the extra)."""
+        super().check_feasible(group)
+        _pari()
+
     def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[PariContext, Mapping[str, int]]:
         _pari()
         ctx = PariContext(group, self.rng)

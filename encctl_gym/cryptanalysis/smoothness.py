@@ -156,7 +156,8 @@ def rational_reconstruction(y: int, p: int, bound: Optional[int] = None) -> tupl
 
 # ----------------------------------------------------------------------------- Dickman rho
 _RHO_TERMS = 90
-_RHO_MAX_U = 40
+#: Largest u for which :func:`dickman_rho` is computed (rho(40) is about 1e-71).
+RHO_MAX_U = 40
 
 
 @lru_cache(maxsize=1)
@@ -170,7 +171,7 @@ def _rho_coefficients() -> tuple[tuple[float, ...], ...]:
     # positive terms (no cancellation, so rho keeps its relative precision down to 1e-70).
     # The c_i shrink like k^-i, so 90 terms reach double precision. k = 1: rho = 1.
     coeffs = [tuple([1.0] + [0.0] * (_RHO_TERMS - 1))]
-    for k in range(2, _RHO_MAX_U + 1):
+    for k in range(2, RHO_MAX_U + 1):
         d = coeffs[-1]
         c = [0.0] * _RHO_TERMS
         for i in range(1, _RHO_TERMS):
@@ -198,8 +199,8 @@ def dickman_rho(u: float) -> float:
         raise ParameterError(f"u must be a finite number >= 0, got {u!r}")
     if u <= 1:
         return 1.0
-    if u > _RHO_MAX_U:
-        raise ParameterError(f"dickman_rho is computed up to u = {_RHO_MAX_U}, got u = {u:g}")
+    if u > RHO_MAX_U:
+        raise ParameterError(f"dickman_rho is computed up to u = {RHO_MAX_U}, got u = {u:g}")
     k = math.ceil(u)
     xi = k - u
     c = _rho_coefficients()[k - 1]

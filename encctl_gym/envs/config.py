@@ -53,7 +53,10 @@ from ..loop import BACKENDS as _LOOP_BACKENDS
 from .layout import ObservationLayout
 from .rewards import REWARDS as _REWARD_CLASSES
 
-__all__ = ["default_config", "AttackParams", "resolve_params", "REWARDS", "BACKENDS"]
+__all__ = ["default_config", "AttackParams", "resolve_params", "REWARDS", "BACKENDS", "DECIPHERING_CLOCKS"]
+
+#: What the environment charges for deciphering: the cost model's tau(N), or the breaker's measured seconds.
+DECIPHERING_CLOCKS: tuple[str, ...] = ("model", "measured")
 
 #: Names of the rewards (:data:`encctl_gym.envs.rewards.REWARDS`) and backends (:data:`encctl_gym.loop.BACKENDS`).
 REWARDS: tuple[str, ...] = tuple(_REWARD_CLASSES)
@@ -80,6 +83,23 @@ def default_config() -> dict[str, Any]:
                                   ``"paper"`` (def:sdt: ``2^lambda`` per key), ``"precomputation"``
                                   (one GNFS precomputation per group, then a cheap step per key),
                                   ``"generic"`` (Pollard rho per key)
+    ``breaker``                   ``None`` (the break is simulated: the plant's key of the period
+                                  is read) or a key breaker of :mod:`encctl_gym.cryptanalysis`
+                                  (``"index-calculus"``, ``"pari"``, ``"rho-multi"``, ...): every
+                                  key paid for is broken for real and the states are decrypted
+                                  with the recovered exponents only; needs ``crypto="elgamal"``
+                                  and a group the breaker can break (the loop's group has
+                                  64 bits for ``key_length <= 64``: index calculus and PARI
+                                  break it in about 0.5 s, then about 1 ms resp. 0.1 s per key)
+    ``breaker_time_limit``        seconds (or a duration) the breaker may take for its
+                                  precomputation and for each key; a breaker expected to take
+                                  longer is refused when the environment is made
+    ``deciphering_clock``         ``"model"``: the time charged is the cost model's tau(N)
+                                  (deterministic, also with a breaker: the same numbers as
+                                  without); ``"measured"``: the wall seconds the breaker took on
+                                  this machine (not reproducible across machines; needs a
+                                  breaker and ``max_samples``; the episode terminates when the
+                                  time passes ``tau_c``)
     ``gnfs_correction``           o(1) correction of the GNFS cost in bits (0: the paper's; the
                                   documented alternative ``"guillevic"``, 11.91)
     ``upsilon``, ``tau_c``        attacker FLOPS and defense period in s or a duration such as
@@ -120,6 +140,9 @@ def default_config() -> dict[str, Any]:
         "key_length": None,
         "deciphering_model": "paper",
         "gnfs_correction": 0.0,
+        "breaker": None,
+        "breaker_time_limit": 60.0,
+        "deciphering_clock": "model",
         "upsilon": None,
         "tau_c": None,
         "gamma_c": None,
@@ -163,6 +186,7 @@ class AttackParams:
     horizon: int  # N: the attack length in samples
     independent_keys: bool  # every sample under its own key (def:sdt), else one break reveals all
     budget_limited: bool  # the horizon is set by tau_c (terminated) rather than max_samples (truncated)
+    #  (with deciphering_clock="measured" the horizon is max_samples; tau_c ends the episode when measured time passes it)
     decipher_delay: int | None  # None means "end"
     warmup_steps: int
     estimator: Any  # the estimator specification (a name or a mapping), checked
@@ -175,6 +199,9 @@ class AttackParams:
     input_history: int
     gamma_opt: bool
     crypto_seed: int | None
+    breaker: str | None  # None: the break is simulated (the plant's key is read)
+    breaker_time_limit: float
+    deciphering_clock: str  # "model" (tau(N) of the cost model) or "measured" (the breaker's wall seconds)
     tr_psi_u: float
     tr_psi_w: float
     sources: dict[str, str] = field(default_factory=dict)  # where A, B, the variances and design values came from
@@ -227,6 +254,24 @@ def _choice(name: str, value: Any, options: tuple[str, ...]) -> str:
     if not isinstance(value, str) or value not in options:
         raise ParameterError(f"unknown {name} {format_value(value)}; choose one of {', '.join(options)}")
     return value
+
+
+def _breaking(cfg: Mapping[str, Any], crypto: str) -> tuple[str | None, str, float]:
+    """The checked ``breaker``, ``deciphering_clock`` and ``breaker_time_limit`` (the breaker's
+    feasibility on the loop's group is checked when the backend is built)."""
+    from ..cryptanalysis.registry import BREAKERS as breakers
+
+    breaker = cfg["breaker"]
+    if breaker is not None:
+        breaker = _choice("breaker", breaker, tuple(breakers))
+        if crypto != "elgamal":
+            raise ParameterError(
+                f"breaker={breaker!r} needs crypto='elgamal': the {crypto} backend has no ciphertexts to break"
+            )
+    clock = _choice("deciphering_clock", cfg["deciphering_clock"], DECIPHERING_CLOCKS)
+    if clock == "measured" and breaker is None:
+        raise ParameterError("deciphering_clock='measured' needs a breaker: nothing is broken, so nothing is measured")
+    return breaker, clock, parse_duration(cfg["breaker_time_limit"], "breaker_time_limit")
 
 
 def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> AttackParams:
@@ -307,6 +352,7 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     estimator = cfg["estimator"]
     make_estimator(estimator).check_dimensions(A.shape[0], B.shape[1])  # an unknown or impossible estimator fails here
     crypto = _choice("crypto backend", cfg["crypto"], BACKENDS)
+    breaker, clock, breaker_limit = _breaking(cfg, crypto)
 
     n, m = A.shape[0], B.shape[1]
     psi_u = controllability_gramian(A, B)
@@ -343,6 +389,13 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     max_samples = cfg["max_samples"]
     if max_samples is not None:
         max_samples = check_int("max_samples", max_samples, minimum=1)
+    if clock == "measured":
+        if max_samples is None:
+            raise ParameterError(
+                "with deciphering_clock='measured' the number of samples tau_c buys is known only as the "
+                "keys are broken: set max_samples (the episode terminates earlier if the measured time passes tau_c)"
+            )
+        budget = math.inf  # the measured clock, not the model, ends the episode within tau_c
     if math.isinf(budget) and max_samples is None:
         raise ParameterError(
             f"with scheme={scheme!r} and adversary={adversary!r} one break reveals every sample, so the "
@@ -389,5 +442,6 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         u_max=action_scale * math.sqrt(sigma_u2),
         input_history=check_int("input_history", cfg["input_history"], minimum=0),
         gamma_opt=check_bool("gamma_opt", cfg["gamma_opt"]), crypto_seed=crypto_seed,
+        breaker=breaker, breaker_time_limit=breaker_limit, deciphering_clock=clock,
         tr_psi_u=tr_psi_u, tr_psi_w=tr_psi_w, sources=sources,
     )

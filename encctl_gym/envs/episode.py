@@ -219,7 +219,9 @@ class EpisodeCore:
         self.gamma_opt_table = np.full(N + 1, np.inf)
         if design is not None:
             self.gamma_opt_table[2:] = design.gamma(Ns[2:])
-        self.time_table = np.asarray(p.deciphering_time(Ns), dtype=np.float64)  # Definition def:sdt, under the model
+        # Definition def:sdt, under the model; with the measured clock, filled as the keys are broken
+        self._measured = p.deciphering_clock == "measured"
+        self.time_table = np.zeros(N + 1) if self._measured else np.asarray(p.deciphering_time(Ns), dtype=np.float64)
         self._time_frac = self.time_table / p.tau_c
         # the same tables as Python floats, for the per-step info scalars
         self._gamma_list, self._time_list = self.gamma_table.tolist(), self.time_table.tolist()
@@ -251,6 +253,7 @@ class EpisodeCore:
         est = make_estimator(p.estimator)
         self.estimator = None if isinstance(est, OrdinaryLeastSquares) else est
         self.collected = 0  # samples collected and paid for
+        self.expired = False  # the measured deciphering time passed tau_c (deciphering_clock="measured")
         self.delivered = 0  # samples delivered to the agent
         self.new = False
         self.done = False
@@ -417,6 +420,7 @@ class EpisodeCore:
             self.estimator.start(self.K, self.n, self.m)
         self.reward.reset(self)
         self.collected = self.delivered = 0
+        self.expired = False
         self.done = False
         self.history = []
         self._collect()
@@ -440,8 +444,21 @@ class EpisodeCore:
 
     # ----------------------------------------------------------------- step
     def _collect(self) -> None:
-        """Collect and pay for the state ciphertext of the current period."""
+        """Collect and pay for the state ciphertext of the current period.
+
+        With the measured clock the time paid is what the breaker took so far this episode; a
+        sample whose break ends past ``tau_c`` came too late: it is not counted, and the episode
+        has :attr:`expired`.
+        """
         self.X[self.collected] = self.loop.collect_state(self.x)
+        if self._measured:
+            spent = self.loop.deciphering_seconds
+            if spent > self.p.tau_c:
+                self.expired = True
+                return
+            self.time_table[self.collected + 1] = spent
+            self._time_frac[self.collected + 1] = spent / self.p.tau_c
+            self._time_list[self.collected + 1] = spent
         self.collected += 1
 
     def _sync_gram(self, upto: int) -> None:
@@ -602,7 +619,7 @@ class EpisodeCore:
         p = self.p
         act = self.check_actions(action)
         w = self._draw_noise()
-        ended = self.collected >= p.horizon
+        ended = self.collected >= p.horizon or self.expired
         if self._fused and self._all_ready and not ended:
             # steady state of the ideal backend: period, delivery, recursive LS, error, reward,
             # observation and info in one compiled call
@@ -647,11 +664,13 @@ class EpisodeCore:
             self.loop.tick()
             if not ended:
                 self._collect()
+                ended = self.expired  # the measured clock passed tau_c: the attack is over now
         self.reward.begin(self)
         self.new = self._deliver(final=ended)
         reward = self.reward.end(self)
         self.done = ended
-        return reward, ended and p.budget_limited, ended and not p.budget_limited
+        out_of_time = p.budget_limited or self.expired
+        return reward, ended and out_of_time, ended and not out_of_time
 
     # ----------------------------------------------------------------- observation and info
     def observation(self) -> np.ndarray:

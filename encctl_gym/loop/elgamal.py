@@ -5,10 +5,16 @@ def:modification (``scheme="modified"``), the conventional token-based dynamic k
 (``"token"``) or one fixed key pair (``"static"``). One copy.
 
 The parties hold their own randomness and nothing of each other's: the plant (keys, state
-encryptions), the controller server (the token scheme's CtUpd re-randomisation) and the
-adversary (the randomness of its forged ciphertexts). With ``crypto_seed`` the three streams are
-derived from it independently (``numpy.random.SeedSequence`` children), so a run is
-reproducible and still no party can recompute another's draws from its own.
+encryptions), the controller server (the token scheme's CtUpd re-randomisation), the
+adversary (the randomness of its forged ciphertexts) and the adversary's key breaker (its
+walks and descents, a stream of its own so that breaking changes none of the other draws). With
+``crypto_seed`` the streams are derived from it independently (``numpy.random.SeedSequence``
+children), so a run is reproducible and still no party can recompute another's draws from its own.
+
+The adversary reads the state ciphertexts it paid for through a decipherer
+(:mod:`encctl_gym.attacks.decipherer`): by default the plant's key of the period (the break is
+simulated), with ``breaker=...`` the exponent a real discrete-logarithm attack recovers from
+the period's public key.
 """
 
 from __future__ import annotations
@@ -23,7 +29,7 @@ from .backend import lqr_gain
 __all__ = ["ElGamalLoop", "party_random_sources"]
 
 #: The parties of the loop that draw randomness, in the order their seeded streams are spawned.
-PARTIES = ("plant", "server", "adversary")
+PARTIES = ("plant", "server", "adversary", "breaker")
 
 
 def party_random_sources(crypto_seed: int | None) -> dict[str, Any]:
@@ -56,7 +62,15 @@ class ElGamalLoop:
     update token and CtUpds Phi's ciphertexts. ``"static"``: one key pair, never updated.
 
     The adversary's break of a state ciphertext (paid for in time by the environment) is
-    simulated by decrypting with the plant's key of that period.
+    done by :attr:`decipherer`: simulated by decrypting with the plant's key of that period
+    (default), or a real break of the period's public key with ``params.breaker``
+    (:class:`~encctl_gym.attacks.decipherer.KeyBreaking`: then nothing of the plant's is read).
+
+    Raises
+    ------
+    BreakerLimitError
+        With a breaker the group is too large for, or whose expected time exceeds
+        ``params.breaker_time_limit`` (before any work).
     """
 
     batched = False
@@ -75,6 +89,10 @@ class ElGamalLoop:
         self.Phi = -lqr_gain(params.A, params.B)
         #: each party's random source (privileged: who holds which randomness), see :func:`party_random_sources`
         self.random_sources = party_random_sources(params.crypto_seed)
+        from ..attacks.decipherer import make_decipherer
+
+        #: how the adversary obtains the exponent of each period's key (:mod:`encctl_gym.attacks.decipherer`)
+        self.decipherer = make_decipherer(params, group, lambda: self.plant.secret_key, self.random_sources["breaker"])
         self.plant: Any = None
         self.server: Any = None
         self.last_state_ciphertexts: list[Any] | None = None
@@ -86,6 +104,7 @@ class ElGamalLoop:
 
         quant = QuantizedLinearController(self.Phi, self.encoder, self.params.x_bound)
         self.plant, self.server = self._scheme.parties(quant, self.random_sources["plant"], self.random_sources["server"])
+        self.decipherer.start_episode()
 
     @staticmethod
     def _single(v: np.ndarray) -> np.ndarray:
@@ -95,12 +114,19 @@ class ElGamalLoop:
 
     def collect_state(self, x: np.ndarray) -> np.ndarray:
         """Encrypt ``x_t`` under ``pk_t`` (what the server and an eavesdropper receive) and
-        return what breaking those ciphertexts reveals: ``Dcd(Dec(sk_t, ct))``."""
-        from ..crypto.elgamal import decrypt
+        return what breaking those ciphertexts reveals: ``Dcd(Dec(s_t, ct))`` with the exponent
+        ``s_t`` of :attr:`decipherer`."""
+        from ..crypto.elgamal import decrypt_components
 
-        self.last_state_ciphertexts = self.plant.encrypt_state(self._single(x))
-        sk_t = self.plant.secret_key
-        return np.array([[self.encoder.decode(decrypt(sk_t, ct)) for ct in self.last_state_ciphertexts]])
+        pk = self.plant.pk
+        cts = self.last_state_ciphertexts = self.plant.encrypt_state(self._single(x))
+        s_t = self.decipherer.secret(pk)
+        return np.array([[self.encoder.decode(decrypt_components(self.group, s_t, ct.c1, ct.c2)) for ct in cts]])
+
+    @property
+    def deciphering_seconds(self) -> float:
+        """Wall seconds the decipherer's breaks took this episode (0 when the break is simulated)."""
+        return float(self.decipherer.seconds)
 
     def control(self, x: np.ndarray) -> np.ndarray:
         """A full period of normal operation: encrypt, server evaluation (eq:ec), decrypt, Sum,
@@ -126,3 +152,5 @@ class ElGamalLoop:
         token = self.plant.update_keys()
         if self._scheme.token_to_server:
             self.server.receive_token(token)
+            if self.params.adversary == "server":  # the malicious server sees what it receives
+                self.decipherer.observe_token(token)
