@@ -88,6 +88,8 @@ __all__ = [
     "write_csv",
     "read_csv",
     "plot",
+    "model_curves",
+    "plot_models",
     "add_arguments",
     "run",
     "main",
@@ -350,6 +352,89 @@ def plot(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
     return path
 
 
+def model_curves(bits: Sequence[int], n: Sequence[int], *, model_bits: int) -> dict[str, dict[str, np.ndarray]]:
+    """What each deciphering-cost model of :mod:`encctl_gym.security.cost_models` predicts, in the
+    units the measurements can be compared with (ratios: the models count abstract operations):
+
+    ``ratio``: ``T_1 / T_first`` of a key length, ``C_next / C_first`` (nan where the model's
+    formula is not valid, the GNFS models below 40 bits); ``tau``: ``tau(N) / T_first`` at
+    ``model_bits``, ``(C_first + (N - 1) C_next) / C_first``.
+    """
+    from encctl_gym.errors import ModelRangeError
+    from encctl_gym.security.cost_models import DECIPHERING_MODELS, deciphering_model
+
+    out: dict[str, dict[str, np.ndarray]] = {}
+    n_arr = np.asarray(n, dtype=float)
+    for name in DECIPHERING_MODELS:
+        model = deciphering_model(name)
+        ratio = []
+        for k in bits:
+            try:
+                c = model.break_cost(int(k))
+            except ModelRangeError:
+                ratio.append(float("nan"))
+            else:
+                ratio.append(float(c.next / c.first))
+        c = model.break_cost(int(model_bits))
+        r = float(c.next / c.first)
+        out[name] = {"ratio": np.array(ratio), "tau": 1.0 + (n_arr - 1.0) * r}
+    return out
+
+
+def plot_models(rows: Sequence[dict[str, Any]], path: str | Path, *, model_bits: int = 64) -> Path:
+    """The measured deciphering time overlaid on each cost model (issue 13), in one figure.
+
+    Left: ``T_1 / T_first`` against the bit length, measured per breaker (markers) and predicted
+    by the ``paper``, ``precomputation`` and ``generic`` models (lines). Right: ``tau(N) / T_first``
+    of each breaker's largest size against N, with the models' ``tau(N) / T_first`` at
+    ``model_bits``. Ratios only: the models count abstract operations, the breakers CPU seconds.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fits = fit(rows)
+    breakers = list(dict.fromkeys(r["breaker"] for r in rows))
+    all_bits = sorted({int(f["bits"]) for f in fits})
+    grid_bits = np.arange(min(all_bits), max(all_bits) + 1)
+    n_max = max(int(r["N"]) for r in rows)
+    n_line = np.unique(np.geomspace(1, n_max, 50).round())
+    curves = model_curves(grid_bits, n_line, model_bits=model_bits)
+    styles = {"paper": ("k", "-"), "precomputation": ("tab:red", "--"), "generic": ("tab:gray", ":")}
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 5.8))
+    for breaker in breakers:
+        mine = sorted((f for f in fits if f["breaker"] == breaker), key=lambda f: f["bits"])
+        ratio = np.array([f["ratio"] for f in mine])
+        ax1.semilogy([f["bits"] for f in mine], np.where(ratio > 0, ratio, np.nan), "o", ms=5, label=f"measured: {breaker}")
+        bits = max(f["bits"] for f in mine)
+        t_first = next(f["T_first"] for f in mine if f["bits"] == bits)
+        seq = sorted((r for r in rows if r["breaker"] == breaker and int(r["bits"]) == bits and r["kind"] == "sequence"),
+                     key=lambda r: int(r["N"]))
+        ax2.loglog([int(r["N"]) for r in seq], [float(r["tau"]) / t_first for r in seq], "o-", ms=3, lw=1.2,
+                   label=f"{breaker}, {bits} bits")
+    for name, (color, ls) in styles.items():
+        if name not in curves:
+            continue
+        ax1.semilogy(grid_bits, curves[name]["ratio"], color=color, ls=ls, lw=1.6, label=f"model: {name}")
+        ax2.loglog(n_line, curves[name]["tau"], color=color, ls=ls, lw=1.6, label=f"model: {name} ({model_bits} bits)")
+    ax1.set_xlabel("bit length of $p$")
+    ax1.set_ylabel("$T_1 / T_{first}$")
+    ax1.set_title("each further key relative to the first: breakers (markers) and cost models (lines)", fontsize=9)
+    ax1.grid(True, which="both", alpha=0.3)
+    ax1.legend(fontsize=7, ncol=3, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.14))
+    ax2.set_xlabel("keys broken $N$")
+    ax2.set_ylabel(r"$\tau(N) / T_{first}$")
+    ax2.set_title(r"$\tau(N)$ of one dynamic-key sequence, in units of one key from scratch", fontsize=9)
+    ax2.grid(True, which="major", alpha=0.3)
+    ax2.legend(fontsize=7, ncol=3, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.14))
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
 def format_table(fits: Sequence[dict[str, Any]]) -> str:
     """The measured table: bits, breaker, T_first, T_1, T_1 / T_first, and each breaker's largest size."""
     largest = {}
@@ -364,24 +449,36 @@ def format_table(fits: Sequence[dict[str, Any]]) -> str:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Command-line options (``--out --quick --seed --n-jobs --scheduler --no-progress``)."""
+    """Command-line options (``--out --quick --seed --n-jobs --scheduler --no-progress --from-csv``)."""
     add_common_arguments(parser)
+    parser.add_argument(
+        "--from-csv", default=None, metavar="PATH",
+        help="redraw the figures and the table from a recorded deciphering_time.csv instead of measuring",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
-    """Compute, save ``deciphering_time.csv``, ``deciphering_time_fit.csv`` and ``.png``; print the table."""
+    """Compute (or read ``--from-csv``), save ``deciphering_time.csv``, ``deciphering_time_fit.csv``,
+    ``deciphering_time.png`` and ``deciphering_models.png``; print the table."""
     out = ensure_out_dir(args.out)
     t0 = time.perf_counter()
-    rows = compute(QUICK_PLAN if args.quick else FULL_PLAN, seed=args.seed, n_jobs=args.n_jobs,
-                   scheduler=args.scheduler, progress=not args.no_progress)
+    source = getattr(args, "from_csv", None)
+    if source is not None:
+        if not Path(source).is_file():
+            raise ParameterError(f"--from-csv: no such file {source!r}")
+        rows = read_csv(source)
+    else:
+        rows = compute(QUICK_PLAN if args.quick else FULL_PLAN, seed=args.seed, n_jobs=args.n_jobs,
+                       scheduler=args.scheduler, progress=not args.no_progress)
     elapsed = time.perf_counter() - t0
     fits = fit(rows)
     csv_path = write_csv(rows, out / "deciphering_time.csv")
     fit_path = write_csv(fits, out / "deciphering_time_fit.csv", FIT_COLUMNS)
     png_path = plot(rows, out / "deciphering_time.png")
-    print(f"Deciphering time: {len(rows)} rows in {elapsed:.1f} s")
+    models_path = plot_models(rows, out / "deciphering_models.png")
+    print(f"Deciphering time: {len(rows)} rows in {elapsed:.1f} s" + (f" (read from {source})" if source else ""))
     print(format_table(fits))
-    for path in (csv_path, fit_path, png_path):
+    for path in (csv_path, fit_path, png_path, models_path):
         print(f"  wrote {path}")
     return 0
 

@@ -202,3 +202,33 @@ def test_cost_model_is_consistent() -> None:
         assert model["per_key"] < 0.05 * model["first"]
         assert 1 / model["trials_per_relation"] == pytest.approx(relation_probability(bits, bound))
     assert choose_bound(96) > choose_bound(64) > choose_bound(32)
+
+
+def test_model_curves_against_hand_computation() -> None:
+    """paper and generic charge every key in full; the precomputation model's ratio at 64 bits is
+    C_key / (C_pre + C_key) with C_pre = Omega(64) (eq:opt_key's GNFS formula, written out here)
+    and C_key = max(1, C_pre 2^-r), r the 768-bit record's ratio: 5300 core-years of 365 days
+    against 2 core-days per further logarithm."""
+    import math
+
+    curves = deciphering_time.model_curves([32, 64], [1, 2, 64], model_bits=64)
+    assert np.allclose(curves["paper"]["tau"], [1, 2, 64]) and np.allclose(curves["generic"]["tau"], [1, 2, 64])
+    assert math.isnan(curves["paper"]["ratio"][0])  # the GNFS formula starts at 40 bits
+    assert curves["generic"]["ratio"][0] == 1.0
+    ln_p = 64 * math.log(2)
+    c_pre = math.exp((64 / 9) ** (1 / 3) * ln_p ** (1 / 3) * math.log(ln_p) ** (2 / 3))
+    c_key = max(1.0, c_pre / (5300 * 365 / 2))
+    ratio = c_key / (c_pre + c_key)
+    assert curves["precomputation"]["ratio"][1] == pytest.approx(ratio, rel=1e-9)
+    assert curves["precomputation"]["tau"][2] == pytest.approx(1 + 63 * ratio, rel=1e-9)
+
+
+def test_models_figure_and_from_csv(quick_rows: list, tmp_path) -> None:
+    path = deciphering_time.write_csv(quick_rows, tmp_path / "rec.csv")
+    png = deciphering_time.plot_models(quick_rows, tmp_path / "m.png", model_bits=40)
+    assert png.stat().st_size > 10_000
+    out = tmp_path / "redraw"
+    assert deciphering_time.main(["--from-csv", str(path), "--out", str(out), "--no-progress"]) == 0
+    assert (out / "deciphering_models.png").is_file()
+    assert (out / "deciphering_time.csv").read_text() == path.read_text()
+    assert deciphering_time.main(["--from-csv", str(tmp_path / "missing.csv"), "--out", str(out)]) == 2
