@@ -382,7 +382,7 @@ def model_curves(bits: Sequence[int], n: Sequence[int], *, model_bits: int) -> d
 
 
 def plot_models(rows: Sequence[dict[str, Any]], path: str | Path, *, model_bits: int = 64) -> Path:
-    """The measured deciphering time overlaid on each cost model (issue 13), in one figure.
+    """The measured deciphering time overlaid on each cost model, in one figure.
 
     Left: ``T_1 / T_first`` against the bit length, measured per breaker (markers) and predicted
     by the ``paper``, ``precomputation`` and ``generic`` models (lines). Right: ``tau(N) / T_first``
