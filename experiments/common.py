@@ -323,6 +323,33 @@ def run_figure(args: argparse.Namespace, compute: Callable[..., "Table"], plot: 
     return 0
 
 
+def entry_point(
+    name: str, doc: str | None, add_arguments: Callable[[argparse.ArgumentParser], None],
+    run: Callable[[argparse.Namespace], int],
+) -> Callable[..., int]:
+    """The ``main(argv=None) -> int`` of the experiment script ``experiments/<name>.py``
+    (:func:`script_main` over its options and its run)."""
+
+    def main(argv: Sequence[str] | None = None) -> int:
+        return script_main(name, doc, add_arguments, run, argv)
+
+    main.__doc__ = f"Entry point of ``python experiments/{name}.py``."
+    return main
+
+
+def figure_entry_points(
+    stem: str, label: str, compute: Callable[..., "Table"], plot: Callable[..., Path], doc: str | None
+) -> tuple[Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int], Callable[..., int]]:
+    """``add_arguments``, ``run`` and ``main`` of a figure script: the common options, then
+    :func:`run_figure` (``<stem>.csv`` and ``<stem>.png`` under ``--out``)."""
+
+    def run(args: argparse.Namespace) -> int:
+        return run_figure(args, compute, plot, stem, label)
+
+    run.__doc__ = f"Compute, save ``{stem}.csv`` and ``.png`` under ``args.out``; print the paths."
+    return add_common_arguments, run, entry_point(stem, doc, add_common_arguments, run)
+
+
 def script_main(
     name: str,
     doc: str | None,

@@ -66,14 +66,14 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 import numpy as np
 
-from encctl_gym.crypto import arith
-from encctl_gym.crypto.group import generate_safe_prime_group
 from encctl_gym.cryptanalysis import get_breaker, pari_available
 from encctl_gym.cryptanalysis.cli import key_sequence
 from encctl_gym.cryptanalysis.sequence import break_sequence
+from encctl_gym.crypto import arith
+from encctl_gym.crypto.group import generate_safe_prime_group
 from encctl_gym.errors import BreakerError, ParameterError
 from encctl_gym.parallel import child_seeds, run_tasks
-from experiments.common import add_common_arguments, ensure_out_dir, script_main
+from experiments.common import add_common_arguments, ensure_out_dir, entry_point
 
 __all__ = [
     "Plan",
@@ -483,9 +483,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``python experiments/deciphering_time.py``."""
-    return script_main("deciphering_time", __doc__, add_arguments, run, argv)
+main = entry_point("deciphering_time", __doc__, add_arguments, run)
 
 
 if __name__ == "__main__":

@@ -34,7 +34,7 @@ from encctl_gym.presets import PAPER_DESIGN_PARAMETERS, PAPER_REPORTED, get_pres
 from encctl_gym.security.cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION
 from encctl_gym.security.design import SecurityDesign, design_security_parameter, paper_design_example
 from encctl_gym.security.key_length import KeyLengthDesign, KeyValue, design_key_length, key_length_value
-from experiments.common import add_common_arguments, ensure_out_dir, script_main
+from experiments.common import add_common_arguments, ensure_out_dir, entry_point
 
 __all__ = [
     "PAPER_VALUES",
@@ -189,9 +189,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``python experiments/design_example.py``."""
-    return script_main("design_example", __doc__, add_arguments, run, argv)
+main = entry_point("design_example", __doc__, add_arguments, run)
 
 
 if __name__ == "__main__":

@@ -17,10 +17,9 @@ Usage: ``python experiments/fig1_variance_ratio.py [--quick] [--out DIR] [--seed
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -31,12 +30,10 @@ from experiments.common import (
     FULL,
     GridConfig,
     Table,
-    add_common_arguments,
+    figure_entry_points,
     figure_table,
     panel_figure,
     preset_spec,
-    run_figure,
-    script_main,
 )
 
 __all__ = ["PANELS", "panel_systems", "compute", "plot", "add_arguments", "run", "main"]
@@ -85,19 +82,9 @@ def plot(table: Table, path: str | Path) -> Path:
     )
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Command-line options (``--out --quick --seed --n-jobs --scheduler --no-progress``)."""
-    add_common_arguments(parser)
-
-
-def run(args: argparse.Namespace) -> int:
-    """Compute, save ``fig1_variance_ratio.csv`` and ``.png`` under ``args.out``; print the paths."""
-    return run_figure(args, compute, plot, "fig1_variance_ratio", "Figure 1")
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``python experiments/fig1_variance_ratio.py``."""
-    return script_main("fig1_variance_ratio", __doc__, add_arguments, run, argv)
+#: the command-line options (``--out --quick --seed --n-jobs --scheduler --no-progress``),
+#: the run (``fig1_variance_ratio.csv`` and ``.png`` under ``--out``) and ``main``
+add_arguments, run, main = figure_entry_points("fig1_variance_ratio", "Figure 1", compute, plot, __doc__)
 
 
 if __name__ == "__main__":

@@ -17,10 +17,9 @@ Usage: ``python experiments/fig2_gramian.py [--quick] [--out DIR] [--seed S] [--
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -31,12 +30,10 @@ from experiments.common import (
     FULL,
     GridConfig,
     Table,
-    add_common_arguments,
+    figure_entry_points,
     figure_table,
     panel_figure,
     preset_spec,
-    run_figure,
-    script_main,
 )
 
 __all__ = ["PSI_U", "PANELS", "panel_systems", "compute", "plot", "add_arguments", "run", "main"]
@@ -90,19 +87,9 @@ def plot(table: Table, path: str | Path) -> Path:
     )
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Command-line options (``--out --quick --seed --n-jobs --scheduler --no-progress``)."""
-    add_common_arguments(parser)
-
-
-def run(args: argparse.Namespace) -> int:
-    """Compute, save ``fig2_gramian.csv`` and ``.png`` under ``args.out``; print the paths."""
-    return run_figure(args, compute, plot, "fig2_gramian", "Figure 2")
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``python experiments/fig2_gramian.py``."""
-    return script_main("fig2_gramian", __doc__, add_arguments, run, argv)
+#: the command-line options (``--out --quick --seed --n-jobs --scheduler --no-progress``),
+#: the run (``fig2_gramian.csv`` and ``.png`` under ``--out``) and ``main``
+add_arguments, run, main = figure_entry_points("fig2_gramian", "Figure 2", compute, plot, __doc__)
 
 
 if __name__ == "__main__":

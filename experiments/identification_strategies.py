@@ -62,7 +62,7 @@ from encctl_gym.ident.registry import estimator_names, make_estimator
 from encctl_gym.security.design import minimum_key_length, optimal_security_parameter, sample_size_for_rate
 from encctl_gym.sim.montecarlo import log_grid
 from experiments.attackers_vs_bounds import Setting, attackers_for, bound_rows, find_runs, fit_rate, make_setting
-from experiments.common import add_common_arguments, ensure_out_dir, script_main
+from experiments.common import add_common_arguments, ensure_out_dir, entry_point
 
 __all__ = [
     "DEFAULT_SYSTEMS",
@@ -553,9 +553,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``python experiments/identification_strategies.py``."""
-    return script_main("identification_strategies", __doc__, add_arguments, run, argv)
+main = entry_point("identification_strategies", __doc__, add_arguments, run)
 
 
 if __name__ == "__main__":

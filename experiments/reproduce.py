@@ -16,12 +16,11 @@ import importlib
 import sys
 import time
 from pathlib import Path
-from typing import Sequence
 
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from experiments.common import add_common_arguments, script_main
+from experiments.common import add_common_arguments, entry_point
 
 __all__ = ["STEPS", "add_arguments", "run", "main"]
 
@@ -59,9 +58,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``python experiments/reproduce.py``."""
-    return script_main("reproduce", __doc__, add_arguments, run, argv)
+main = entry_point("reproduce", __doc__, add_arguments, run)
 
 
 if __name__ == "__main__":

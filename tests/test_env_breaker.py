@@ -1,4 +1,4 @@
-"""The environment breaks the keys for real (issue 12): ``breaker=...`` and ``deciphering_clock``.
+"""The environment breaks the keys for real: ``breaker=...`` and ``deciphering_clock``.
 
 The loop's group for ``key_length = 64`` is the shipped 64-bit group, which the index calculus
 breaks in about half a second (then about a millisecond per key).
