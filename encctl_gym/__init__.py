@@ -8,50 +8,12 @@ Systems Against Eavesdropper and Malicious Server" (arXiv 2303.13059).
 
 from __future__ import annotations
 
-from .errors import (
-    BreakerError,
-    BreakerLimitError,
-    BreakerTimeoutError,
-    BudgetError,
-    CiphertextError,
-    ConfigError,
-    EncctlError,
-    EncodingOverflowError,
-    GroupError,
-    KeyMismatchError,
-    ModelRangeError,
-    OptionalDependencyError,
-    ParameterError,
-    PlaintextError,
-    ResourceLimitError,
-    ShapeError,
-    SolverError,
-    UnstableSystemError,
-)
+from . import errors
+from .errors import *  # noqa: F401,F403  (the error hierarchy, at the top level)
 
 __version__ = "0.1.0"
 
-__all__ = [
-    "__version__",
-    "EncctlError",
-    "ParameterError",
-    "ShapeError",
-    "UnstableSystemError",
-    "GroupError",
-    "KeyMismatchError",
-    "PlaintextError",
-    "CiphertextError",
-    "EncodingOverflowError",
-    "SolverError",
-    "BudgetError",
-    "ConfigError",
-    "ModelRangeError",
-    "ResourceLimitError",
-    "BreakerError",
-    "BreakerLimitError",
-    "BreakerTimeoutError",
-    "OptionalDependencyError",
-]
+__all__ = ["__version__", *errors.__all__]
 
 
 from .registration import register_when_gymnasium_loads

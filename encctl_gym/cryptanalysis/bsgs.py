@@ -15,7 +15,7 @@ p < 2^64 (and by default to 56 bits, where the table holds 2^27.5 entries: about
 from __future__ import annotations
 
 import math
-from typing import ClassVar, Mapping, Optional
+from typing import Any, ClassVar, Mapping, Optional
 
 import gmpy2
 import numpy as np
@@ -35,6 +35,17 @@ SECONDS_PER_STEP = 3.0e-7
 
 _CHUNK = 1 << 14
 
+
+
+def _powers(y: Any, step: Any, p: Any, n: int) -> tuple[np.ndarray, Any]:
+    """``y, y step, ..., y step^(n-1)`` modulo p as uint64 (p below 2^64), and ``y step^n``:
+    the baby steps of the table, or the giant steps of a key."""
+    out = []
+    append = out.append
+    for _ in range(n):
+        append(int(y))
+        y = y * step % p
+    return np.array(out, dtype=np.uint64), y
 
 class BabyStepTable(Precomputation):
     """The baby steps ``g^j`` (``0 <= j < m``) sorted by residue, and ``g^-m``.
@@ -66,12 +77,7 @@ class BabyStepTable(Precomputation):
         table, last = self.residues, len(self.residues) - 1
         while steps < n_giant:
             n = min(_CHUNK, n_giant - steps)
-            batch = []
-            append = batch.append
-            for _ in range(n):
-                append(int(y))
-                y = y * giant % p
-            values = np.array(batch, dtype=np.uint64)
+            values, y = _powers(y, giant, p, n)
             pos = np.minimum(np.searchsorted(table, values), last)
             hits = np.flatnonzero(table[pos] == values)
             if hits.size:
@@ -136,12 +142,7 @@ class BabyStepGiantStep(Breaker):
         done = 0
         while done < m:
             n = min(_CHUNK, m - done)
-            batch = []
-            append = batch.append
-            for _ in range(n):
-                append(int(y))
-                y = y * g % p
-            residues[done:done + n] = batch
+            residues[done:done + n], y = _powers(y, g, p, n)
             done += n
             deadline.check()
         order = np.argsort(residues, kind="stable")
