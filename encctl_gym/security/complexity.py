@@ -165,23 +165,14 @@ def sic_asymptotic_from_traces(
 ) -> float | np.ndarray:
     """Large-sample complexity eq:sic2 (Corollary of Theorem thm:sic) from the Gramian traces.
 
-    ``gamma(N) = (m+n) / ((N-1) [R_sigma (tr Psi_u + m) + tr Psi_w])``.
+    ``gamma(N) = (m+n) / ((N-1) [R_sigma (tr Psi_u + m) + tr Psi_w])``, of the shape of ``N``.
 
     Parameters
     ----------
-    N : int or array_like of int
-        Sample size(s), integers >= 2.
-    tr_psi_u, tr_psi_w : float
-        Traces of ``Psi_u`` (>= 0) and ``Psi_w`` (> 0).
-    m, n : int
-        Input and state dimensions.
+    N, tr_psi_u, tr_psi_w, m, n
+        As in :func:`sic_from_traces`.
     r_sigma : float
         ``R_sigma = sigma_u2 / sigma_w2 > 0``.
-
-    Returns
-    -------
-    float or ndarray
-        Same shape as ``N``.
     """
     Nf, scalar = check_sample_size(N)
     m, n = _check_dims(m, n)
@@ -196,14 +187,10 @@ def sample_identifying_complexity(
 
     Parameters
     ----------
-    N : int or array_like of int
-        Sample size(s), integers >= 2.
     A, B : array_like, shapes (n, n) and (n, m)
         Plant of eq:system; ``A`` Schur stable.
-    sigma_u2, sigma_w2 : float
-        Variances (> 0) of the i.i.d. Gaussian attack input and of the noise.
-    sigma_x2 : float, default 1.0
-        Variance (>= 0) of x_0.
+    N, sigma_u2, sigma_w2, sigma_x2
+        As in :func:`sic_from_traces` (the attack input is i.i.d. Gaussian).
 
     Returns
     -------
@@ -214,52 +201,31 @@ def sample_identifying_complexity(
     ------
     UnstableSystemError, ShapeError, ParameterError
     """
-    A, B = check_system(A, B)
-    n, m = B.shape
-    tr_u = float(np.trace(controllability_gramian(A, B)))
-    tr_w = float(np.trace(noise_gramian(A)))
+    tr_u, tr_w, m, n = _traces(A, B)
     return sic_from_traces(N, tr_u, tr_w, m, n, sigma_u2, sigma_w2, sigma_x2)
 
 
 def sample_identifying_complexity_asymptotic(N: Any, A: Any, B: Any, *, r_sigma: float) -> float | np.ndarray:
     """Large-sample complexity eq:sic2 of the plant ``(A, B)``.
 
-    Parameters
-    ----------
-    N : int or array_like of int
-        Sample size(s), integers >= 2.
-    A, B : array_like, shapes (n, n) and (n, m)
-        Plant of eq:system; ``A`` Schur stable.
-    r_sigma : float
-        ``R_sigma = sigma_u2 / sigma_w2 > 0``.
-
-    Returns
-    -------
-    float or ndarray
-        Same shape as ``N``.
+    ``N``, ``A``, ``B`` as in :func:`sample_identifying_complexity`, ``r_sigma`` as in
+    :func:`sic_asymptotic_from_traces`; the result has the shape of ``N``.
     """
+    tr_u, tr_w, m, n = _traces(A, B)
+    return sic_asymptotic_from_traces(N, tr_u, tr_w, m, n, r_sigma)
+
+
+def _traces(A: Any, B: Any) -> tuple[float, float, int, int]:
+    """``tr Psi_u``, ``tr Psi_w``, m and n of the plant ``(A, B)`` (checked)."""
     A, B = check_system(A, B)
     n, m = B.shape
-    tr_u = float(np.trace(controllability_gramian(A, B)))
-    tr_w = float(np.trace(noise_gramian(A)))
-    return sic_asymptotic_from_traces(N, tr_u, tr_w, m, n, r_sigma)
+    return float(np.trace(controllability_gramian(A, B))), float(np.trace(noise_gramian(A))), m, n
 
 
 def input_upper_bound(N: Any, m: int, n: int, r_sigma: float) -> float | np.ndarray:
     """Upper bound eq:bound of eq:sic2 as ``tr Psi_u -> 0``: ``(m+n) / ((N-1) m R_sigma)``.
 
-    Parameters
-    ----------
-    N : int or array_like of int
-        Sample size(s), integers >= 2.
-    m, n : int
-        Input and state dimensions.
-    r_sigma : float
-        ``R_sigma > 0``.
-
-    Returns
-    -------
-    float or ndarray
+    ``N``, ``m``, ``n`` as in :func:`sic_from_traces`; ``r_sigma = R_sigma > 0``.
     """
     Nf, scalar = check_sample_size(N)
     m, n = _check_dims(m, n)
@@ -272,16 +238,7 @@ def noise_upper_bound(N: Any, m: int, n: int) -> float | np.ndarray:
 
     It holds because ``tr Psi_w >= n`` (with equality only for ``A = 0``).
 
-    Parameters
-    ----------
-    N : int or array_like of int
-        Sample size(s), integers >= 2.
-    m, n : int
-        Input and state dimensions.
-
-    Returns
-    -------
-    float or ndarray
+    ``N``, ``m``, ``n`` as in :func:`sic_from_traces`.
     """
     Nf, scalar = check_sample_size(N)
     m, n = _check_dims(m, n)
