@@ -87,6 +87,16 @@ class Estimator(Protocol):
         """Regression columns delivered online since :meth:`start`."""
         ...
 
+    @property
+    def ready(self) -> bool:
+        """Whether :meth:`estimate` is defined (enough columns since :meth:`start`)."""
+        ...
+
+    def check_dimensions(self, n: int, m: int) -> None:
+        """Raise :class:`~encctl_gym.errors.ParameterError` if the method cannot identify an
+        ``n``-state, ``m``-input plant (before any data)."""
+        ...
+
 
 def estimate_errors(theta: np.ndarray, A: Any, B: Any) -> np.ndarray:
     """Definition def:error of a stack of estimates ``theta (..., n, n + m)``; NaN where an

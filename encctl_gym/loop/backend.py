@@ -39,10 +39,16 @@ class LoopBackend(Protocol):
         True if the backend steps any number of copies at once (else exactly one).
     quantization : Quantization or None
         The fixed-point arithmetic for the environment's compiled fast path, or ``None``.
+    deciphering_seconds : float
+        The measured clock of ``deciphering_clock="measured"``.
     """
 
     batched: bool
     quantization: Quantization | None
+
+    @property
+    def deciphering_seconds(self) -> float:
+        """Seconds the adversary's real key breaks took this episode (0 where the break is simulated)."""
 
     def start_episode(self) -> None:
         """Prepare a new episode (fresh keys and ciphertexts where there are any)."""
