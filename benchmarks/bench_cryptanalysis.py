@@ -12,6 +12,7 @@ Usage::
 
     python benchmarks/bench_cryptanalysis.py            # 32 ... 80 bits, 8 keys per size
     python benchmarks/bench_cryptanalysis.py --quick    # 32 and 48 bits, 4 keys
+    python benchmarks/bench_cryptanalysis.py --record   # also write benchmarks/results/ for the README table
 """
 
 from __future__ import annotations
@@ -60,13 +61,16 @@ def calibrate() -> None:
               f"{model['linear_algebra']:.2f} s)")
 
 
-def bench(sizes: list[int], keys: int) -> None:
+def bench(sizes: list[int], keys: int) -> list[dict]:
+    """Each breaker's first-key and per-key CPU time on the same keys, against the reference
+    (PARI if installed); printed, and returned as rows."""
     breakers = ["pari"] if pari_available() else []
     breakers += ["index-calculus", "token-chain", *GENERIC]
     if not pari_available():
         print("cypari is not installed: ratios are against the index calculus instead of PARI "
               "(pip install 'encctl-gym[cryptanalysis]')")
     reference = breakers[0]
+    rows = []
     print(f"{'bits':>5} {'breaker':<15} {'T_first (s)':>12} {'T_1 (s)':>12} {'T_first/ref':>12} {'T_1/ref':>10}"
           f"   (ref = {reference}, same keys, this run)")
     for bits in sizes:
@@ -85,16 +89,30 @@ def bench(sizes: list[int], keys: int) -> None:
             if ref is None:
                 ref = (first, later)
             print(f"{bits:>5} {name:<15} {first:12.4g} {later:12.4g} {first / ref[0]:12.3g} {later / ref[1]:10.3g}")
+            rows.append({"bits": bits, "breaker": name, "reference": reference, "first_s": first, "per_key_s": later,
+                         "first_ratio": first / ref[0], "per_key_ratio": later / ref[1]})
+    return rows
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="two sizes, 4 keys")
+    parser.add_argument("--record", action="store_true", help="record the figures for the README table")
     args = parser.parse_args()
     t0 = time.perf_counter()
     calibrate()
-    bench([32, 48] if args.quick else [32, 40, 48, 64, 80], 4 if args.quick else 8)
+    rows = bench([32, 48] if args.quick else [32, 40, 48, 64, 80], 4 if args.quick else 8)
     print(f"done in {time.perf_counter() - t0:.1f} s")
+    if args.record:
+        from record import write
+
+        largest = max(r["bits"] for r in rows)
+        ic = next(r for r in rows if r["bits"] == largest and r["breaker"] == "index-calculus")
+        write("bench_cryptanalysis", {"rows": rows}, [
+            (f"index calculus vs {ic['reference']} at {largest} bits (same keys, CPU time)",
+             f"first key {ic['first_s']:.3g} s ({ic['first_ratio']:.2g}x), each further key {ic['per_key_s'] * 1e3:.3g} ms "
+             f"({ic['per_key_ratio']:.2g}x)"),
+        ], sys.argv[1:])
     return 0
 
 
