@@ -5,7 +5,5 @@ Kept as an import path for one version; import from :mod:`encctl_gym.ident` inst
 
 from __future__ import annotations
 
-from ..ident import least_squares
 from ..ident.least_squares import *  # noqa: F403
-
-__all__ = list(least_squares.__all__)
+from ..ident.least_squares import __all__  # noqa: F401  (the same public names)
