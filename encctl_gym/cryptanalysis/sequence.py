@@ -158,6 +158,11 @@ def break_sequence(
         raise ParameterError(f"group must be a GroupParams, got {group!r}")
     hs = [check_element(group, h) for h in hs]
     n_jobs = check_int("n_jobs", n_jobs)
+    if breaker.MAIN_THREAD_ONLY and scheduler is not None:
+        raise ParameterError(
+            f"breaker {breaker.name!r} runs only in a process's main thread and Dask runs tasks in threads: "
+            "break its keys without a scheduler"
+        )
     if pre is None:
         pre = breaker.precompute(group, time_limit=time_limit)
     elif pre.breaker != breaker.name or pre.group != group:
@@ -171,11 +176,6 @@ def break_sequence(
         for h in tqdm(hs, desc=f"{breaker.name} keys", disable=not progress, leave=False):
             keys.append(breaker.break_key(h, pre, time_limit=time_limit))
         return BreakReport(breaker.name, group, pre.cost, keys)
-    if breaker.MAIN_THREAD_ONLY and scheduler is not None:
-        raise ParameterError(
-            f"breaker {breaker.name!r} runs only in a process's main thread and Dask runs tasks in threads: "
-            "break its keys without a scheduler"
-        )
     workers = (os.cpu_count() or 1) if n_jobs == -1 else n_jobs
     n_chunks = max(1, min(len(hs), check_int("chunks", chunks if chunks is not None else workers, minimum=1)))
     bounds = np.linspace(0, len(hs), n_chunks + 1).round().astype(int)
