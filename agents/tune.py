@@ -166,7 +166,7 @@ def tune(
     out: str | Path = "results/tune",
     storage: str | None = None,
     study_name: str | None = None,
-    episodes: int = 32,
+    episodes: int = 100,
     sampler_seed: int = 0,
     prune: bool = True,
     progress: bool = False,
@@ -268,7 +268,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--n-timesteps", type=int, default=None, help="training steps of every trial")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                         help="override a config entry of every trial (as train --set); repeatable")
-    parser.add_argument("--episodes", type=int, default=32, help="seeds of each trial's paired ratio to the oracle (default 32)")
+    parser.add_argument("--episodes", type=int, default=100, help="seeds of each trial's paired ratio to the oracle (default 100)")
     parser.add_argument("--out", default="results/tune", help="output directory (default results/tune)")
     parser.add_argument("--storage", default=None, metavar="URL",
                         help="Optuna storage URL shared by several machines (default: sqlite file OUT/study.db)")
