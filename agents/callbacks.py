@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
@@ -93,13 +93,17 @@ class LearningCurveCallback(EvalCallback):
         Where the curve is written after every evaluation (``.npz``).
     eval_seed : int
         Environment seed of every evaluation (the same episodes each time).
+    on_evaluation : callable, optional
+        Called with the curve after every evaluation; returning False stops training.
     **kwargs
         Passed to ``EvalCallback`` (``n_eval_episodes``, ``eval_freq``, ``log_path``,
         ``best_model_save_path``, ``deterministic``, ``verbose``).
     """
 
-    def __init__(self, eval_env: Any, *, curve: LearningCurve, curve_path: str | Path, eval_seed: int, **kwargs: Any) -> None:
+    def __init__(self, eval_env: Any, *, curve: LearningCurve, curve_path: str | Path, eval_seed: int,
+                 on_evaluation: Callable[[LearningCurve], bool] | None = None, **kwargs: Any) -> None:
         super().__init__(eval_env, **kwargs)
+        self.on_evaluation = on_evaluation
         self.curve = curve
         self.curve_path = Path(curve_path)
         self.eval_seed = int(eval_seed)
@@ -125,4 +129,6 @@ class LearningCurveCallback(EvalCallback):
         if self._finals:
             self.curve.append(self.num_timesteps, np.asarray(self._finals))
             self.curve.save(self.curve_path)
+            if self.on_evaluation is not None and self.on_evaluation(self.curve) is False:
+                keep_going = False
         return keep_going

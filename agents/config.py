@@ -19,6 +19,8 @@ key               meaning
 ``horizon``       attack length N of the training episodes, set through the deciphering
                   budget (:func:`agents.evaluate.budget_config`); ``null``: the preset's own
 ``observation``   what the policy sees: ``full``, ``no_budget``, ``blind``
+``features``      columns the attacker computes itself and appends to them (names of
+                  :data:`agents.features.FEATURES`, e.g. ``[dither]``: its own randomness)
 ``reward_scaling`` ``none`` or ``samples`` (:class:`agents.sb3.SB3VecEnv`)
 ``n_envs``        parallel copies of the native vector environment
 ``n_timesteps``   training budget in environment steps (summed over the copies)
@@ -82,6 +84,7 @@ COMMON: dict[str, Any] = {
     "env": {"preset": "paper-example", "reward": "log_error", "decipher_delay": 0},
     "horizon": None,
     "observation": "full",
+    "features": [],
     "reward_scaling": "none",
     "n_envs": 16,
     "n_timesteps": 100_000,
@@ -297,6 +300,13 @@ def _typed(typ: type | tuple[type, ...], label: str) -> Check:
 
 
 _bool = _typed(bool, "true or false")
+
+
+def _features(name: str, v: Any) -> Any:
+    from .features import check_features
+
+    return check_features(v, name)
+
 _str = _typed(str, "a string")
 
 #: Checks of every entry but ``env`` and ``hyperparams`` (checked against the environment and
@@ -308,6 +318,7 @@ SCHEMA: dict[str, Any] = {
     "quick": _bool,
     "horizon": _int(2, optional=True),
     "observation": _choice(OBSERVATION_MODES),
+    "features": lambda name, v: _features(name, v),
     "reward_scaling": _choice(REWARD_SCALINGS),
     "n_envs": _int(1),
     "n_timesteps": _int(1),

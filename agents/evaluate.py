@@ -21,7 +21,7 @@ from encctl_gym.errors import ParameterError
 
 from .base import Attacker
 
-__all__ = ["Rollout", "rollout", "env_config", "budget_config", "elgamal_config"]
+__all__ = ["Rollout", "rollout", "env_config", "budget_config", "elgamal_config", "design_efficiency"]
 
 
 def env_config(config: dict[str, Any] | None = None, **overrides: Any) -> dict[str, Any]:
@@ -116,6 +116,11 @@ class Rollout:
         ``gamma(N)`` of eq:sic at ``N``.
     seconds : float
         Wall time.
+    covariance : ndarray (n+m, n+m) or None
+        With ``rollout(..., covariance=True)``: the regressor covariance of the delivered data,
+        ``sum_e D_e D_e^T / sum_e (N_e - 1)`` over the episodes (``D`` of eq:data, columns
+        ``z_t = [x_t; u_t]``), the ``Sigma`` of :mod:`encctl_gym.security.attack_design` that
+        the attack realised.
     """
 
     attacker: str
@@ -129,6 +134,7 @@ class Rollout:
     seconds: float
     crypto: str = "ideal"
     extra: dict[str, Any] = field(default_factory=dict)
+    covariance: np.ndarray | None = None
 
     @property
     def episodes(self) -> int:
@@ -150,6 +156,7 @@ def rollout(
     batch: int | None = None,
     record: bool = True,
     progress: Any = None,
+    covariance: bool = False,
 ) -> Rollout:
     """Play ``episodes`` episodes of ``attacker`` and record ``epsilon`` after every step.
 
@@ -171,6 +178,8 @@ def rollout(
         ``(E, 1)``).
     progress : tqdm-like, optional
         ``progress.update(k)`` is called with the number of environment steps done.
+    covariance : bool
+        Also record the regressor covariance of the delivered data (:attr:`Rollout.covariance`).
 
     Returns
     -------
@@ -186,6 +195,16 @@ def rollout(
         raise ParameterError("the attacker was built for a different observation layout than this environment")
     t0 = time.perf_counter()
     eps_rows, en_rows, finals, powers, energies = [], [], [], [], []
+    d = params.n + params.m
+    gram, columns = np.zeros((d, d)), 0
+
+    def add_gram(core: Any, take: int) -> None:
+        nonlocal gram, columns
+        X, U = core.delivered_data()
+        Z = np.concatenate([X[:take, :-1], U[:take]], axis=2)
+        gram = gram + np.einsum("eti,etj->ij", Z, Z)
+        columns += Z.shape[0] * Z.shape[1]
+
     N_steps: np.ndarray | None = None
     if params.crypto == "ideal":
         B = min(episodes, 64) if batch is None else check_int("batch", batch, minimum=1)
@@ -207,6 +226,8 @@ def rollout(
                 if te[0] or tr[0]:
                     break
             take = min(B, episodes - done_eps)
+            if covariance:
+                add_gram(env.episode, take)
             eps_rows.append(np.stack(eps_t, axis=1)[:take] if record else info["epsilon"][:take, None])
             en_rows.append(np.stack(en_t, axis=1)[:take] if record else info["input_energy"][:take, None])
             if N_steps is None:
@@ -232,6 +253,8 @@ def rollout(
                     progress.update(1)
                 if te or tr:
                     break
+            if covariance:
+                add_gram(env1.episode, 1)
             eps_rows.append(np.array(eps_t if record else [info["epsilon"]])[None])
             en_rows.append(np.array(en_t if record else [info["input_energy"]])[None])
             if N_steps is None:
@@ -254,4 +277,23 @@ def rollout(
         gamma=gamma,
         seconds=time.perf_counter() - t0,
         crypto=params.crypto,
+        covariance=gram / columns if covariance and columns else None,
     )
+
+
+def design_efficiency(covariance: np.ndarray, design: Any) -> float:
+    """``tr(Sigma_opt^-1) / tr(Sigma^-1)``: how close a realised regressor covariance comes to
+    the A-optimal design at the same input power (1 for the optimum, ``0.77`` for the Gaussian
+    attack on the design example).
+
+    The large-N error of least squares is ``sigma_w2 tr(Sigma^-1) / ((n + m)(N - 1))``, so this
+    is the ratio of ``gamma_opt(N)`` to the error the realised ``Sigma`` implies: a measure of the
+    attack *design* without the noise of the estimate's error (which needs hundreds of episodes
+    to resolve a few per cent). ``Sigma`` from :func:`rollout` with ``covariance=True``,
+    ``design`` an :class:`~encctl_gym.security.attack_design.AttackDesign`.
+    """
+    S = np.asarray(covariance, dtype=float)
+    w = np.linalg.eigvalsh(0.5 * (S + S.T))
+    if w.min() <= 0.0:
+        return 0.0  # a singular regressor covariance: nothing identified in some direction
+    return float(design.trace_inv / np.sum(1.0 / w))

@@ -11,7 +11,10 @@ What a YAML file can express is checked: numbers, booleans, strings, ``null``, l
 and mappings, by the annotation's structure (``int | None``, ``list[int] | dict[str,
 list[int]]``, ...). Parameters whose type is a class or a callable (schedules, buffer or
 optimizer classes, action noise) cannot be given in a config, except ``activation_fn``, given by
-name (:data:`ACTIVATIONS`).
+name (:data:`ACTIVATIONS`), and the schedules of :data:`SCHEDULED` (``learning_rate``,
+``clip_range``, ``delta_std``), which may be given as rl-zoo3's ``lin_<value>``: a value that
+falls linearly from ``<value>`` at the start of training to 0 at its end
+(:func:`make_schedules`).
 """
 
 from __future__ import annotations
@@ -25,7 +28,8 @@ from typing import Any
 
 from encctl_gym.errors import ConfigError
 
-__all__ = ["ACTIVATIONS", "RESERVED", "type_hints", "check_value", "check_kwargs", "policy_kwargs"]
+__all__ = ["ACTIVATIONS", "RESERVED", "SCHEDULED", "type_hints", "check_value", "check_kwargs", "policy_kwargs",
+           "parse_schedule", "make_schedules"]
 
 #: ``activation_fn`` names accepted in configs -> ``torch.nn`` class names.
 ACTIVATIONS = {"tanh": "Tanh", "relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "silu": "SiLU", "gelu": "GELU"}
@@ -37,8 +41,54 @@ _POLICY_RESERVED = frozenset({"observation_space", "action_space", "lr_schedule"
 
 #: Hyperparameters that must be positive integers (or floats in (0, 1]) whatever the algorithm.
 _POSITIVE_INT = frozenset({"n_steps", "batch_size", "n_epochs", "buffer_size", "stats_window_size",
-                           "target_update_interval", "policy_delay", "lstm_hidden_size", "n_lstm_layers"})
+                           "target_update_interval", "policy_delay", "lstm_hidden_size", "n_lstm_layers",
+                           "n_delta", "n_top", "n_eval_episodes"})
 _UNIT_INTERVAL = frozenset({"gamma", "gae_lambda", "tau"})
+#: Hyperparameters that accept a schedule, given in a config as ``lin_<value>``.
+SCHEDULED = frozenset({"learning_rate", "clip_range", "delta_std"})
+
+
+def parse_schedule(name: str, value: Any) -> float | None:
+    """The start value of a ``lin_<value>`` schedule (``None`` if ``value`` is not such a string).
+
+    Raises
+    ------
+    ConfigError
+        For a ``lin_`` string whose value is not a positive number.
+    """
+    if not (isinstance(value, str) and value.startswith("lin_")):
+        return None
+    try:
+        start = float(value[4:])
+    except ValueError:
+        raise ConfigError(f"{name}={value!r}: a schedule is lin_<positive number>") from None
+    if not (start > 0.0 and start < float("inf")):
+        raise ConfigError(f"{name}={value!r}: a schedule is lin_<positive number>")
+    return start
+
+
+class LinearSchedule:
+    """``start * progress_remaining``: from ``start`` at the beginning of training to 0 at its end
+    (picklable, so it is saved with the model)."""
+
+    def __init__(self, start: float) -> None:
+        self.start = float(start)
+
+    def __call__(self, progress_remaining: float) -> float:
+        return self.start * float(progress_remaining)
+
+    def __repr__(self) -> str:
+        return f"lin_{self.start:g}"
+
+
+def make_schedules(hyperparams: dict[str, Any]) -> dict[str, Any]:
+    """``hyperparams`` with every ``lin_<value>`` of :data:`SCHEDULED` replaced by its schedule."""
+    out = dict(hyperparams)
+    for key in SCHEDULED & set(out):
+        start = parse_schedule(key, out[key])
+        if start is not None:
+            out[key] = LinearSchedule(start)
+    return out
 
 
 def type_hints(fn: Any) -> tuple[list[str], dict[str, Any]]:
@@ -106,14 +156,16 @@ def check_value(name: str, value: Any, annotation: Any) -> Any:
     ConfigError
         Naming ``name``, the value and the expected type.
     """
+    leaf = name.rsplit(".", 1)[-1]
+    if leaf in SCHEDULED and parse_schedule(name, value) is not None:
+        return value
     if not _matches(value, annotation):
         raise ConfigError(f"{name}={value!r} does not fit its type {_describe(annotation)}")
-    leaf = name.rsplit(".", 1)[-1]
     if leaf in _POSITIVE_INT and value is not None and value < 1:
         raise ConfigError(f"{name} must be >= 1, got {value!r}")
     if leaf in _UNIT_INTERVAL and not 0.0 < float(value) <= 1.0:
         raise ConfigError(f"{name} must lie in (0, 1], got {value!r}")
-    if leaf in ("learning_rate", "clip_range") and isinstance(value, numbers.Real) and not float(value) > 0.0:
+    if leaf in ("learning_rate", "clip_range", "delta_std") and isinstance(value, numbers.Real) and not float(value) > 0.0:
         raise ConfigError(f"{name} must be > 0, got {value!r}")
     if leaf == "net_arch" and value is not None:
         sizes = value if isinstance(value, list) else [v for layer in value.values() for v in layer]

@@ -75,6 +75,14 @@ class RunInfo:
     meta: dict[str, Any] = field(repr=False)
 
     @property
+    def features(self) -> list[str]:
+        """The features (:mod:`agents.features`) the policy was trained with (``[]`` for runs
+        without the ``features`` entry)."""
+        from .features import check_features
+
+        return check_features(self.meta.get("config", {}).get("features") or [], f"{self.path / RUN_FILE}: config.features")
+
+    @property
     def custom_plant(self) -> bool:
         """True if the plant matrices were given explicitly (``--system FILE``), not by a preset."""
         return self.env.get("A") is not None or self.env.get("B") is not None

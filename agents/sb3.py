@@ -4,8 +4,9 @@
   copies stepped at once) to stable-baselines3's ``VecEnv`` API: same-step autoreset
   with ``info["terminal_observation"]`` and ``info["TimeLimit.truncated"]``, seeding through
   ``VecEnv.seed``, and an observation *mode* (:func:`agents.base.observation_indices`) that
-  selects the columns the policy sees. It is several times faster than a ``DummyVecEnv`` over
-  single environments.
+  selects the columns the policy sees, followed by the columns of its *features*
+  (:mod:`agents.features`). It is several times faster than a ``DummyVecEnv`` over single
+  environments.
 * :class:`SB3Attacker` wraps a trained model (PPO, SAC, RecurrentPPO; with its
   ``VecNormalize`` statistics) as an :class:`~agents.base.Attacker`.
 * :func:`load_attacker` loads a training run written by :mod:`agents.train`.
@@ -30,7 +31,9 @@ from stable_baselines3.common.vec_env import VecEnv
 from encctl_gym.envs.config import AttackParams, resolve_params
 from encctl_gym.errors import ConfigError, ParameterError
 
+from .ars import PairedARS
 from .base import Attacker, observation_indices
+from .features import FeatureSet
 
 __all__ = ["SB3VecEnv", "SB3Attacker", "load_attacker", "ALGORITHMS", "algorithm_class", "INFO_KEYS"]
 
@@ -41,6 +44,7 @@ ALGORITHMS: dict[str, type[BaseAlgorithm]] = {
     "ppo": PPO,
     "sac": SAC,
     "recurrent_ppo": RecurrentPPO,
+    "ars": PairedARS,
 }
 
 #: Info keys copied into the SB3 info dicts at the end of an episode.
@@ -79,9 +83,11 @@ class SB3VecEnv(VecEnv):
     cost more than the step itself).
     """
 
-    def __init__(self, config: dict[str, Any], num_envs: int, observation: str = "full", reward_scaling: str = "none") -> None:
+    def __init__(self, config: dict[str, Any], num_envs: int, observation: str = "full", reward_scaling: str = "none",
+                 features: Any = ()) -> None:
         from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
 
+        self.config = dict(config)
         self.venv = EncryptedLTIAttackVectorEnv(num_envs, config=config)
         self.params: AttackParams = self.venv.params
         self.observation = observation
@@ -89,22 +95,40 @@ class SB3VecEnv(VecEnv):
             raise ParameterError(f"reward_scaling must be 'none' or 'samples', got {reward_scaling!r}")
         self.reward_scaling = reward_scaling
         self.obs_idx = observation_indices(self.params, observation)
+        self.features = FeatureSet(features, self.params)
+        self.feature_names = list(self.features.names)
         low, high = self.params.observation_bounds()
-        obs_space = spaces.Box(low[self.obs_idx], high[self.obs_idx], dtype=np.float32)
+        f_low, f_high = self.features.bounds()
+        obs_space = spaces.Box(np.concatenate([low[self.obs_idx], f_low]), np.concatenate([high[self.obs_idx], f_high]), dtype=np.float32)
         self.num_envs = num_envs
         self.render_mode = None
         self._actions = np.zeros((num_envs, self.params.m), dtype=np.float32)
+        self._feature_rng: np.random.Generator | None = None
         super().__init__(num_envs, obs_space, self.venv.single_action_space)
 
     def _obs(self, obs: np.ndarray) -> np.ndarray:
-        return np.ascontiguousarray(obs[:, self.obs_idx], dtype=np.float32)
+        return self.features.append(obs, np.ascontiguousarray(obs[:, self.obs_idx], dtype=np.float32))
 
     def reset(self) -> np.ndarray:
         seeds = self._seeds
         if seeds[0] is not None:
-            obs, _ = self.venv.reset(seed=[int(s) for s in seeds])  # type: ignore[arg-type]
-        else:
-            obs, _ = self.venv.reset()
+            return self.reset_episodes([int(s) for s in seeds])  # type: ignore[arg-type]
+        obs, _ = self.venv.reset()
+        if self._feature_rng is None:  # never seeded: fresh entropy, kept across episodes
+            self._feature_rng = np.random.default_rng()
+        self.features.reset(self.num_envs, rng=self._feature_rng)
+        self._reset_options()
+        return self._obs(obs)
+
+    def reset_episodes(self, seeds: list[int]) -> np.ndarray:
+        """Reset every copy with its own environment seed (copies with one seed play the same
+        episode, their features draw the same numbers) and return the observations.
+
+        The seeds also seed the features' generator of the episodes that follow by autoreset.
+        """
+        obs, _ = self.venv.reset(seed=[int(s) for s in seeds])
+        self.features.reset(self.num_envs, seeds=seeds)
+        self._feature_rng = np.random.default_rng(np.random.SeedSequence([int(s) for s in seeds[:1]] + [0x7a]))
         self._reset_seeds()
         self._reset_options()
         return self._obs(obs)
@@ -128,6 +152,7 @@ class SB3VecEnv(VecEnv):
                 for i in range(self.num_envs)
             ]
             obs, _ = self.venv.reset()
+            self.features.reset(self.num_envs, rng=self._feature_rng)
         else:
             infos = [{} for _ in range(self.num_envs)]
         return self._obs(obs), np.asarray(reward, dtype=np.float32), dones, infos
@@ -136,7 +161,8 @@ class SB3VecEnv(VecEnv):
         pass
 
     def get_attr(self, attr_name: str, indices: Any = None) -> list[Any]:
-        value = getattr(self, attr_name) if attr_name in ("render_mode", "params", "observation") else getattr(self.venv, attr_name)
+        own = ("render_mode", "params", "observation", "config", "feature_names")
+        value = getattr(self, attr_name) if attr_name in own else getattr(self.venv, attr_name)
         return [value for _ in self._get_indices(indices)]
 
     def set_attr(self, attr_name: str, value: Any, indices: Any = None) -> None:
@@ -168,6 +194,10 @@ class SB3Attacker(Attacker):
         them only ``observation="full"`` is possible and the layout is not checked.
     observation : str
         The observation mode the model was trained with.
+    features : sequence of str
+        The features (:mod:`agents.features`) the model was trained with; their columns are
+        computed here from the observations and the attacker's own generator (seeded by
+        :meth:`reset`), as in training. Features need ``params``.
     name : str, optional
         Label (default: the algorithm's name).
     """
@@ -180,8 +210,11 @@ class SB3Attacker(Attacker):
         *,
         params: AttackParams | None = None,
         observation: str = "full",
+        features: Any = (),
         name: str | None = None,
     ) -> None:
+        if params is None and features:
+            raise ParameterError("an SB3Attacker with features needs the environment's params")
         if params is None:
             if observation != "full":
                 raise ParameterError("an SB3Attacker with observation mode other than 'full' needs the environment's params")
@@ -193,9 +226,12 @@ class SB3Attacker(Attacker):
             super().__init__(params)
             self._obs_idx = observation_indices(params, observation)
             self._dim = self.layout.dim
-        if len(self._obs_idx) != int(np.prod(model.observation_space.shape)):
+        self._features = FeatureSet(features, params) if params is not None else FeatureSet((), None)
+        if len(self._obs_idx) + self._features.dim != int(np.prod(model.observation_space.shape)):
             raise ParameterError(
-                f"the model expects {model.observation_space.shape} observations, the {observation!r} mode gives {len(self._obs_idx)}"
+                f"the model expects {model.observation_space.shape} observations, the {observation!r} mode"
+                f"{' with features ' + ','.join(self._features.names) if self._features else ''} gives "
+                f"{len(self._obs_idx) + self._features.dim}"
             )
         self.model = model
         self.vecnormalize = vecnormalize
@@ -242,9 +278,10 @@ class SB3Attacker(Attacker):
     def _start(self, K: int) -> None:
         self._state = None
         self._episode_start = np.ones(K, dtype=bool)
+        self._features.reset(K, rng=self.rng)
 
     def _act(self, obs: np.ndarray) -> np.ndarray:
-        o = obs[:, self._obs_idx].astype(np.float32)
+        o = self._features.append(obs, obs[:, self._obs_idx].astype(np.float32))
         if self.vecnormalize is not None:
             o = self.vecnormalize.normalize_obs(o)
         if self.recurrent:
@@ -314,11 +351,12 @@ def load_attacker(
         from stable_baselines3.common.vec_env import VecNormalize
 
         try:
-            vecnorm = VecNormalize.load(str(vn_path), SB3VecEnv(env_cfg, 1, run.observation))
+            vecnorm = VecNormalize.load(str(vn_path), SB3VecEnv(env_cfg, 1, run.observation, features=run.features))
         except (EOFError, OSError, ValueError, KeyError, AttributeError, pickle.UnpicklingError) as exc:
             raise ConfigError(f"cannot load {vn_path}: {type(exc).__name__}: {_first_line(exc)}") from exc
     return SB3Attacker(
-        model, vecnorm, deterministic, params=params, observation=run.observation, name=name or run.algo,
+        model, vecnorm, deterministic, params=params, observation=run.observation, features=run.features,
+        name=name or run.algo,
     )
 
 

@@ -32,7 +32,7 @@ import json
 import math
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -41,7 +41,7 @@ from encctl_gym.errors import ConfigError
 
 from .config import CONFIG_DIR, apply_override, env_config, load_config, run_name, validate_config
 from .curves import CURVE_FILE, curve_for, plot_learning_curves
-from .hyperparams import policy_kwargs
+from .hyperparams import make_schedules, policy_kwargs
 from .runs import RUN_FILE, new_run_dir, read_run
 from .sb3 import ALGORITHMS, SB3VecEnv, algorithm_class, load_attacker
 
@@ -51,7 +51,7 @@ __all__ = ["CONFIG_DIR", "load_config", "apply_override", "train", "final_evalua
 def _make_env(cfg: dict[str, Any], env_cfg: dict[str, Any], num_envs: int, reward_scaling: str) -> Any:
     from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
-    venv: Any = VecMonitor(SB3VecEnv(env_cfg, num_envs, cfg["observation"], reward_scaling))
+    venv: Any = VecMonitor(SB3VecEnv(env_cfg, num_envs, cfg["observation"], reward_scaling, features=cfg.get("features") or ()))
     norm = cfg.get("normalize") or {}
     if norm.get("norm_obs") or norm.get("norm_reward"):
         venv = VecNormalize(venv, norm_obs=bool(norm.get("norm_obs", True)), norm_reward=bool(norm.get("norm_reward", False)),
@@ -73,6 +73,7 @@ def train(
     verbose: int = 0,
     name: str | None = None,
     overwrite: bool = False,
+    on_evaluation: Callable[[Any], bool] | None = None,
 ) -> Path:
     """Train one attacker as configured; return the run directory (model saved, run.json written).
 
@@ -95,6 +96,10 @@ def train(
     overwrite : bool
         Replace an earlier run of the same name; otherwise a new ``{name}-{i}`` directory is used
         (:func:`agents.runs.new_run_dir`).
+    on_evaluation : callable, optional
+        Called with the :class:`agents.curves.LearningCurve` after every evaluation; returning
+        False stops training there (the tuner's pruning). The run is then recorded with
+        ``status: "stopped"``.
 
     Raises
     ------
@@ -112,7 +117,7 @@ def train(
     validate_config(cfg)
     seed = int(cfg["seed"])
     algo_cls = algorithm_class(cfg["algo"])
-    hp = dict(cfg["hyperparams"])
+    hp = make_schedules(cfg["hyperparams"])
     hp["policy_kwargs"] = policy_kwargs(algo_cls, cfg["policy"], hp.get("policy_kwargs"))
     torch.set_num_threads(1)
     n_envs = int(cfg["n_envs"])
@@ -144,6 +149,7 @@ def train(
             eval_env, curve=curve, curve_path=run_dir / CURVE_FILE, eval_seed=int(ev["seed"]),
             n_eval_episodes=n_eval, eval_freq=max(int(ev["freq"]) // n_envs, 1),
             log_path=str(run_dir), best_model_save_path=str(run_dir), deterministic=False, verbose=verbose,
+            on_evaluation=on_evaluation,
         ),
     ]
     if progress:
@@ -156,8 +162,9 @@ def train(
         env.save(str(run_dir / "vecnormalize.pkl"))
     if len(curve.timesteps):
         plot_learning_curves([curve], run_dir / "learning_curve.png", title=f"{run_dir.name}: evaluation error over the optimum")
+    stopped = int(model.num_timesteps) < total
     meta.update(
-        status="finished", timesteps_done=int(model.num_timesteps), train_seconds=round(seconds, 1),
+        status="stopped" if stopped else "finished", timesteps_done=int(model.num_timesteps), train_seconds=round(seconds, 1),
         steps_per_second=round(model.num_timesteps / seconds, 1), torch_threads=torch.get_num_threads(),
         learning_curve={"N": curve.N, "gamma": curve.gamma, "gamma_gauss": curve.gamma_gauss, "gamma_opt": curve.gamma_opt, "design": curve.design_kind,
                         "evaluations": int(len(curve.timesteps)),

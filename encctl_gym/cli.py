@@ -33,6 +33,10 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "experiments.compare.cli",
         "the headline experiment: every attacker against gamma(N) and gamma_opt(N)",
     ),
+    "tune": (
+        "agents.tune",
+        "hyperparameter search for a learned attacker with Optuna, written as a tuned config (needs the [rl] and [optuna] extras)",
+    ),
     "evaluate": (
         "experiments.compare.evaluate_run",
         "a training run against the Gaussian, AR(1) and oracle attackers on paired seeds (needs the [rl] extra)",

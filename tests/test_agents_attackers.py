@@ -193,3 +193,57 @@ def test_every_attacker_runs_through_real_elgamal_ciphertexts(delay):
         # the ideal backend computes the same arithmetic without big integers: same episode
         r_ideal = rollout(att, ideal, episodes=1, seed=2, record=True)
         assert np.allclose(r.epsilon, r_ideal.epsilon, rtol=1e-9), att.name
+
+
+# ------------------------------------------------------------------ realised design
+def test_rollout_covariance_is_the_delivered_regressors_gram_over_their_count():
+    cfg = budget_config({"preset": "small", "gamma_opt": False}, 40)
+    p = resolve_params(cfg)
+    r = rollout(GaussianAttacker(p), cfg, episodes=3, seed=2, record=False, covariance=True, batch=2)
+    from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
+
+    att = GaussianAttacker(p)
+    G, cols = 0.0, 0
+    for chunk, k in [(0, 0), (0, 1), (1, 0)]:  # batches of 2: episodes 0, 1, then episode 2
+        venv = EncryptedLTIAttackVectorEnv(2, config=cfg)
+        obs, _ = venv.reset(seed=2 + 2 * chunk)
+        att.reset(seed=np.random.SeedSequence([2, chunk]))
+        while True:
+            obs, _, te, tr, _ = venv.step(att.act(obs))
+            if te[0] or tr[0]:
+                break
+        X, U = venv.episode.delivered_data()
+        Z = np.concatenate([X[k, :-1], U[k]], axis=1)
+        G, cols = G + Z.T @ Z, cols + Z.shape[0]
+    assert np.allclose(r.covariance, G / cols, rtol=1e-12)
+
+
+def test_design_efficiency_of_the_gaussian_attack_and_the_oracle():
+    from agents.evaluate import design_efficiency
+
+    cfg = budget_config({"preset": "paper-example", "gamma_opt": False}, 2048)
+    p = resolve_params(cfg)
+    opt = optimal_attack_design(p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2)
+    gauss = gaussian_attack_design(p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2)
+    from scipy.optimize import minimize_scalar
+
+    assert design_efficiency(gauss.Sigma, opt) == pytest.approx(opt.trace_inv / gauss.trace_inv, rel=1e-12)
+    # by hand: one channel x+ = a x + b u + w under u = k x + v with E u^2 = s_u (A, B diagonal)
+    a, b, sw, su = p.A[0, 0], p.B[0, 0], p.sigma_w2, p.sigma_u2
+
+    def tr_inv(k):
+        sxx = (b * b * su + sw) / (1 - (a + b * k) ** 2 + b * b * k * k)
+        v = su - k * k * sxx
+        return (sxx + su) / (sxx * v) if v > 0 and abs(a + b * k) < 1 else np.inf
+
+    best = minimize_scalar(tr_inv, bounds=(-1.0, 1.0), method="bounded")
+    assert opt.trace_inv == pytest.approx(p.n * best.fun, rel=1e-6) and opt.K[0, 0] == pytest.approx(best.x, abs=1e-3)
+    assert gauss.trace_inv == pytest.approx(p.n * tr_inv(0.0), rel=1e-12)
+    assert design_efficiency(opt.Sigma, opt) == pytest.approx(1.0, rel=1e-9)
+    assert design_efficiency(np.diag([1.0, 0.0]), opt) == 0.0
+    g = rollout(GaussianAttacker(p), cfg, episodes=16, seed=0, record=False, covariance=True)
+    o = rollout(OptimalDesignAttacker(p, design=opt), cfg, episodes=16, seed=0, record=False, covariance=True)
+    # 16 x 2047 regressors: the realised designs come within a few per cent of their closed forms
+    assert design_efficiency(g.covariance, opt) == pytest.approx(best.fun / tr_inv(0.0), abs=0.02)
+    assert design_efficiency(o.covariance, opt) == pytest.approx(1.0, abs=0.02)
+    assert np.allclose(np.diag(g.covariance)[p.n:], p.sigma_u2, rtol=0.05)

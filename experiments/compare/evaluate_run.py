@@ -33,7 +33,7 @@ from encctl_gym.errors import ConfigError
 
 from .cli import names, positive, write_outputs
 from .protocol import compute
-from .report import comparison_table
+from .report import comparison_table, design_efficiencies
 from .settings import Setting, make_setting, parse_delays
 
 __all__ = ["BASELINES", "EPISODES", "run_settings", "system_config", "add_arguments", "run"]
@@ -133,6 +133,8 @@ def run(args: argparse.Namespace) -> int:
         cmd.append("--deterministic")
     _, paths = write_outputs(result, out, command=" ".join(cmd), title=f"{info.path.name} against the baselines (`encctl-gym evaluate`)")
     print(comparison_table(result))
+    print()
+    print(design_efficiencies(result))
     print(f"\n{episodes} episodes per attacker and attack length on environment seeds {args.seed}, {args.seed + 1}, ...; "
           f"{'deterministic' if args.deterministic else 'stochastic'} policy ({args.which} model).")
     print("wrote " + ", ".join(str(p) for p in paths))

@@ -63,6 +63,10 @@ class Curve:
     along_N, along_mean, along_se, along_energy : ndarray, optional
         With delivered states: the running estimate within one full-length attack and the mean
         fraction of the episode's energy budget spent so far.
+    covariance : ndarray, optional
+        The regressor covariance the attacks at the horizon realised
+        (:attr:`agents.evaluate.Rollout.covariance`; its design efficiency is
+        :func:`agents.evaluate.design_efficiency`).
     """
 
     attacker: str
@@ -78,6 +82,7 @@ class Curve:
     along_mean: np.ndarray | None = None
     along_se: np.ndarray | None = None
     along_energy: np.ndarray | None = None
+    covariance: np.ndarray | None = None
 
 
 def evaluate(setting: Setting, attacker: Attacker, *, episodes: int, seed: int, points: int, progress: Any = None) -> Curve:
@@ -92,19 +97,23 @@ def evaluate(setting: Setting, attacker: Attacker, *, episodes: int, seed: int, 
     cols, t = [], 0.0
     along = None
     if setting.params.decipher_delay is not None:
-        along = rollout(attacker, setting.config, episodes=episodes, seed=seed, record=True, progress=progress)
+        along = rollout(attacker, setting.config, episodes=episodes, seed=seed, record=True, progress=progress, covariance=True)
     final = power = None
+    cov = None
     for N in grid:
         if along is not None and N == setting.params.horizon:
             r = along  # the same attack, same seeds
         else:
-            r = rollout(attacker, budget_config(setting.config, int(N)), episodes=episodes, seed=seed, record=False, progress=progress)
+            last = N == grid[-1]
+            r = rollout(attacker, budget_config(setting.config, int(N)), episodes=episodes, seed=seed, record=False, progress=progress,
+                        covariance=bool(last))
             t += r.seconds
+        cov = r.covariance
         cols.append(r.final_epsilon)
         final, power = r.final_epsilon, r.average_power
     mean, se = mean_se(np.stack(cols, axis=1))
     assert final is not None and power is not None
-    c = Curve(attacker.name, attacker.oracle, grid, mean, se, episodes, final, power, t)
+    c = Curve(attacker.name, attacker.oracle, grid, mean, se, episodes, final, power, t, covariance=cov)
     if along is not None:
         d = setting.params.n + setting.params.m
         first = int(np.argmax(along.N >= min(2 * d + 1, int(along.N[-1]))))

@@ -16,7 +16,7 @@ import numpy as np
 from .protocol import GAUSSIAN_NAME, Result
 from .statistics import paired_ratio
 
-__all__ = ["comparison_table", "findings", "summary_markdown"]
+__all__ = ["comparison_table", "design_efficiencies", "findings", "summary_markdown"]
 
 
 def _ratio(r: dict[str, Any], which: str) -> str:
@@ -51,6 +51,21 @@ def comparison_table(result: Result) -> str:
         lines.append(f"| {r['system']} | {r['delay']} | *{r['attacker']}* | | | | | | | {r['rate_over_gaussian_design']:.3f} | "
                      f"{r['N_to_gamma_c']} | {r['lambda_needed']} | {r['k_needed']} |")
     return "\n".join(lines)
+
+
+def design_efficiencies(result: Result) -> str:
+    """One line per setting: each attacker's design efficiency ``tr(Sigma_opt^-1) / tr(Sigma^-1)``
+    of the regressors its attacks at the horizon delivered (:func:`agents.evaluate.design_efficiency`;
+    1 is the setting's optimal design, closed loop with delivered states, open loop when blind)."""
+    from agents.evaluate import design_efficiency
+
+    out = []
+    for s in result.settings:
+        parts = [f"{c.attacker} {design_efficiency(c.covariance, s.design):.4f}" for c in result.curves[s.key] if c.covariance is not None]
+        if parts:
+            out.append(f"{s.system}, delay {s.delay}, N = {s.params.horizon}: design efficiency tr(Sigma_opt^-1) / tr(Sigma^-1) "
+                       f"({s.design.kind} optimum): " + ", ".join(parts) + ".")
+    return "\n".join(out)
 
 
 def findings(result: Result) -> str:
@@ -101,6 +116,10 @@ def summary_markdown(result: Result, *, command: str, plots: Sequence[Path], tit
     lines.append("")
     lines.append(f"Environment seeds {result.seed}, {result.seed + 1}, ... for every attacker (paired). "
                  "N marked * is set by the evaluation (a cap or an exact length), not by the system's tau_c budget. " + findings(result))
+    eff = design_efficiencies(result)
+    if eff:
+        lines.append("")
+        lines.append(eff.replace("\n", "\n\n"))
     if result.elgamal:
         same = sum(abs(r["error_elgamal"] - r["error_ideal_same_seed"]) <= 1e-9 * r["error_ideal_same_seed"] for r in result.elgamal)
         lines.append("")
