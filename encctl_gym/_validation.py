@@ -118,8 +118,7 @@ def _as_float(name: str, value: Any) -> float:
         v = float(value)
     except OverflowError:
         raise ParameterError(
-            f"{name} must be a finite real number within the float64 range (|x| <= {FLOAT_MAX:.4g}), "
-            f"got {format_value(value)}"
+            f"{name} must be a finite real number within the float64 range (|x| <= {FLOAT_MAX:.4g}), got {format_value(value)}"
         ) from None
     if not math.isfinite(v):
         raise ParameterError(f"{name} must be finite, got {format_value(value)}")
@@ -220,9 +219,7 @@ def as_finite_array(name: str, value: Any, ndim: int | None = None) -> np.ndarra
     try:
         arr = np.asarray(raw, dtype=np.float64)
     except OverflowError as exc:
-        raise ParameterError(
-            f"{name} must have entries within the float64 range, got {format_value(value)}"
-        ) from exc
+        raise ParameterError(f"{name} must have entries within the float64 range, got {format_value(value)}") from exc
     except (TypeError, ValueError) as exc:
         raise ParameterError(f"{name} must be a numeric array, got {format_value(value)}") from exc
     if ndim is not None and arr.ndim != ndim:
@@ -256,7 +253,5 @@ def check_schur_stable(A: np.ndarray) -> float:
     """Raise :class:`UnstableSystemError` unless A is Schur stable; return its spectral radius."""
     rho = spectral_radius(A)
     if not rho < 1.0:
-        raise UnstableSystemError(
-            f"A must be Schur stable (spectral radius < 1), got spectral radius {rho:.6g}"
-        )
+        raise UnstableSystemError(f"A must be Schur stable (spectral radius < 1), got spectral radius {rho:.6g}")
     return rho

@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
-from typing import Sequence
+from collections.abc import Sequence
 
 from . import __version__
 from .errors import EncctlError
@@ -21,18 +21,9 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
         "encctl_gym.security.design_cli",
         "optimal security parameter and key length for a plant (Theorem thm:opt_sec, eq:opt_key)",
     ),
-    "reproduce": (
-        "experiments.reproduce",
-        "reproduce the paper's figures and design example (writes PNG and CSV)",
-    ),
-    "train": (
-        "agents.train",
-        "train a learned attacker with stable-baselines3 (needs the [rl] extra)",
-    ),
-    "compare": (
-        "experiments.compare.cli",
-        "the headline experiment: every attacker against gamma(N) and gamma_opt(N)",
-    ),
+    "reproduce": ("experiments.reproduce", "reproduce the paper's figures and design example (writes PNG and CSV)"),
+    "train": ("agents.train", "train a learned attacker with stable-baselines3 (needs the [rl] extra)"),
+    "compare": ("experiments.compare.cli", "the headline experiment: every attacker against gamma(N) and gamma_opt(N)"),
     "tune": (
         "agents.tune",
         "hyperparameter search for a learned attacker with Optuna, written as a tuned config (needs the [rl] and [optuna] extras)",
@@ -53,8 +44,7 @@ def build_parser(selected: str | None = None) -> argparse.ArgumentParser:
     ``design`` does not load torch)."""
     parser = argparse.ArgumentParser(
         prog="encctl-gym",
-        description="Adversarial experiments on encrypted control systems "
-        "(Teranishi & Kogiso, arXiv 2303.13059).",
+        description="Adversarial experiments on encrypted control systems (Teranishi & Kogiso, arXiv 2303.13059).",
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")

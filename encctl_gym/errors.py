@@ -89,6 +89,8 @@ class ResourceLimitError(ParameterError):
     bound, YAML aliases expanding past the node bound, an SDP too large to solve, a safe prime
     too slow to generate, an episode or table too large to allocate); the message names the
     estimate and the bound."""
+
+
 class BreakerError(SolverError):
     """A key breaker (:mod:`encctl_gym.cryptanalysis`) failed: no logarithm found, or a recovered
     exponent failed the check g^s = h (a breaker never returns an unchecked key)."""

@@ -25,7 +25,8 @@ from __future__ import annotations
 
 import contextlib
 import logging
-from typing import Any, Callable, Iterator, Sequence, TypeVar, Union
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -34,7 +35,7 @@ from .errors import ConfigError, ParameterError
 
 __all__ = ["SeedLike", "as_seed_sequence", "child_seeds", "run_tasks"]
 
-SeedLike = Union[int, np.integer, np.random.SeedSequence]
+SeedLike = int | np.integer | np.random.SeedSequence
 """An integer seed or a :class:`numpy.random.SeedSequence`."""
 
 
@@ -53,6 +54,7 @@ def as_seed_sequence(seed: SeedLike) -> np.random.SeedSequence:
     if isinstance(seed, np.random.SeedSequence):
         return seed
     return np.random.SeedSequence(check_int("seed", seed, minimum=0))
+
 
 #: How long to wait for a remote Dask scheduler before giving up.
 CONNECT_TIMEOUT = "10s"
@@ -80,10 +82,7 @@ def child_seeds(seed: SeedLike, n: int) -> list[np.random.SeedSequence]:
     """
     ss = as_seed_sequence(seed)
     n = check_int("n", n, minimum=0)
-    return [
-        np.random.SeedSequence(ss.entropy, spawn_key=(*ss.spawn_key, i), pool_size=ss.pool_size)
-        for i in range(n)
-    ]
+    return [np.random.SeedSequence(ss.entropy, spawn_key=(*ss.spawn_key, i), pool_size=ss.pool_size) for i in range(n)]
 
 
 def _import_distributed() -> Any:
@@ -92,8 +91,7 @@ def _import_distributed() -> Any:
         from distributed import Client, LocalCluster  # noqa: F401
     except ImportError as exc:  # pragma: no cover - depends on the environment
         raise ConfigError(
-            "the Dask scheduler needs the optional dependency dask[distributed]; "
-            "install it with: pip install 'encctl-gym[dask]'"
+            "the Dask scheduler needs the optional dependency dask[distributed]; install it with: pip install 'encctl-gym[dask]'"
         ) from exc
     return distributed
 

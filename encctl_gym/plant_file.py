@@ -33,9 +33,10 @@ from __future__ import annotations
 import json
 import numbers
 import zipfile
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -44,15 +45,7 @@ from .errors import ConfigError, ParameterError, ResourceLimitError
 from .presets import DESIGN_FIELDS, SystemPreset, design_defaults
 from .units import parse_duration
 
-__all__ = [
-    "PlantSpec",
-    "load_plant_file",
-    "load_system",
-    "PLANT_FIELDS",
-    "MAX_FILE_BYTES",
-    "MAX_YAML_NODES",
-    "SUFFIXES",
-]
+__all__ = ["PlantSpec", "load_plant_file", "load_system", "PLANT_FIELDS", "MAX_FILE_BYTES", "MAX_YAML_NODES", "SUFFIXES"]
 
 #: Every field a plant file may hold.
 PLANT_FIELDS: tuple[str, ...] = ("A", "B", *DESIGN_FIELDS)
@@ -342,9 +335,16 @@ def load_plant_file(path: str | Path, *, defaults: Mapping[str, Any] | SystemPre
             raise type(exc)(f"{where}: {exc}") from None
         (from_file if from_file_ else from_defaults).append(key)
     preset = SystemPreset(
-        name=f"file:{p}", description=f"plant from {p}", A=A, B=B,
-        sigma_w2=values["sigma_w2"], sigma_u2=values["sigma_u2"], sigma_x2=values["sigma_x2"],
-        gamma_c=values["gamma_c"], tau_c=values["tau_c"], upsilon=values["upsilon"],
+        name=f"file:{p}",
+        description=f"plant from {p}",
+        A=A,
+        B=B,
+        sigma_w2=values["sigma_w2"],
+        sigma_u2=values["sigma_u2"],
+        sigma_x2=values["sigma_x2"],
+        gamma_c=values["gamma_c"],
+        tau_c=values["tau_c"],
+        upsilon=values["upsilon"],
     )
     return PlantSpec(str(p), preset, tuple(from_file), tuple(from_defaults))
 
@@ -359,4 +359,3 @@ def load_system(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     """
     spec = load_plant_file(path)
     return spec.A, spec.B
-

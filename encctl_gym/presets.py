@@ -58,7 +58,12 @@ PAPER_DESIGN_PARAMETERS: dict[str, float] = {"gamma_c": 1e-6, "tau_c": 31536e4, 
 PAPER_VARIANCES: dict[str, float] = {"sigma_u2": 10.0, "sigma_w2": 0.1, "sigma_x2": 1.0}
 #: The design example from its Gramian traces (Psi_w = 2I, Psi_u = 0.5I, n = m = 4).
 PAPER_DESIGN_EXAMPLE: dict[str, float | int] = {
-    "tr_psi_u": 2, "tr_psi_w": 8, "m": 4, "n": 4, **PAPER_VARIANCES, **PAPER_DESIGN_PARAMETERS,
+    "tr_psi_u": 2,
+    "tr_psi_w": 8,
+    "m": 4,
+    "n": 4,
+    **PAPER_VARIANCES,
+    **PAPER_DESIGN_PARAMETERS,
 }
 #: What the paper reports for its design example: shown beside computed values, never used to compute them.
 PAPER_REPORTED: dict[str, int] = {"N_star": 13159, "lam_star": 74, "k_star": 712}
@@ -106,7 +111,10 @@ def _build() -> dict[str, SystemPreset]:
     presets["paper-example"] = SystemPreset(
         "paper-example",
         "design example of Section 'Numerical Simulation': Psi_w = 2I, Psi_u = 0.5I, R_sigma = 100",
-        A, B, sigma_w2=PAPER_VARIANCES["sigma_w2"], sigma_u2=PAPER_VARIANCES["sigma_u2"],
+        A,
+        B,
+        sigma_w2=PAPER_VARIANCES["sigma_w2"],
+        sigma_u2=PAPER_VARIANCES["sigma_u2"],
     )
     variances = [0.1, 1.0, 10.0]
     letters = "abcdefghi"
@@ -118,7 +126,10 @@ def _build() -> dict[str, SystemPreset]:
             presets[name] = SystemPreset(
                 name,
                 f"Figure 1 ({letters[k]}): A = 0.7071 I, B = I, sigma_w2 = {sw}, sigma_u2 = {su}, R_sigma = {su / sw:g}",
-                A, B, sigma_w2=sw, sigma_u2=su,
+                A,
+                B,
+                sigma_w2=sw,
+                sigma_u2=su,
             )
             k += 1
     for psi_u in [2.0, 1.0, 0.5, 0.3, 0.2, 0.1]:
@@ -128,13 +139,20 @@ def _build() -> dict[str, SystemPreset]:
         presets[name] = SystemPreset(
             name,
             f"Figure 2: Psi_w = 2I, Psi_u = {psi_u:g} I (A = I/sqrt(2), B = {b:.6g} I), R_sigma = 100",
-            A, B, sigma_w2=0.1, sigma_u2=10.0, extra={"psi_u": psi_u},
+            A,
+            B,
+            sigma_w2=0.1,
+            sigma_u2=10.0,
+            extra={"psi_u": psi_u},
         )
     presets["small"] = SystemPreset(
         "small",
         "n = m = 2 system for quick training runs (not from the paper)",
-        np.array([[0.6, 0.2], [-0.1, 0.5]]), np.array([[1.0, 0.0], [0.3, 0.8]]),
-        sigma_w2=0.1, sigma_u2=1.0, gamma_c=1e-3,
+        np.array([[0.6, 0.2], [-0.1, 0.5]]),
+        np.array([[1.0, 0.0], [0.3, 0.8]]),
+        sigma_w2=0.1,
+        sigma_u2=1.0,
+        gamma_c=1e-3,
     )
     return presets
 

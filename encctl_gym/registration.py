@@ -14,8 +14,9 @@ from __future__ import annotations
 import importlib.abc
 import importlib.machinery
 import sys
+from collections.abc import Sequence
 from types import ModuleType
-from typing import Any, Sequence
+from typing import Any
 
 __all__ = ["ENV_ID", "register_envs", "register_when_gymnasium_loads"]
 

@@ -36,20 +36,28 @@ __all__ = ["SECONDS_PER_YEAR", "SECONDS_PER_UNIT", "parse_duration"]
 SECONDS_PER_YEAR: int = 365 * 24 * 3600
 
 #: Seconds per canonical unit.
-SECONDS_PER_UNIT: dict[str, float] = {
-    "s": 1.0,
-    "min": 60.0,
-    "h": 3600.0,
-    "d": 86400.0,
-    "y": float(SECONDS_PER_YEAR),
-}
+SECONDS_PER_UNIT: dict[str, float] = {"s": 1.0, "min": 60.0, "h": 3600.0, "d": 86400.0, "y": float(SECONDS_PER_YEAR)}
 
 _ALIASES: dict[str, str] = {
-    "": "s", "s": "s", "sec": "s", "second": "s", "seconds": "s",
-    "min": "min", "mins": "min", "minute": "min", "minutes": "min",
-    "h": "h", "hour": "h", "hours": "h",
-    "d": "d", "day": "d", "days": "d",
-    "y": "y", "yr": "y", "year": "y", "years": "y",
+    "": "s",
+    "s": "s",
+    "sec": "s",
+    "second": "s",
+    "seconds": "s",
+    "min": "min",
+    "mins": "min",
+    "minute": "min",
+    "minutes": "min",
+    "h": "h",
+    "hour": "h",
+    "hours": "h",
+    "d": "d",
+    "day": "d",
+    "days": "d",
+    "y": "y",
+    "yr": "y",
+    "year": "y",
+    "years": "y",
 }
 
 _DURATION = re.compile(r"([0-9]*\.?[0-9]+(?:e[+-]?[0-9]+)?|[0-9]+\.)\s*([a-z]*)")
@@ -85,9 +93,7 @@ def parse_duration(value: Any, name: str = "tau_c") -> float:
     s = value.strip().lower()
     match = _DURATION.fullmatch(s) if len(s) <= _MAX_TEXT else None
     if not match:
-        raise ParameterError(
-            f"{name} must be a duration like 10y, 5d, 2h, 30min, 3600s or seconds, got {format_value(value)}"
-        )
+        raise ParameterError(f"{name} must be a duration like 10y, 5d, 2h, 30min, 3600s or seconds, got {format_value(value)}")
     number, unit = match.groups()
     canonical = _ALIASES.get(unit)
     if canonical is None:

@@ -24,7 +24,8 @@ from scratch.
 
 from __future__ import annotations
 
-from typing import Any, Callable, Protocol, runtime_checkable
+from collections.abc import Callable
+from typing import Any, Protocol, runtime_checkable
 
 from ..errors import BreakerLimitError, ParameterError
 
@@ -109,8 +110,14 @@ class KeyBreaking:
     """
 
     def __init__(
-        self, breaker: str, group: Any, *, scheme: str, adversary: str,
-        time_limit: float = DEFAULT_BREAKER_TIME_LIMIT, rng: Any = None,
+        self,
+        breaker: str,
+        group: Any,
+        *,
+        scheme: str,
+        adversary: str,
+        time_limit: float = DEFAULT_BREAKER_TIME_LIMIT,
+        rng: Any = None,
     ) -> None:
         from ..cryptanalysis import TokenChain, get_breaker
         from ..cryptanalysis.base import format_seconds
@@ -192,6 +199,10 @@ def make_decipherer(params: Any, group: Any, read_key: Callable[[], Any], rng: A
     if not isinstance(name, str):
         raise ParameterError(f"breaker must be a breaker name, got {name!r}")
     return KeyBreaking(
-        name, group, scheme=params.scheme, adversary=params.adversary,
-        time_limit=getattr(params, "breaker_time_limit", DEFAULT_BREAKER_TIME_LIMIT), rng=rng,
+        name,
+        group,
+        scheme=params.scheme,
+        adversary=params.adversary,
+        time_limit=getattr(params, "breaker_time_limit", DEFAULT_BREAKER_TIME_LIMIT),
+        rng=rng,
     )

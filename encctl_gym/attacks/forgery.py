@@ -100,14 +100,7 @@ def _injection_plaintexts(a: Any, encoder: Encoder, n_cols: int) -> list[list[in
 
 
 def forge_injection(
-    pk_0: PublicKey,
-    pk_t: PublicKey,
-    a: Any,
-    encoder: Encoder,
-    n_cols: int,
-    rng: RngLike = None,
-    *,
-    per_entry: bool = False,
+    pk_0: PublicKey, pk_t: PublicKey, a: Any, encoder: Encoder, n_cols: int, rng: RngLike = None, *, per_entry: bool = False
 ) -> ModMatrix:
     """Forge, from public keys only, a modified-scheme output that the plant decodes to ``a``.
 
@@ -170,8 +163,7 @@ def forge_injection(
     first = entry(1, r, r2)  # the mask itself, reused for every entry
     mask = first.c3
     return [
-        [ModifiedCiphertext(grp, first.c1, first.c2, int(arith.mulmod(m, mask, p)), pk_0.t, pk_t.t) for m in row]
-        for row in plain
+        [ModifiedCiphertext(grp, first.c1, first.c2, int(arith.mulmod(m, mask, p)), pk_0.t, pk_t.t) for m in row] for row in plain
     ]
 
 

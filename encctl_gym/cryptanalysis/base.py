@@ -33,7 +33,8 @@ import dataclasses
 import math
 import threading
 import time
-from typing import Any, ClassVar, Mapping, Optional
+from collections.abc import Mapping
+from typing import Any, ClassVar
 
 from .._validation import check_int, check_positive, format_value
 from ..crypto import arith
@@ -41,16 +42,7 @@ from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, KeyMismatchError, ParameterError
 
-__all__ = [
-    "Cost",
-    "RecoveredKey",
-    "Deadline",
-    "Precomputation",
-    "Breaker",
-    "check_element",
-    "verify_exponent",
-    "format_seconds",
-]
+__all__ = ["Cost", "RecoveredKey", "Deadline", "Precomputation", "Breaker", "check_element", "verify_exponent", "format_seconds"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -75,8 +67,11 @@ class Cost:
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict ``{"seconds": ..., "cpu_seconds": ..., "operations": {...}}``."""
-        return {"seconds": float(self.seconds), "cpu_seconds": float(self.cpu_seconds),
-                "operations": {k: int(v) for k, v in self.operations.items()}}
+        return {
+            "seconds": float(self.seconds),
+            "cpu_seconds": float(self.cpu_seconds),
+            "operations": {k: int(v) for k, v in self.operations.items()},
+        }
 
 
 @dataclasses.dataclass(frozen=True)
@@ -129,7 +124,7 @@ class Deadline:
 
     __slots__ = ("limit", "what", "start", "cpu_start", "_end")
 
-    def __init__(self, time_limit: Optional[float], what: str) -> None:
+    def __init__(self, time_limit: float | None, what: str) -> None:
         self.limit = None if time_limit is None else check_positive("time_limit", time_limit)
         self.what = what
         self.cpu_start = time.process_time()
@@ -154,8 +149,7 @@ class Deadline:
         """The error raised when the limit has passed (also used by breakers that time out inside
         a library call)."""
         return BreakerTimeoutError(
-            f"{self.what} stopped at its time limit of {self.limit:g} s "
-            f"(after {time.perf_counter() - self.start:.3g} s)"
+            f"{self.what} stopped at its time limit of {self.limit:g} s (after {time.perf_counter() - self.start:.3g} s)"
         )
 
 
@@ -192,7 +186,7 @@ def verify_exponent(group: GroupParams, h: int, s: int, who: str) -> int:
     return s
 
 
-def _check_time_limit(time_limit: Optional[float]) -> Optional[float]:
+def _check_time_limit(time_limit: float | None) -> float | None:
     return None if time_limit is None else check_positive("time_limit", time_limit)
 
 
@@ -217,7 +211,7 @@ class Precomputation:
         Number of keys broken with it so far.
     """
 
-    def __init__(self, breaker: str, group: GroupParams, rng: Optional[RandomSource] = None) -> None:
+    def __init__(self, breaker: str, group: GroupParams, rng: RandomSource | None = None) -> None:
         self.breaker = breaker
         self.group = group
         self.rng = rng
@@ -229,7 +223,7 @@ class Precomputation:
         state["rng"] = None  # gmpy2 random states do not pickle; workers pass their own rng
         return state
 
-    def break_key(self, h: Any, *, time_limit: Optional[float] = None, rng: RngLike = None) -> RecoveredKey:
+    def break_key(self, h: Any, *, time_limit: float | None = None, rng: RngLike = None) -> RecoveredKey:
         """Recover ``s`` with ``g^s = h`` (checked) and its per-key cost.
 
         Parameters
@@ -290,9 +284,9 @@ class Breaker(abc.ABC):
     #: Set by breakers that need a process's main thread (PARI).
     MAIN_THREAD_ONLY: ClassVar[bool] = False
 
-    def __init__(self, *, max_bits: Optional[int] = None, rng: RngLike = None) -> None:
+    def __init__(self, *, max_bits: int | None = None, rng: RngLike = None) -> None:
         self.max_bits = check_int("max_bits", self.DEFAULT_MAX_BITS if max_bits is None else max_bits, minimum=2)
-        self.rng: Optional[RandomSource] = None if rng is None else arith.as_random_source(rng)
+        self.rng: RandomSource | None = None if rng is None else arith.as_random_source(rng)
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(max_bits={self.max_bits})"
@@ -323,7 +317,7 @@ class Breaker(abc.ABC):
         """Further structural requirements of a breaker (raise GroupError); none by default."""
 
     # ------------------------------------------------------------------ the two phases
-    def precompute(self, group: GroupParams, *, time_limit: Optional[float] = None) -> Precomputation:
+    def precompute(self, group: GroupParams, *, time_limit: float | None = None) -> Precomputation:
         """Phase 1: the work that depends only on the group (once per group).
 
         Parameters
@@ -362,9 +356,7 @@ class Breaker(abc.ABC):
     def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[Precomputation, Mapping[str, int]]:
         """Return the precomputation and its operation counts."""
 
-    def break_key(
-        self, h: Any, pre: Precomputation, *, time_limit: Optional[float] = None, rng: RngLike = None
-    ) -> RecoveredKey:
+    def break_key(self, h: Any, pre: Precomputation, *, time_limit: float | None = None, rng: RngLike = None) -> RecoveredKey:
         """Phase 2: recover one key with a precomputation of this breaker (see
         :meth:`Precomputation.break_key`)."""
         if not isinstance(pre, Precomputation) or pre.breaker != self.name:

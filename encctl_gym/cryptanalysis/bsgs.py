@@ -15,7 +15,8 @@ p < 2^64 (and by default to 56 bits, where the table holds 2^27.5 entries: about
 from __future__ import annotations
 
 import math
-from typing import Any, ClassVar, Mapping, Optional
+from collections.abc import Mapping
+from typing import Any, ClassVar
 
 import gmpy2
 import numpy as np
@@ -36,16 +37,16 @@ SECONDS_PER_STEP = 3.0e-7
 _CHUNK = 1 << 14
 
 
-
 def _powers(y: Any, step: Any, p: Any, n: int) -> tuple[np.ndarray, Any]:
     """``y, y step, ..., y step^(n-1)`` modulo p as uint64 (p below 2^64), and ``y step^n``:
     the baby steps of the table, or the giant steps of a key."""
-    out = []
+    out: list[Any] = []
     append = out.append
     for _ in range(n):
         append(int(y))
         y = y * step % p
     return np.array(out, dtype=np.uint64), y
+
 
 class BabyStepTable(Precomputation):
     """The baby steps ``g^j`` (``0 <= j < m``) sorted by residue, and ``g^-m``.
@@ -60,8 +61,7 @@ class BabyStepTable(Precomputation):
         ``g^-m mod p``.
     """
 
-    def __init__(self, group: GroupParams, m: int, residues: np.ndarray, exponents: np.ndarray,
-                 rng: Optional[RandomSource]) -> None:
+    def __init__(self, group: GroupParams, m: int, residues: np.ndarray, exponents: np.ndarray, rng: RandomSource | None) -> None:
         super().__init__(BabyStepGiantStep.name, group, rng)
         self.m = m
         self.residues = residues
@@ -105,8 +105,9 @@ class BabyStepGiantStep(Breaker):
     name: ClassVar[str] = "bsgs"
     DEFAULT_MAX_BITS: ClassVar[int] = 56
 
-    def __init__(self, *, baby_steps: Optional[int] = None, max_table: int = 1 << 26,
-                 max_bits: Optional[int] = None, rng: RngLike = None) -> None:
+    def __init__(
+        self, *, baby_steps: int | None = None, max_table: int = 1 << 26, max_bits: int | None = None, rng: RngLike = None
+    ) -> None:
         super().__init__(max_bits=max_bits, rng=rng)
         if self.max_bits > 64:
             raise BreakerLimitError(f"bsgs stores residues in 64 bits: max_bits must be <= 64, got {self.max_bits}")
@@ -142,7 +143,7 @@ class BabyStepGiantStep(Breaker):
         done = 0
         while done < m:
             n = min(_CHUNK, m - done)
-            residues[done:done + n], y = _powers(y, g, p, n)
+            residues[done : done + n], y = _powers(y, g, p, n)
             done += n
             deadline.check()
         order = np.argsort(residues, kind="stable")

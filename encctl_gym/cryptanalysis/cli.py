@@ -25,7 +25,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any, Optional
+from typing import Any
 
 from .._validation import check_int, check_positive
 from ..crypto import arith
@@ -89,21 +89,43 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the options of ``encctl-gym crack``."""
     parser.add_argument("--bits", type=int, default=64, help="bit length of p (default 64)")
     parser.add_argument("--keys", type=int, default=32, help="number N of keys of the sequence (default 32)")
-    parser.add_argument("--breaker", default="index-calculus", choices=list(BREAKERS),
-                        help="key breaker (default index-calculus)")
-    parser.add_argument("--inner", default="index-calculus", choices=[b for b in BREAKERS if b != "token-chain"],
-                        help="breaker of the first key for --breaker token-chain (default index-calculus)")
-    parser.add_argument("--group", default="auto", choices=("auto", "shipped", "fresh"),
-                        help="shipped group of that size, or a fresh seeded one (default: shipped if there is one)")
+    parser.add_argument(
+        "--breaker", default="index-calculus", choices=list(BREAKERS), help="key breaker (default index-calculus)"
+    )
+    parser.add_argument(
+        "--inner",
+        default="index-calculus",
+        choices=[b for b in BREAKERS if b != "token-chain"],
+        help="breaker of the first key for --breaker token-chain (default index-calculus)",
+    )
+    parser.add_argument(
+        "--group",
+        default="auto",
+        choices=("auto", "shipped", "fresh"),
+        help="shipped group of that size, or a fresh seeded one (default: shipped if there is one)",
+    )
     parser.add_argument("--seed", type=int, default=0, help="seed of the group, the keys and the attack (default 0)")
-    parser.add_argument("--time-limit", dest="time_limit", type=float, default=None, metavar="T",
-                        help="seconds allowed for the precomputation and for each key (default: none)")
-    parser.add_argument("--max-bits", dest="max_bits", type=int, default=None,
-                        help="override the breaker's size limit (bits of p)")
-    parser.add_argument("--scheduler", default=None,
-                        help="run the keys as Dask tasks: 'local' or a scheduler address (needs encctl-gym[dask])")
-    parser.add_argument("--n-jobs", dest="n_jobs", type=int, default=1,
-                        help="workers of the parallel path (default 1: keys in this process; -1: all cores)")
+    parser.add_argument(
+        "--time-limit",
+        dest="time_limit",
+        type=float,
+        default=None,
+        metavar="T",
+        help="seconds allowed for the precomputation and for each key (default: none)",
+    )
+    parser.add_argument(
+        "--max-bits", dest="max_bits", type=int, default=None, help="override the breaker's size limit (bits of p)"
+    )
+    parser.add_argument(
+        "--scheduler", default=None, help="run the keys as Dask tasks: 'local' or a scheduler address (needs encctl-gym[dask])"
+    )
+    parser.add_argument(
+        "--n-jobs",
+        dest="n_jobs",
+        type=int,
+        default=1,
+        help="workers of the parallel path (default 1: keys in this process; -1: all cores)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 
@@ -117,8 +139,12 @@ def summary(report: BreakReport) -> dict[str, float]:
     t = report.key_seconds()
     first = report.precomputation.seconds + float(t[0])
     later = float(t[1:].mean()) if t.size > 1 else float("nan")
-    return {"T_first": first, "mean_later_key": later, "ratio": later / first if first > 0 else float("nan"),
-            "total": float(report.tau()[-1])}
+    return {
+        "T_first": first,
+        "mean_later_key": later,
+        "ratio": later / first if first > 0 else float("nan"),
+        "total": float(report.tau()[-1]),
+    }
 
 
 def run(args: argparse.Namespace) -> int:
@@ -137,9 +163,15 @@ def run(args: argparse.Namespace) -> int:
     breaker.check_feasible(group)  # refuse before generating keys
     hs, secrets, tokens = key_sequence(group, n, arith.seeded_random(seed + 1))
     report = break_sequence(
-        breaker, group, hs, tokens=tokens if args.breaker == "token-chain" else None,
-        time_limit=args.time_limit, progress=not args.no_progress and not args.json,
-        scheduler=args.scheduler, n_jobs=args.n_jobs, seed=seed,
+        breaker,
+        group,
+        hs,
+        tokens=tokens if args.breaker == "token-chain" else None,
+        time_limit=args.time_limit,
+        progress=not args.no_progress and not args.json,
+        scheduler=args.scheduler,
+        n_jobs=args.n_jobs,
+        seed=seed,
     )
     if report.secrets != secrets:  # never expected: every key was checked against g^s = h
         raise BreakerError("a recovered key differs from the sequence's secret key")
@@ -149,22 +181,24 @@ def run(args: argparse.Namespace) -> int:
         out.update({"bits": group.bits, "group_source": source, "keys_match": True, **stats})
         print(json.dumps(out, indent=1))
         return 0
-    print(f"crack: {breaker.name} on a {group.bits}-bit {source} group (p = {group.p:#x}), "
-          f"{n} keys of one dynamic-key sequence")
+    print(f"crack: {breaker.name} on a {group.bits}-bit {source} group (p = {group.p:#x}), {n} keys of one dynamic-key sequence")
     pre = report.precomputation
     print(f"precomputation: {format_seconds(pre.seconds)}  ({_ops(dict(pre.operations))})")
     print(f"{'t':>5}  {'seconds':>12}  {'cpu seconds':>12}  {'method':<15} operations")
     for i, key in enumerate(report.keys):
-        print(f"{i:>5}  {key.cost.seconds:12.6f}  {key.cost.cpu_seconds:12.6f}  {key.method:<15} "
-              f"{_ops(dict(key.cost.operations))}")
+        print(
+            f"{i:>5}  {key.cost.seconds:12.6f}  {key.cost.cpu_seconds:12.6f}  {key.method:<15} {_ops(dict(key.cost.operations))}"
+        )
     later = "n/a" if n == 1 else format_seconds(stats["mean_later_key"])
-    print(f"T_first = {format_seconds(stats['T_first'])} (precomputation + key 0), mean later key = {later}, "
-          f"T_1 / T_first = {stats['ratio']:.3g}, total = {format_seconds(stats['total'])}")
+    print(
+        f"T_first = {format_seconds(stats['T_first'])} (precomputation + key 0), mean later key = {later}, "
+        f"T_1 / T_first = {stats['ratio']:.3g}, total = {format_seconds(stats['total'])}"
+    )
     print(f"all {n} keys checked (g^s = h) and equal to the sequence's secret keys")
     return 0
 
 
-def main(argv: Optional[list[str]] = None) -> int:  # pragma: no cover - use encctl-gym crack
+def main(argv: list[str] | None = None) -> int:  # pragma: no cover - use encctl-gym crack
     """Entry point of ``python -m encctl_gym.cryptanalysis.cli``."""
     from ..cli import main as cli_main
 

@@ -46,7 +46,8 @@ from __future__ import annotations
 
 import math
 import time
-from typing import ClassVar, Mapping, Optional
+from collections.abc import Mapping
+from typing import ClassVar
 
 import gmpy2
 
@@ -150,7 +151,7 @@ class _PhaseClock:
         self.cpu = dict(self.wall)
         self._name = ""
 
-    def __call__(self, name: str) -> "_PhaseClock":
+    def __call__(self, name: str) -> _PhaseClock:
         self._name = name
         return self
 
@@ -176,13 +177,15 @@ class Relation(tuple):
         return self[1]
 
 
-def _split(fb: FactorBase, y: int, p: int, half: int) -> Optional[dict[int, int]]:
+def _split(fb: FactorBase, y: int, p: int, half: int) -> dict[int, int] | None:
     """The exponent vector of lambda(y) = lambda(a) - lambda(|b|), or None if a or b is not smooth."""
     a, b = rational_reconstruction(y, p, half)
     if not (fb.is_smooth(a) and fb.is_smooth(b)):
         return None
-    row = dict(fb.factor(a))
-    for j, e in fb.factor(b).items():
+    fa, fb_ = fb.factor(a), fb.factor(b)
+    assert fa is not None and fb_ is not None  # both smooth
+    row = dict(fa)
+    for j, e in fb_.items():
         row[j] = row.get(j, 0) - e
     return {j: e for j, e in row.items() if e}
 
@@ -240,15 +243,14 @@ class FactorBaseLogs(Precomputation):
         The FLINT matrix type of the linear algebra (``nmod_mat`` or ``fmpz_mod_mat``).
     """
 
-    def __init__(self, group: GroupParams, bound: int, logs: list[Optional[int]],
-                 rng: Optional[RandomSource]) -> None:
+    def __init__(self, group: GroupParams, bound: int, logs: list[int | None], rng: RandomSource | None) -> None:
         super().__init__(IndexCalculus.name, group, rng)
         self.bound = bound
         self.logs = logs
         self.phase_seconds: dict[str, float] = {}
         self.phase_cpu_seconds: dict[str, float] = {}
         self.backend = flint_backend(group.q)
-        self._fb: Optional[FactorBase] = None
+        self._fb: FactorBase | None = None
 
     def __getstate__(self) -> dict:
         state = super().__getstate__()
@@ -284,8 +286,9 @@ class FactorBaseLogs(Precomputation):
             for _ in range(_CHECK_EVERY):
                 trials += 1
                 row = _split(fb, int(z), p, half)
-                if row is not None and all(logs[j] is not None for j in row):
-                    lam = sum(e * logs[j] for j, e in row.items())
+                known = None if row is None else [(e, logs[j]) for j, e in row.items()]
+                if known is not None and all(v is not None for _, v in known):
+                    lam = sum(e * v for e, v in known if v is not None)
                     s = (lam * n_inv - r) % q
                     return s, {"smoothness_tests": trials}, ""
                 z = z * step % pm
@@ -316,7 +319,7 @@ class IndexCalculus(Breaker):
     #: Rounds of extra relations collected when the system leaves too many unknowns free.
     MAX_ROUNDS: ClassVar[int] = 6
 
-    def __init__(self, *, bound: Optional[int] = None, max_bits: Optional[int] = None, rng: RngLike = None) -> None:
+    def __init__(self, *, bound: int | None = None, max_bits: int | None = None, rng: RngLike = None) -> None:
         super().__init__(max_bits=max_bits, rng=rng)
         if self.max_bits > 128:
             raise BreakerLimitError(f"index-calculus supports at most 128 bits (max_bits), got {self.max_bits}")
@@ -336,8 +339,7 @@ class IndexCalculus(Breaker):
         n = group.cofactor
         if group.q == 2 or n % group.q == 0:
             raise GroupError(
-                f"index-calculus needs an odd q that does not divide the cofactor (p - 1) / q; got q = {group.q}, "
-                f"cofactor = {n}"
+                f"index-calculus needs an odd q that does not divide the cofactor (p - 1) / q; got q = {group.q}, cofactor = {n}"
             )
 
     def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[FactorBaseLogs, Mapping[str, int]]:
@@ -354,7 +356,7 @@ class IndexCalculus(Breaker):
         relations: list[Relation] = []
         trials = 0
         rank = 0
-        logs: list[Optional[int]] = [None] * k
+        logs: list[int | None] = [None] * k
         small = sum(1 for ell in fb.primes if ell <= max(2, math.isqrt(min(fb.bound, group.p))))
         for _ in range(self.MAX_ROUNDS):
             with clock("relations"):
@@ -385,11 +387,5 @@ class IndexCalculus(Breaker):
         pre = FactorBaseLogs(group, fb.bound, logs, self.rng)
         pre._fb = fb
         pre.phase_seconds, pre.phase_cpu_seconds = clock.wall, clock.cpu
-        ops = {
-            "factor_base": k,
-            "smoothness_tests": trials,
-            "relations": len(relations),
-            "rank": rank,
-            "solved_logs": pre.solved,
-        }
+        ops = {"factor_base": k, "smoothness_tests": trials, "relations": len(relations), "rank": rank, "solved_logs": pre.solved}
         return pre, ops

@@ -9,7 +9,7 @@ unknowns it leaves free are reported as ``None``, never guessed.
 
 from __future__ import annotations
 
-from typing import Mapping, Optional, Sequence
+from collections.abc import Mapping, Sequence
 
 from ..errors import BreakerError, OptionalDependencyError, ParameterError
 
@@ -22,9 +22,7 @@ def _flint():  # python-flint is a core dependency; the error is for broken inst
     try:
         import flint
     except ImportError as exc:  # pragma: no cover - depends on the installation
-        raise OptionalDependencyError(
-            "the index calculus needs python-flint; install it with: pip install python-flint"
-        ) from exc
+        raise OptionalDependencyError("the index calculus needs python-flint; install it with: pip install python-flint") from exc
     return flint
 
 
@@ -33,9 +31,7 @@ def flint_backend(q: int) -> str:
     return "nmod_mat" if q < _WORD else "fmpz_mod_mat"
 
 
-def solve_mod_prime(
-    rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols: int, q: int
-) -> tuple[list[Optional[int]], int]:
+def solve_mod_prime(rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols: int, q: int) -> tuple[list[int | None], int]:
     """Solve ``sum_j rows[i][j] x_j = rhs[i] (mod q)`` for every unknown the system determines.
 
     Parameters
@@ -81,17 +77,17 @@ def solve_mod_prime(
         mat = flint.fmpz_mod_mat(len(rows), width, entries, flint.fmpz_mod_ctx(q))
     reduced, rank = mat.rref()
     values = [int(v) for v in reduced.entries()]
-    solution: list[Optional[int]] = [None] * ncols
+    solution: list[int | None] = [None] * ncols
     pivots = []
     for i in range(rank):
-        row = values[i * width:(i + 1) * width]
-        lead = next(k for k, v in enumerate(row) if v)
+        reduced_row = values[i * width : (i + 1) * width]
+        lead = next(k for k, v in enumerate(reduced_row) if v)
         if lead == width - 1:
             raise BreakerError("the relations are inconsistent modulo q (a wrong relation)")
-        pivots.append((lead, row))
+        pivots.append((lead, reduced_row))
     pivot_cols = {lead for lead, _ in pivots}
     free = [k for k in range(width - 1) if k not in pivot_cols]
-    for lead, row in pivots:
-        if all(row[k] == 0 for k in free):  # this unknown does not depend on a free one
-            solution[used[lead]] = row[width - 1]
+    for lead, reduced_row in pivots:
+        if all(reduced_row[k] == 0 for k in free):  # this unknown does not depend on a free one
+            solution[used[lead]] = reduced_row[width - 1]
     return solution, rank

@@ -18,10 +18,11 @@ from __future__ import annotations
 
 import math
 import threading
-from typing import Any, ClassVar, Mapping, Optional
+from collections.abc import Mapping
+from typing import Any, ClassVar
 
-from ..crypto.arith import RandomSource, format_int
 from .._validation import format_value
+from ..crypto.arith import RandomSource, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, OptionalDependencyError
 from .base import Breaker, Deadline, Precomputation
@@ -70,9 +71,9 @@ class PariContext(Precomputation):
     """The group as PARI objects: ``Mod(g, p)`` and the order ``[q, [q, 1]]`` (rebuilt lazily, so
     that the context pickles)."""
 
-    def __init__(self, group: GroupParams, rng: Optional[RandomSource]) -> None:
+    def __init__(self, group: GroupParams, rng: RandomSource | None) -> None:
         super().__init__(PariZnlog.name, group, rng)
-        self._objects: Optional[tuple[Any, Any]] = None
+        self._objects: tuple[Any, Any] | None = None
 
     def __getstate__(self) -> dict:
         state = super().__getstate__()

@@ -14,7 +14,7 @@ name                class                                        per key after p
 
 from __future__ import annotations
 
-from typing import Any, Union
+from typing import Any
 
 from ..errors import ParameterError
 from .base import Breaker
@@ -32,7 +32,7 @@ BREAKERS: dict[str, type[Breaker]] = {
 }
 
 
-def get_breaker(name: Union[str, Breaker], **kwargs: Any) -> Breaker:
+def get_breaker(name: str | Breaker, **kwargs: Any) -> Breaker:
     """Build the breaker registered as ``name`` with keyword arguments ``kwargs`` (a
     :class:`~.base.Breaker` instance is returned as is).
 

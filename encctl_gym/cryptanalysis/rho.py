@@ -24,7 +24,8 @@ van Oorschot and Wiener). About ``sqrt(pi q / 2)`` steps are needed for the firs
 from __future__ import annotations
 
 import math
-from typing import ClassVar, Mapping, Optional
+from collections.abc import Mapping
+from typing import ClassVar
 
 import gmpy2
 
@@ -68,8 +69,7 @@ class RandomWalk(Precomputation):
         Whether :attr:`known` persists across keys.
     """
 
-    def __init__(self, name: str, group: GroupParams, src: RandomSource, reuse: bool,
-                 rng: Optional[RandomSource]) -> None:
+    def __init__(self, name: str, group: GroupParams, src: RandomSource, reuse: bool, rng: RandomSource | None) -> None:
         super().__init__(name, group, rng)
         q, p, g = group.q, group.p, group.g
         self.steps = [src.between(1, q) for _ in range(R)]
@@ -84,7 +84,7 @@ class RandomWalk(Precomputation):
         """About 2^dp_bits steps between distinguished points."""
         return 1 << self.dp_bits
 
-    def walk(self, y: int, a: int, deadline: Deadline) -> tuple[Optional[int], int, int]:
+    def walk(self, y: int, a: int, deadline: Deadline) -> tuple[int | None, int, int]:
         """Walk from ``y`` (exponent offset ``a``) to the next distinguished point.
 
         Returns
@@ -127,7 +127,7 @@ class RandomWalk(Precomputation):
         pending: dict[int, tuple[int, int]] = {}
         give_up = 100 * math.sqrt(math.pi * q / 2) + 100 * self.mean_walk_length + 10_000
         steps = walks = 0
-        s: Optional[int] = None
+        s: int | None = None
         while s is None:
             a0, b = src.between(0, q), src.between(1, q)
             start = int(gmpy2.powmod(g, a0, p) * gmpy2.powmod(h, b, p) % p)
@@ -201,7 +201,7 @@ class MultiLogRho(PollardRho):
     name: ClassVar[str] = "rho-multi"
     _REUSE: ClassVar[bool] = True
 
-    def __init__(self, *, table_walks: int = 0, max_bits: Optional[int] = None, rng: RngLike = None) -> None:
+    def __init__(self, *, table_walks: int = 0, max_bits: int | None = None, rng: RngLike = None) -> None:
         super().__init__(max_bits=max_bits, rng=rng)
         self.table_walks = check_int("table_walks", table_walks, minimum=0)
 
@@ -213,5 +213,4 @@ class MultiLogRho(PollardRho):
     def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[RandomWalk, Mapping[str, int]]:
         walk = self._walk(group, deadline)
         steps = walk.add_known_walks(self.table_walks, self.rng or arith.secure_random(), deadline)
-        return walk, {"exponentiations": R + self.table_walks, "group_operations": steps,
-                      "distinguished_points": len(walk.known)}
+        return walk, {"exponentiations": R + self.table_walks, "group_operations": steps, "distinguished_points": len(walk.known)}

@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import dataclasses
 import os
-from typing import Any, Iterable, Optional
+from collections.abc import Iterable
+from typing import Any
 
 import numpy as np
 
@@ -75,8 +76,7 @@ class BreakReport:
             "group": self.group.to_dict(),
             "precomputation": self.precomputation.to_dict(),
             "keys": [
-                {"t": i, "h": hex(k.h), "s": hex(k.s), "method": k.method, **k.cost.to_dict()}
-                for i, k in enumerate(self.keys)
+                {"t": i, "h": hex(k.h), "s": hex(k.s), "method": k.method, **k.cost.to_dict()} for i, k in enumerate(self.keys)
             ],
             "total_seconds": float(self.tau()[-1]) if self.keys else self.precomputation.seconds,
         }
@@ -88,7 +88,7 @@ def _clock(clock: str) -> str:
     return "seconds" if clock == "wall" else "cpu_seconds"
 
 
-def _break_chunk(task: tuple[Precomputation, list[int], Optional[float]], seed: np.random.SeedSequence) -> list[RecoveredKey]:
+def _break_chunk(task: tuple[Precomputation, list[int], float | None], seed: np.random.SeedSequence) -> list[RecoveredKey]:
     # One task of the parallel path: a copy of the precomputation and a run of consecutive keys.
     pre, hs, time_limit = task
     rng = arith.seeded_random(int(seed.generate_state(1, np.uint64)[0]))
@@ -100,13 +100,13 @@ def break_sequence(
     group: GroupParams,
     hs: Iterable[int],
     *,
-    tokens: Optional[Iterable[Any]] = None,
-    pre: Optional[Precomputation] = None,
-    time_limit: Optional[float] = None,
+    tokens: Iterable[Any] | None = None,
+    pre: Precomputation | None = None,
+    time_limit: float | None = None,
     progress: bool = False,
     scheduler: Any = None,
     n_jobs: int = 1,
-    chunks: Optional[int] = None,
+    chunks: int | None = None,
     seed: int = 0,
 ) -> BreakReport:
     """Break the public-key elements ``hs`` of one group with one precomputation.
@@ -182,7 +182,8 @@ def break_sequence(
     tasks = [(pre, hs[a:b], time_limit) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
     from ..parallel import run_tasks
 
-    parts = run_tasks(_break_chunk, tasks, seed=seed, n_jobs=n_jobs, scheduler=scheduler,
-                      progress=progress, desc=f"{breaker.name} keys")
+    parts = run_tasks(
+        _break_chunk, tasks, seed=seed, n_jobs=n_jobs, scheduler=scheduler, progress=progress, desc=f"{breaker.name} keys"
+    )
     keys = [k for part in parts for k in part]
     return BreakReport(breaker.name, group, pre.cost, keys)

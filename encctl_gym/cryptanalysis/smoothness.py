@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from typing import Optional
 
 import gmpy2
 import numpy as np
@@ -23,13 +22,7 @@ from .._validation import check_int, check_positive
 from ..crypto.group import _small_primes
 from ..errors import ParameterError
 
-__all__ = [
-    "primes_up_to",
-    "FactorBase",
-    "rational_reconstruction",
-    "dickman_rho",
-    "smooth_probability",
-]
+__all__ = ["primes_up_to", "FactorBase", "rational_reconstruction", "dickman_rho", "smooth_probability"]
 
 
 def primes_up_to(bound: int) -> tuple[int, ...]:
@@ -89,7 +82,7 @@ class FactorBase:
         e = max(1, (x.bit_length() - 1).bit_length())
         return gmpy2.powmod(self.product % x, 1 << e, x) == 0
 
-    def factor(self, x: int) -> Optional[dict[int, int]]:
+    def factor(self, x: int) -> dict[int, int] | None:
         """The exponents ``{column: e}`` of a B-smooth ``|x|`` (``None`` if it is not smooth)."""
         x = abs(int(x))
         if x == 0:
@@ -121,7 +114,7 @@ def _product(values: tuple[int, ...]) -> gmpy2.mpz:
     return items[0]
 
 
-def rational_reconstruction(y: int, p: int, bound: Optional[int] = None) -> tuple[int, int]:
+def rational_reconstruction(y: int, p: int, bound: int | None = None) -> tuple[int, int]:
     """Return ``(a, b)`` with ``a = b y (mod p)``, ``0 <= a <= bound`` and ``|b| < p / bound``.
 
     The extended Euclidean algorithm on ``(p, y)`` keeps ``r_i = t_i y (mod p)`` and stops at

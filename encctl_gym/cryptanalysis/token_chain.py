@@ -15,7 +15,8 @@ objects with attributes ``h`` and ``d`` (``crypto.dyn_elgamal.UpdateToken``) or 
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, Iterable, Mapping, Optional, Union
+from collections.abc import Iterable, Mapping
+from typing import Any, ClassVar
 
 import gmpy2
 
@@ -42,7 +43,9 @@ def as_token(group: GroupParams, token: Any) -> tuple[int, int]:
         try:
             h, d = token
         except (TypeError, ValueError) as exc:
-            raise ParameterError(f"an update token must have fields h and d, or be a pair (h, d); got {format_value(token)}") from exc
+            raise ParameterError(
+                f"an update token must have fields h and d, or be a pair (h, d); got {format_value(token)}"
+            ) from exc
     h = check_element(group, h)
     d = check_int("token d", d)
     if not 0 <= d < group.q:
@@ -65,7 +68,7 @@ class TokenChainState(Precomputation):
         ``h_{t+1} -> s_{t+1}`` for keys that a known key and its token determine.
     """
 
-    def __init__(self, inner: Precomputation, rng: Optional[RandomSource]) -> None:
+    def __init__(self, inner: Precomputation, rng: RandomSource | None) -> None:
         super().__init__(TokenChain.name, inner.group, rng)
         self.inner = inner
         self.tokens: dict[int, int] = {}
@@ -87,7 +90,7 @@ class TokenChainState(Precomputation):
         h_next = int(gmpy2.mpz(h) * gmpy2.powmod(grp.g, d, grp.p) % grp.p)
         self.reachable[h_next] = (s + d) % grp.q
 
-    def break_key(self, h: Any, *, time_limit: Optional[float] = None, rng: RngLike = None) -> RecoveredKey:
+    def break_key(self, h: Any, *, time_limit: float | None = None, rng: RngLike = None) -> RecoveredKey:
         key = super().break_key(h, time_limit=time_limit, rng=rng)
         self.known[key.h] = key.s
         if key.h in self.tokens:
@@ -121,8 +124,7 @@ class TokenChain(Breaker):
     name: ClassVar[str] = "token-chain"
     DEFAULT_MAX_BITS: ClassVar[int] = 2048
 
-    def __init__(self, inner: Union[str, Breaker] = "index-calculus", *, max_bits: Optional[int] = None,
-                 rng: RngLike = None) -> None:
+    def __init__(self, inner: str | Breaker = "index-calculus", *, max_bits: int | None = None, rng: RngLike = None) -> None:
         from .registry import get_breaker
 
         if isinstance(inner, Breaker):

@@ -34,19 +34,36 @@ from __future__ import annotations
 import sys
 
 from .arith import *  # noqa: F403
-from .group import *  # noqa: F403
 from .checks import *  # noqa: F403
-from .encoding import *  # noqa: F403
-from .elgamal import *  # noqa: F403
-from .dyn_elgamal import *  # noqa: F403
-from .modified import *  # noqa: F403
-from .quantized import *  # noqa: F403
-from .servers import *  # noqa: F403
-from .plant_side import *  # noqa: F403
-from .schemes import *  # noqa: F403
 from .controller import *  # noqa: F403
+from .dyn_elgamal import *  # noqa: F403
+from .elgamal import *  # noqa: F403
+from .encoding import *  # noqa: F403
+from .group import *  # noqa: F403
+from .modified import *  # noqa: F403
+from .plant_side import *  # noqa: F403
+from .quantized import *  # noqa: F403
+from .schemes import *  # noqa: F403
+from .servers import *  # noqa: F403
 
 #: The public names of the modules above, in their order (each module's ``__all__``).
-__all__ = list(dict.fromkeys(
-    name for module in ("arith", "group", "checks", "encoding", "elgamal", "dyn_elgamal", "modified", "quantized", "servers", "plant_side", "schemes", "controller") for name in sys.modules[f"{__name__}.{module}"].__all__
-))
+__all__ = list(
+    dict.fromkeys(
+        name
+        for module in (
+            "arith",
+            "group",
+            "checks",
+            "encoding",
+            "elgamal",
+            "dyn_elgamal",
+            "modified",
+            "quantized",
+            "servers",
+            "plant_side",
+            "schemes",
+            "controller",
+        )
+        for name in sys.modules[f"{__name__}.{module}"].__all__
+    )
+)

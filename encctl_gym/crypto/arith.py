@@ -43,7 +43,7 @@ from __future__ import annotations
 import hashlib
 import numbers
 import secrets
-from typing import Any, Union
+from typing import Any
 
 import gmpy2
 import numpy as np
@@ -99,9 +99,7 @@ def powmod(base: int, exp: int, mod: int) -> int:
     try:
         return gmpy2.powmod(base, exp, mod)
     except (ValueError, ZeroDivisionError) as exc:  # e.g. no inverse for a negative exponent
-        raise ParameterError(
-            f"powmod({format_int(base)}, {format_int(exp)}, {format_int(mod)}) is undefined: {exc}"
-        ) from exc
+        raise ParameterError(f"powmod({format_int(base)}, {format_int(exp)}, {format_int(mod)}) is undefined: {exc}") from exc
 
 
 def powmod_count() -> int:
@@ -124,7 +122,7 @@ class PowmodCounter:
         self.start = 0
         self.count = 0
 
-    def __enter__(self) -> "PowmodCounter":
+    def __enter__(self) -> PowmodCounter:
         self.start = _POWMOD_CALLS
         self.count = 0
         return self
@@ -222,7 +220,7 @@ class RandomSource:
             raise ParameterError(f"empty range [{format_int(low)}, {format_int(high)})")
         return low + self.below(high - low)
 
-    def spawn(self, purpose: str) -> "RandomSource":
+    def spawn(self, purpose: str) -> RandomSource:
         """An independent child stream for another party or purpose.
 
         The child is keyed by 256 bits drawn from this source and by ``purpose``; knowing the
@@ -251,7 +249,7 @@ class SecureRandom(RandomSource):
         n = self._check_n(n)
         return secrets.randbelow(int(n))
 
-    def spawn(self, purpose: str) -> "SecureRandom":
+    def spawn(self, purpose: str) -> SecureRandom:
         _check_purpose(purpose)
         return SecureRandom()
 
@@ -308,15 +306,13 @@ class SeededRandom(RandomSource):
         nbytes = (bits + 7) >> 3
         drop = 8 * nbytes - bits
         while True:
-            block = hashlib.shake_256(
-                b"encctl-gym draw\0" + self._key + self._draws.to_bytes(8, "big")
-            ).digest(nbytes)
+            block = hashlib.shake_256(b"encctl-gym draw\0" + self._key + self._draws.to_bytes(8, "big")).digest(nbytes)
             self._draws += 1
             v = int.from_bytes(block, "big") >> drop
             if v < n:
                 return v
 
-    def spawn(self, purpose: str) -> "SeededRandom":
+    def spawn(self, purpose: str) -> SeededRandom:
         """An independent child stream keyed by this stream's key, a spawn counter and ``purpose``.
 
         Spawning does not consume draws of this stream; spawning twice with the same purpose
@@ -326,8 +322,7 @@ class SeededRandom(RandomSource):
         child.seed = self.seed
         child.purpose = f"{self.purpose}/{_check_purpose(purpose)}"
         child._key = hashlib.shake_256(
-            b"encctl-gym spawn\0" + self._key + self._spawned.to_bytes(8, "big")
-            + _length_prefixed(purpose.encode("utf-8"))
+            b"encctl-gym spawn\0" + self._key + self._spawned.to_bytes(8, "big") + _length_prefixed(purpose.encode("utf-8"))
         ).digest(32)
         child._draws = 0
         child._spawned = 0
@@ -352,7 +347,7 @@ def seeded_random(seed: int, purpose: str = "") -> SeededRandom:
     return SeededRandom(seed, purpose)
 
 
-RngLike = Union[None, int, RandomSource, np.random.Generator]
+RngLike = None | int | RandomSource | np.random.Generator
 
 
 def _generator_seed(gen: np.random.Generator) -> int:
@@ -385,9 +380,7 @@ def as_random_source(rng: RngLike, purpose: str = "") -> RandomSource:
     if isinstance(rng, np.random.Generator):
         return SeededRandom(_generator_seed(rng), purpose)
     if isinstance(rng, bool) or not isinstance(rng, (numbers.Integral, np.integer)):
-        raise ParameterError(
-            f"rng must be None, an int seed, a numpy Generator or a RandomSource, got {rng!r}"
-        )
+        raise ParameterError(f"rng must be None, an int seed, a numpy Generator or a RandomSource, got {rng!r}")
     return SeededRandom(int(rng), purpose)
 
 

@@ -79,9 +79,7 @@ def group_field(obj: Any, err: type) -> GroupParams:
 def check_instance(value: Any, cls: type, name: str) -> None:
     """Raise :class:`ParameterError` unless ``value`` is a ``cls`` (the message names both)."""
     if not isinstance(value, cls):
-        raise ParameterError(
-            f"{name} must be a {cls.__name__}, got {type(value).__name__}: {value!r}"
-        )
+        raise ParameterError(f"{name} must be a {cls.__name__}, got {type(value).__name__}: {value!r}")
 
 
 def check_same_group(a: Any, b: Any, what: str = "keys") -> GroupParams:
@@ -100,9 +98,7 @@ def check_same_group(a: Any, b: Any, what: str = "keys") -> GroupParams:
 def check_group_of(obj: Any, group: GroupParams, what: str = "ciphertext") -> None:
     """Raise :class:`KeyMismatchError` unless ``obj`` (a ciphertext or token) belongs to ``group``."""
     if obj.group is not group and obj.group != group:
-        raise KeyMismatchError(
-            f"{what} belongs to the group {obj.group!r}, the key to the group {group!r}"
-        )
+        raise KeyMismatchError(f"{what} belongs to the group {obj.group!r}, the key to the group {group!r}")
 
 
 def check_component(group: GroupParams, c: int, name: str) -> None:

@@ -16,7 +16,8 @@ scheme, rng)`` builds the plant party of a scheme; the forging of injected input
 from __future__ import annotations
 
 import warnings
-from typing import Any, Optional, Sequence, Union
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -111,12 +112,12 @@ class EncryptedLinearController:
     def __init__(
         self,
         Phi: Any,
-        group: Union[GroupParams, int],
+        group: GroupParams | int,
         delta: float,
         x_bound: float,
         scheme: str = "modified",
         rng: RngLike = None,
-        max_shift: Optional[int] = None,
+        max_shift: int | None = None,
     ) -> None:
         self.scheme_parts = get_scheme(scheme)
         src = arith.as_random_source(rng, "controller")
@@ -127,8 +128,8 @@ class EncryptedLinearController:
         self.alpha, self.beta = self.quantized.alpha, self.quantized.beta
         self.x_bound = self.quantized.x_bound
         self.plant, self.server = self.scheme_parts.parties(self.quantized, src.spawn("plant"), src.spawn("server"))
-        self.last_state_ciphertexts: Optional[list[Ciphertext]] = None
-        self.last_output_ciphertexts: Optional[list[list[Any]]] = None
+        self.last_state_ciphertexts: list[Ciphertext] | None = None
+        self.last_output_ciphertexts: list[list[Any]] | None = None
 
     @property
     def pk(self) -> PublicKey:
@@ -145,7 +146,7 @@ class EncryptedLinearController:
         """The current time step (number of completed steps)."""
         return self.plant.t
 
-    def step(self, x: Any, inject: Optional[Sequence[Sequence[Any]]] = None) -> np.ndarray:
+    def step(self, x: Any, inject: Sequence[Sequence[Any]] | None = None) -> np.ndarray:
         """One control step: encrypt x, evaluate on the server, decrypt, Sum, decode, update keys.
 
         Parameters

@@ -12,7 +12,6 @@ sends tokens to the controller server.
 from __future__ import annotations
 
 import dataclasses
-from typing import Optional
 
 from ..errors import KeyMismatchError, ParameterError
 from . import arith
@@ -21,12 +20,7 @@ from .checks import check_group_of, check_instance, check_same_group, group_fiel
 from .elgamal import Ciphertext, PublicKey, SecretKey, check_ciphertext
 from .group import GroupParams
 
-__all__ = [
-    "UpdateToken",
-    "key_update",
-    "ciphertext_update",
-    "recover_next_secret_key",
-]
+__all__ = ["UpdateToken", "key_update", "ciphertext_update", "recover_next_secret_key"]
 
 
 @dataclasses.dataclass(frozen=True, slots=True, repr=False)
@@ -53,7 +47,7 @@ class UpdateToken:
     group: GroupParams
     h: int
     d: int = dataclasses.field(repr=False)
-    t: Optional[int] = None
+    t: int | None = None
 
     def __post_init__(self) -> None:
         grp = group_field(self, ParameterError)
@@ -69,9 +63,7 @@ class UpdateToken:
         return f"UpdateToken(bits={self.group.bits}, h={arith.format_int(self.h)}, t={self.t})"
 
 
-def key_update(
-    pk: PublicKey, sk: SecretKey, rng: RngLike = None
-) -> tuple[PublicKey, SecretKey, UpdateToken]:
+def key_update(pk: PublicKey, sk: SecretKey, rng: RngLike = None) -> tuple[PublicKey, SecretKey, UpdateToken]:
     """KeyUpd of Example ex:dyn_elgamal: ``(pk_{t+1}, sk_{t+1}, sigma_t)``.
 
     Draws ``s'`` uniform in {1, ..., q-1}, sets ``d = s' - s mod q`` and ``h' = h g^d mod p``
@@ -102,16 +94,10 @@ def key_update(
     s_next = arith.as_random_stream(rng, "key_update").between(1, grp.q)
     d = (s_next - sk.s) % grp.q
     h_next = int(arith.mulmod(pk.h, arith.powmod(grp.g, d, grp.p), grp.p))
-    return (
-        PublicKey(grp, h_next, pk.t + 1),
-        SecretKey(grp, s_next, sk.t + 1),
-        UpdateToken(grp, pk.h, d, pk.t),
-    )
+    return (PublicKey(grp, h_next, pk.t + 1), SecretKey(grp, s_next, sk.t + 1), UpdateToken(grp, pk.h, d, pk.t))
 
 
-def ciphertext_update(
-    pk: PublicKey, ct: Ciphertext, token: UpdateToken, rng: RngLike = None
-) -> Ciphertext:
+def ciphertext_update(pk: PublicKey, ct: Ciphertext, token: UpdateToken, rng: RngLike = None) -> Ciphertext:
     """CtUpd of Example ex:dyn_elgamal: ``(c1 g^r, (c1 g^r)^d c2 h^r) mod p`` (re-randomised).
 
     ``r`` is drawn again in the (probability 1/(q - 1)) case ``c1 g^r = 1``, which would output
@@ -147,9 +133,7 @@ def ciphertext_update(
     check_ciphertext(grp, ct)
     check_group_of(token, grp, "update token")
     if ct.t is not None and token.t is not None and ct.t != token.t:
-        raise KeyMismatchError(
-            f"ciphertext is of step t = {ct.t} but the token updates step t = {token.t}"
-        )
+        raise KeyMismatchError(f"ciphertext is of step t = {ct.t} but the token updates step t = {token.t}")
     base_t = token.t if token.t is not None else ct.t
     p = grp.p
     src = arith.as_random_stream(rng, "ciphertext_update")
@@ -157,9 +141,7 @@ def ciphertext_update(
     while c1 == 1:
         r = src.between(1, grp.q)
         c1 = arith.mulmod(ct.c1, arith.powmod(grp.g, r, p), p)
-    c2 = arith.mulmod(
-        arith.mulmod(arith.powmod(c1, token.d, p), ct.c2, p), arith.powmod(token.h, r, p), p
-    )
+    c2 = arith.mulmod(arith.mulmod(arith.powmod(c1, token.d, p), ct.c2, p), arith.powmod(token.h, r, p), p)
     return Ciphertext(grp, int(c1), int(c2), None if base_t is None else base_t + 1)
 
 

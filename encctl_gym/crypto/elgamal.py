@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 import numbers
-from typing import Any, Optional, Union
+from typing import Any
 
 import numpy as np
 
@@ -80,9 +80,7 @@ class PublicKey:
         integer_field(self, "h", ParameterError)
         step_field(self, "t", ParameterError, optional=False)
         if self.h == 1:
-            raise KeyMismatchError(
-                "public key h = 1 is degenerate: Enc would output c2 = m, the message in the clear"
-            )
+            raise KeyMismatchError("public key h = 1 is degenerate: Enc would output c2 = m, the message in the clear")
         if not self.group.contains(self.h):
             raise KeyMismatchError(f"public key h = {fmt(self.h)} is not an element of the group")
 
@@ -114,8 +112,7 @@ class SecretKey:
         step_field(self, "t", ParameterError, optional=False)
         if not 0 < self.s < self.group.q:
             raise ParameterError(
-                f"secret exponent must lie in [1, q), got s outside (t = {self.t}; s = 0 would "
-                "give the public key h = 1)"
+                f"secret exponent must lie in [1, q), got s outside (t = {self.t}; s = 0 would give the public key h = 1)"
             )
 
     def __repr__(self) -> str:
@@ -139,7 +136,7 @@ class Ciphertext:
     group: GroupParams
     c1: int
     c2: int
-    t: Optional[int] = None
+    t: int | None = None
 
     def __post_init__(self) -> None:
         group_field(self, CiphertextError)
@@ -164,9 +161,7 @@ def check_plaintext(group: GroupParams, m: Any) -> int:
         If ``m`` is not an integer, is 0, lies outside [1, p) or outside the order-q subgroup.
     """
     if type(m) is not int:
-        if isinstance(m, bool) or not (
-            isinstance(m, (numbers.Integral, np.integer)) or type(m) is _MPZ
-        ):
+        if isinstance(m, bool) or not (isinstance(m, (numbers.Integral, np.integer)) or type(m) is _MPZ):
             raise PlaintextError(f"plaintext must be an integer element of G, got {m!r}")
         m = int(m)
     if m == 0:
@@ -178,7 +173,7 @@ def check_plaintext(group: GroupParams, m: Any) -> int:
     return m
 
 
-def check_ciphertext(group: GroupParams, ct: Any) -> "Ciphertext":
+def check_ciphertext(group: GroupParams, ct: Any) -> Ciphertext:
     """Check that ``ct`` is a :class:`Ciphertext` of ``group`` whose components lie in G.
 
     Raises
@@ -192,9 +187,7 @@ def check_ciphertext(group: GroupParams, ct: Any) -> "Ciphertext":
 
 
 # ---------------------------------------------------------------------- algorithms
-def keygen(
-    group_or_bits: Union[GroupParams, int], rng: RngLike = None
-) -> tuple[PublicKey, SecretKey]:
+def keygen(group_or_bits: GroupParams | int, rng: RngLike = None) -> tuple[PublicKey, SecretKey]:
     """KeyGen of Example ex:elgamal: ``s`` uniform in {1, ..., q-1}, ``pk = (p, q, g, g^s mod p)``.
 
     Parameters
@@ -280,9 +273,7 @@ def decrypt(sk: SecretKey, ct: Ciphertext) -> int:
     check_instance(sk, SecretKey, "sk")
     check_ciphertext(sk.group, ct)
     if ct.t is not None and ct.t != sk.t:
-        raise KeyMismatchError(
-            f"ciphertext was made under the key of step t = {ct.t}, secret key is of step t = {sk.t}"
-        )
+        raise KeyMismatchError(f"ciphertext was made under the key of step t = {ct.t}, secret key is of step t = {sk.t}")
     return decrypt_components(sk.group, sk.s, ct.c1, ct.c2)
 
 
@@ -304,13 +295,11 @@ def mult(pk: PublicKey, ct1: Ciphertext, ct2: Ciphertext) -> Ciphertext:
     check_ciphertext(grp, ct1)
     check_ciphertext(grp, ct2)
     if ct1.t is not None and ct2.t is not None and ct1.t != ct2.t:
-        raise KeyMismatchError(
-            f"Eval needs ciphertexts of the same time step, got t = {ct1.t} and t = {ct2.t}"
-        )
+        raise KeyMismatchError(f"Eval needs ciphertexts of the same time step, got t = {ct1.t} and t = {ct2.t}")
     return mult_members(grp, ct1, ct2, ct1.t if ct1.t is not None else ct2.t)
 
 
-def mult_members(group: GroupParams, ct1: Ciphertext, ct2: Ciphertext, t: Optional[int]) -> Ciphertext:
+def mult_members(group: GroupParams, ct1: Ciphertext, ct2: Ciphertext, t: int | None) -> Ciphertext:
     """Eval of Example ex:elgamal on ciphertexts already checked to belong to ``group`` (no checks).
 
     The raw algorithm under :func:`mult`, for a caller that checks its inputs once (the

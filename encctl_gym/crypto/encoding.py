@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from typing import Any, Optional
+from typing import Any
 
 import numpy as np
 
@@ -134,12 +134,10 @@ def nearest_member(group: GroupParams, v: int, max_shift: int) -> tuple[int, int
             return v + k, k
         if _is_member_residue(group, (v - k) % p):
             return v - k, k
-    raise PlaintextError(
-        f"no element of the order-q subgroup within max_shift = {max_shift} of v = {fmt(v)}"
-    )
+    raise PlaintextError(f"no element of the order-q subgroup within max_shift = {max_shift} of v = {fmt(v)}")
 
 
-def encode_int(group: GroupParams, v: int, max_shift: Optional[int] = None) -> int:
+def encode_int(group: GroupParams, v: int, max_shift: int | None = None) -> int:
     """Integer-level encoder: the plaintext ``m = w mod p`` for the signed integer ``v``.
 
     ``w`` is :func:`nearest_member` of ``v`` (Definition def:ec); raises
@@ -150,9 +148,7 @@ def encode_int(group: GroupParams, v: int, max_shift: Optional[int] = None) -> i
     ms = default_max_shift(group) if max_shift is None else check_int("max_shift", max_shift, 0)
     w, _ = nearest_member(group, v, ms)
     if abs(w) > group.half:
-        raise EncodingOverflowError(
-            f"v = {fmt(v)} encodes to w = {fmt(w)}, outside the representable range |w| <= (p-1)/2"
-        )
+        raise EncodingOverflowError(f"v = {fmt(v)} encodes to w = {fmt(w)}, outside the representable range |w| <= (p-1)/2")
     return w % group.p
 
 
@@ -179,10 +175,7 @@ def _check_power(power: Any) -> int:
     if type(power) is int and power in DECODE_POWERS:  # fast path
         return power
     if isinstance(power, bool) or not isinstance(power, (numbers.Integral, np.integer)) or int(power) not in DECODE_POWERS:
-        raise ParameterError(
-            f"power must be one of {DECODE_POWERS} (Delta for a value, Delta^2 for a product), "
-            f"got {power!r}"
-        )
+        raise ParameterError(f"power must be one of {DECODE_POWERS} (Delta for a value, Delta^2 for a product), got {power!r}")
     return int(power)
 
 
@@ -201,9 +194,7 @@ def decode_scaled(w: int, delta_ratio: tuple[int, int], power: int = 1) -> float
     try:
         return (w * den**power) / num**power
     except OverflowError as exc:
-        raise EncodingOverflowError(
-            f"decoded value {fmt(w)} / Delta^{power} does not fit in a float"
-        ) from exc
+        raise EncodingOverflowError(f"decoded value {fmt(w)} / Delta^{power} does not fit in a float") from exc
 
 
 def _as_int(name: str, value: Any, err: type = ParameterError) -> int:
@@ -246,10 +237,7 @@ def _as_finite_array(name: str, x: Any) -> np.ndarray:
     elif kind == "c":
         bad = arr.ravel()[np.flatnonzero(arr.ravel().imag != 0)[:1]]
         shown = bad[0] if bad.size else arr.ravel()[0]
-        raise ParameterError(
-            f"{name} must be real, got a complex array (e.g. {shown!r}); its imaginary part "
-            "would be lost"
-        )
+        raise ParameterError(f"{name} must be real, got a complex array (e.g. {shown!r}); its imaginary part would be lost")
     elif kind not in "iuf":
         raise ParameterError(f"{name} must be a numeric (real) array, got dtype {arr.dtype}: {x!r}")
     else:
@@ -294,22 +282,14 @@ class Encoder:
     -1.5
     """
 
-    def __init__(
-        self,
-        group: GroupParams,
-        delta: float,
-        x_bound: Optional[float] = None,
-        max_shift: Optional[int] = None,
-    ) -> None:
+    def __init__(self, group: GroupParams, delta: float, x_bound: float | None = None, max_shift: int | None = None) -> None:
         if not isinstance(group, GroupParams):
             raise ParameterError(f"group must be a GroupParams, got {group!r}")
         self.group = group.verify()  # membership tests are only meaningful in a verified group
         self.delta = check_positive("delta", delta)
         self.delta_ratio: tuple[int, int] = self.delta.as_integer_ratio()
-        self.max_shift = (
-            default_max_shift(group) if max_shift is None else check_int("max_shift", max_shift, 0)
-        )
-        self.x_bound: Optional[float] = None
+        self.max_shift = default_max_shift(group) if max_shift is None else check_int("max_shift", max_shift, 0)
+        self.x_bound: float | None = None
         if x_bound is not None:
             xb = _as_finite("x_bound", x_bound)
             if xb < 0:
@@ -344,9 +324,7 @@ class Encoder:
         """
         xf = _as_finite("x", x)
         if self.x_bound is not None and abs(xf) > self.x_bound:
-            raise EncodingOverflowError(
-                f"x = {x!r} is outside the declared input range |x| <= {self.x_bound!r}"
-            )
+            raise EncodingOverflowError(f"x = {x!r} is outside the declared input range |x| <= {self.x_bound!r}")
         v = self._round(xf)
         self._check_v(x, v)
         return v
@@ -377,7 +355,7 @@ class Encoder:
         """Decode an already lifted signed integer (e.g. a row sum of lifted products)."""
         return decode_scaled(_as_int("w", w), self.delta_ratio, power)
 
-    def error_bound(self, shift: Optional[int] = None) -> float:
+    def error_bound(self, shift: int | None = None) -> float:
         """Round-trip bound ``(1/2 + s)/Delta`` (default ``s = max_shift``).
 
         Raises
@@ -387,9 +365,7 @@ class Encoder:
         """
         s = self.max_shift if shift is None else check_int("shift", shift, 0)
         if s > self.max_shift:
-            raise ParameterError(
-                f"shift must be <= max_shift = {self.max_shift} (no encoding has a larger one), got {s}"
-            )
+            raise ParameterError(f"shift must be <= max_shift = {self.max_shift} (no encoding has a larger one), got {s}")
         return (0.5 + s) / self.delta
 
     def max_abs_signed(self, x_bound: float) -> int:
@@ -402,9 +378,7 @@ class Encoder:
         arr = _as_finite_array("x", x)
         if self.x_bound is not None and arr.size and np.max(np.abs(arr)) > self.x_bound:
             bad = float(arr.flat[int(np.argmax(np.abs(arr)))])
-            raise EncodingOverflowError(
-                f"x = {bad!r} is outside the declared input range |x| <= {self.x_bound!r}"
-            )
+            raise EncodingOverflowError(f"x = {bad!r} is outside the declared input range |x| <= {self.x_bound!r}")
         with np.errstate(over="ignore"):
             y = np.rint(self.delta * arr)
         out = np.empty(arr.shape, dtype=object)
@@ -434,7 +408,4 @@ class Encoder:
         return out
 
     def __repr__(self) -> str:
-        return (
-            f"Encoder(bits={self.group.bits}, delta={self.delta!r}, x_bound={self.x_bound!r}, "
-            f"max_shift={self.max_shift})"
-        )
+        return f"Encoder(bits={self.group.bits}, delta={self.delta!r}, x_bound={self.x_bound!r}, max_shift={self.max_shift})"

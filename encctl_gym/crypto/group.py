@@ -30,9 +30,10 @@ import json
 import math
 import sys
 import time
-from functools import cached_property, lru_cache
+from collections.abc import Mapping
+from functools import cache, cached_property, lru_cache
 from pathlib import Path
-from typing import Any, Mapping, Union
+from typing import Any
 
 import numpy as np
 
@@ -184,7 +185,7 @@ class GroupParams:
             return arith.jacobi(m, self.p) == 1
         return arith.powmod(m, self.q, self.p) == 1
 
-    def verify(self, recheck: bool = False) -> "GroupParams":
+    def verify(self, recheck: bool = False) -> GroupParams:
         """Check that p and q are prime, q | p - 1, g != 1 and g^q = 1 mod p (g has order q).
 
         The result is cached per process, so verifying a group again is free.
@@ -212,9 +213,7 @@ class GroupParams:
         if not arith.is_prime(self.p):
             raise GroupError(f"p is not prime: p = {fmt(self.p)}")
         if self.g == 1 or arith.powmod(self.g, self.q, self.p) != 1:
-            raise GroupError(
-                f"g = {fmt(self.g)} does not have order q = {fmt(self.q)} modulo p = {fmt(self.p)} (g^q != 1)"
-            )
+            raise GroupError(f"g = {fmt(self.g)} does not have order q = {fmt(self.q)} modulo p = {fmt(self.p)} (g^q != 1)")
         _VERIFIED.add(key)
         return self
 
@@ -226,16 +225,10 @@ class GroupParams:
     # ------------------------------------------------------------------ serialisation
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict; integers are hexadecimal strings (exact in every JSON parser)."""
-        return {
-            "bits": self.bits,
-            "cofactor": self.cofactor,
-            "p": hex(self.p),
-            "q": hex(self.q),
-            "g": hex(self.g),
-        }
+        return {"bits": self.bits, "cofactor": self.cofactor, "p": hex(self.p), "q": hex(self.q), "g": hex(self.g)}
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> "GroupParams":
+    def from_dict(cls, data: Mapping[str, Any]) -> GroupParams:
         """Inverse of :meth:`to_dict` (also accepts plain integers); does not :meth:`verify`.
 
         Raises
@@ -253,8 +246,7 @@ class GroupParams:
         for name in ("bits", "cofactor"):
             if name in data and _as_int(name, data[name]) != getattr(group, name):
                 raise GroupError(
-                    f"declared {name} = {fmt(data[name])} does not match the parameters "
-                    f"({name} = {getattr(group, name)})"
+                    f"declared {name} = {fmt(data[name])} does not match the parameters ({name} = {getattr(group, name)})"
                 )
         return group
 
@@ -263,7 +255,7 @@ class GroupParams:
         return json.dumps(self.to_dict(), indent=1)
 
     @classmethod
-    def from_json(cls, text: str) -> "GroupParams":
+    def from_json(cls, text: str) -> GroupParams:
         """Parse :meth:`to_json` output; raises :class:`GroupError` on malformed JSON."""
         try:
             data = json.loads(text)
@@ -273,25 +265,22 @@ class GroupParams:
             raise GroupError(f"group JSON must be an object, got a {type(data).__name__}")
         return cls.from_dict(data)
 
-    def save(self, path: Union[str, Path]) -> None:
+    def save(self, path: str | Path) -> None:
         """Write :meth:`to_json` to ``path``."""
         Path(path).write_text(self.to_json() + "\n", encoding="utf-8")
 
     @classmethod
-    def load(cls, path: Union[str, Path], verify: bool = True) -> "GroupParams":
+    def load(cls, path: str | Path, verify: bool = True) -> GroupParams:
         """Read a group written by :meth:`save` (verified unless ``verify=False``)."""
         group = cls.from_json(Path(path).read_text(encoding="utf-8"))
         return group.verify() if verify else group
 
     def __repr__(self) -> str:
-        return (
-            f"GroupParams(bits={self.bits}, cofactor={fmt(self.cofactor)}, p={fmt(self.p)}, "
-            f"g={fmt(self.g)})"
-        )
+        return f"GroupParams(bits={self.bits}, cofactor={fmt(self.cofactor)}, p={fmt(self.p)}, g={fmt(self.g)})"
 
 
 # ---------------------------------------------------------------------- generation
-@lru_cache(maxsize=None)
+@cache
 def _small_primes(limit: int) -> tuple[int, ...]:
     """Odd primes below ``limit`` (sieve of Eratosthenes)."""
     sieve = np.ones(limit, dtype=bool)
@@ -320,7 +309,7 @@ def sieve_window(q0: int, n_cand: int, limit: int) -> np.ndarray:
     return np.flatnonzero(sieve)
 
 
-@lru_cache(maxsize=None)
+@cache
 def _inverses_of_two(limit: int) -> tuple[int, ...]:
     return tuple(pow(2, -1, ell) for ell in _small_primes(limit))
 
@@ -345,8 +334,16 @@ DEFAULT_MAX_GENERATION_SECONDS = 60.0
 # (gmpy2 2.3.2, GMP 6.3.0; benchmarks/bench_crypto.py prints estimate / measured):
 # best time of gmpy2.powmod(2, n - 1, n) for n of the given bit length, in seconds ...
 _POWMOD_SECONDS = (
-    (128, 2.0e-6), (256, 1.21e-5), (512, 5.32e-5), (712, 1.25e-4), (1024, 2.96e-4),
-    (1536, 9.08e-4), (2048, 2.07e-3), (3072, 6.38e-3), (4096, 1.50e-2), (8192, 8.64e-2),
+    (128, 2.0e-6),
+    (256, 1.21e-5),
+    (512, 5.32e-5),
+    (712, 1.25e-4),
+    (1024, 2.96e-4),
+    (1536, 9.08e-4),
+    (2048, 2.07e-3),
+    (3072, 6.38e-3),
+    (4096, 1.50e-2),
+    (8192, 8.64e-2),
     (16384, 0.492),
 )
 # ... and the time per sieving prime per window (two strided assignments and a reduction).
@@ -382,15 +379,11 @@ def _powmod_seconds(bits: float) -> float:
     raise AssertionError("unreachable")  # pragma: no cover
 
 
-@lru_cache(maxsize=None)
+@cache
 def _sieve_survival(limit: int) -> tuple[float, float, int]:
     """(prod (1 - 2/l), prod (1 - 1/l), number of primes) over the sieving primes below ``limit``."""
     primes = np.array(_small_primes(limit), dtype=np.float64)
-    return (
-        float(np.exp(np.log1p(-2.0 / primes).sum())),
-        float(np.exp(np.log1p(-1.0 / primes).sum())),
-        len(primes),
-    )
+    return (float(np.exp(np.log1p(-2.0 / primes).sum())), float(np.exp(np.log1p(-1.0 / primes).sum())), len(primes))
 
 
 def estimate_generation_seconds(bits: int, window: int | None = None) -> float:
@@ -524,8 +517,7 @@ def generate_safe_prime_group(
                 if arith.is_prime(q) and arith.is_prime(p):
                     if progress:
                         print(
-                            f"\rgenerated {bits}-bit safe prime after {tested} candidates "
-                            f"in {time.monotonic() - t0:.1f} s",
+                            f"\rgenerated {bits}-bit safe prime after {tested} candidates in {time.monotonic() - t0:.1f} s",
                             file=sys.stderr,
                             flush=True,
                         )
@@ -569,10 +561,7 @@ def shipped_group(bits: int) -> GroupParams:
 
 
 def get_group(
-    bits: int,
-    rng: RngLike = None,
-    progress: bool = False,
-    max_seconds: float = DEFAULT_MAX_GENERATION_SECONDS,
+    bits: int, rng: RngLike = None, progress: bool = False, max_seconds: float = DEFAULT_MAX_GENERATION_SECONDS
 ) -> GroupParams:
     """The shipped group of ``bits`` bits if there is one, else a freshly generated one.
 
@@ -594,7 +583,7 @@ def get_group(
     return generate_safe_prime_group(bits, rng=rng, progress=progress, max_seconds=max_seconds)
 
 
-def as_group(group_or_bits: Union[GroupParams, int], rng: RngLike = None) -> GroupParams:
+def as_group(group_or_bits: GroupParams | int, rng: RngLike = None) -> GroupParams:
     """Accept a :class:`GroupParams` (verified here) or a bit length (:func:`get_group`, with
     the default time limit; call :func:`get_group` with ``max_seconds`` for larger sizes)."""
     if isinstance(group_or_bits, GroupParams):
@@ -602,9 +591,7 @@ def as_group(group_or_bits: Union[GroupParams, int], rng: RngLike = None) -> Gro
     return get_group(group_or_bits, rng=rng)
 
 
-def write_shipped_groups(
-    path: Union[str, Path] = _DATA_FILE, bits: tuple[int, ...] = SHIPPED_BITS, rng: RngLike = None
-) -> None:
+def write_shipped_groups(path: str | Path = _DATA_FILE, bits: tuple[int, ...] = SHIPPED_BITS, rng: RngLike = None) -> None:
     """Regenerate the shipped-group file (``python -m encctl_gym.crypto.group``).
 
     Each group is made by :func:`generate_safe_prime_group` with secure randomness unless an

@@ -13,7 +13,7 @@ under pk_0 forever and never receive an update token.
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, Optional
+from typing import Any
 
 from ..errors import CiphertextError, KeyMismatchError
 from . import arith
@@ -37,8 +37,8 @@ class ModifiedCiphertext:
     c1: int
     c2: int
     c3: int
-    t1: Optional[int] = None
-    t2: Optional[int] = None
+    t1: int | None = None
+    t2: int | None = None
 
     def __post_init__(self) -> None:
         group_field(self, CiphertextError)

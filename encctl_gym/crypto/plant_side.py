@@ -23,7 +23,8 @@ fixed first components are computed once at set-up. Total: 13 exponentiations pe
 
 from __future__ import annotations
 
-from typing import Any, Optional, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -123,7 +124,7 @@ class PlantParty:
         products = self.decrypt_products(out)
         return self.quantization.decode_row_sums([sum(r) for r in products])
 
-    def update_keys(self) -> Optional[UpdateToken]:
+    def update_keys(self) -> UpdateToken | None:
         """KeyUpd (Example ex:dyn_elgamal): move to step t + 1 and return sigma_t (``None``: no update)."""
         self.pk, self._sk, token = key_update(self.pk, self._sk, self._rng)
         return token
@@ -209,4 +210,3 @@ class StaticPlant(TokenPlant):
     def update_keys(self) -> None:
         """No update: the key pair of step 0 is kept for ever."""
         return None
-

@@ -10,7 +10,8 @@ encrypted loop and this twin agree bit for bit.
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -68,9 +69,7 @@ class QuantizedLinearController:
         self.encoder = encoder
         self.group = encoder.group
         self.x_bound = check_nonnegative("x_bound", x_bound)
-        self.state_encoder = Encoder(
-            encoder.group, encoder.delta, x_bound=self.x_bound, max_shift=encoder.max_shift
-        )
+        self.state_encoder = Encoder(encoder.group, encoder.delta, x_bound=self.x_bound, max_shift=encoder.max_shift)
         self.phi_int = encoder.encode_signed_array(phi)
         # Worst case over |xi_j| <= x_bound: |w_xi| <= round(Delta x_bound) + max_shift.
         w_max = self.state_encoder.max_abs_signed(self.x_bound)
@@ -110,6 +109,5 @@ class QuantizedLinearController:
 
     def __repr__(self) -> str:
         return (
-            f"QuantizedLinearController(alpha={self.alpha}, beta={self.beta}, "
-            f"encoder={self.encoder!r}, x_bound={self.x_bound!r})"
+            f"QuantizedLinearController(alpha={self.alpha}, beta={self.beta}, encoder={self.encoder!r}, x_bound={self.x_bound!r})"
         )

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from typing import Any, Union
+from typing import Any
 
 import numpy as np
 
@@ -86,13 +86,10 @@ def _legendre_table(p: int, n: int) -> np.ndarray:
     return chi
 
 
-def _safe_prime(group_or_p: Union[GroupParams, int]) -> int:
+def _safe_prime(group_or_p: GroupParams | int) -> int:
     if isinstance(group_or_p, GroupParams):
         if not group_or_p.is_safe_prime:
-            raise GroupError(
-                f"the residue table needs a safe-prime group (p = 2q + 1), got cofactor "
-                f"{group_or_p.cofactor}"
-            )
+            raise GroupError(f"the residue table needs a safe-prime group (p = 2q + 1), got cofactor {group_or_p.cofactor}")
         return group_or_p.verify().p
     p = check_int("p", group_or_p, minimum=5)
     if p % 4 != 3:  # p = 2q + 1 with q odd
@@ -132,9 +129,7 @@ class ResidueTable:
         If building the table would need more than ``max_bytes`` (the message gives both).
     """
 
-    def __init__(
-        self, p: Union[GroupParams, int], limit: int, max_bytes: int = DEFAULT_MAX_TABLE_BYTES
-    ) -> None:
+    def __init__(self, p: GroupParams | int, limit: int, max_bytes: int = DEFAULT_MAX_TABLE_BYTES) -> None:
         limit = check_int("limit", limit)
         max_bytes = check_int("max_bytes", max_bytes, minimum=1)
         need = residue_table_bytes(max(limit, 0))
@@ -204,8 +199,6 @@ class ResidueTable:
 
 
 @lru_cache(maxsize=8)
-def residue_table(
-    p: Union[GroupParams, int], limit: int, max_bytes: int = DEFAULT_MAX_TABLE_BYTES
-) -> ResidueTable:
+def residue_table(p: GroupParams | int, limit: int, max_bytes: int = DEFAULT_MAX_TABLE_BYTES) -> ResidueTable:
     """A cached :class:`ResidueTable` (built once per process for each ``(p, limit)``)."""
     return ResidueTable(p, limit, max_bytes)

@@ -20,8 +20,9 @@ parts from it.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 from ..errors import ParameterError
 from .arith import RandomSource

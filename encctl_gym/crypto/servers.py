@@ -22,7 +22,8 @@ when the server is set up.
 
 from __future__ import annotations
 
-from typing import Any, Optional, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 from ..errors import CiphertextError, KeyMismatchError, ParameterError
 from . import arith
@@ -44,7 +45,7 @@ def _parameter_ciphertexts(pk: PublicKey, ct_phi: Sequence[Sequence[Ciphertext]]
     return rows
 
 
-def _state_ciphertexts(pk: PublicKey, ct_xi: Any, beta: int, step: Optional[int]) -> list[Ciphertext]:
+def _state_ciphertexts(pk: PublicKey, ct_xi: Any, beta: int, step: int | None) -> list[Ciphertext]:
     """The ``beta`` state ciphertexts, each checked (group, components in G, and ``step`` if given)."""
     cts = [ct_xi] if isinstance(ct_xi, Ciphertext) else list(ct_xi)
     if len(cts) != beta:
@@ -198,7 +199,7 @@ class TokenControllerServer(StaticControllerServer):
     def __init__(self, pk: PublicKey, ct_phi: Sequence[Sequence[Ciphertext]], rng: RngLike = None) -> None:
         super().__init__(pk, ct_phi)
         self._rng = arith.as_random_source(rng, "token server")
-        self.last_token: Optional[UpdateToken] = None
+        self.last_token: UpdateToken | None = None
 
     def receive_token(self, token: UpdateToken) -> None:
         """CtUpd every ciphertext of Phi with ``sigma_t`` (Example ex:dyn_elgamal), t -> t + 1.

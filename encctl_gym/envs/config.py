@@ -9,22 +9,16 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
-from .._validation import (
-    check_bool,
-    check_int,
-    check_nonnegative,
-    check_positive,
-    check_schur_stable,
-    check_system,
-    format_value,
-)
+from .._validation import check_bool, check_int, check_nonnegative, check_positive, check_schur_stable, check_system, format_value
 from ..errors import BudgetError, ConfigError, ParameterError
 from ..ident.registry import make_estimator
+from ..loop import BACKENDS as _LOOP_BACKENDS
 from ..presets import get_preset
 from ..security.complexity import sic_from_traces
 from ..security.cost_models import (
@@ -49,7 +43,6 @@ from ..security.design import design_from_traces
 from ..security.exact import decimal_fraction
 from ..security.gramians import controllability_gramian, noise_gramian
 from ..units import parse_duration
-from ..loop import BACKENDS as _LOOP_BACKENDS
 from .layout import ObservationLayout
 from .rewards import REWARDS as _REWARD_CLASSES
 
@@ -265,9 +258,7 @@ def _breaking(cfg: Mapping[str, Any], crypto: str) -> tuple[str | None, str, flo
     if breaker is not None:
         breaker = _choice("breaker", breaker, tuple(breakers))
         if crypto != "elgamal":
-            raise ParameterError(
-                f"breaker={breaker!r} needs crypto='elgamal': the {crypto} backend has no ciphertexts to break"
-            )
+            raise ParameterError(f"breaker={breaker!r} needs crypto='elgamal': the {crypto} backend has no ciphertexts to break")
     clock = _choice("deciphering_clock", cfg["deciphering_clock"], DECIPHERING_CLOCKS)
     if clock == "measured" and breaker is None:
         raise ParameterError("deciphering_clock='measured' needs a breaker: nothing is broken, so nothing is measured")
@@ -372,14 +363,24 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     if k_cfg is not None:
         key_length = check_int("key_length", k_cfg, minimum=GENERIC_MIN_KEY_LENGTH)
         cost = model.break_cost(key_length)
-        lam = cost.security_parameter if model_name == "paper" else paper.security_parameter_of_key_length(key_length)
+        lam = cost.security_parameter
+        if model_name != "paper" or lam is None:
+            lam = paper.security_parameter_of_key_length(key_length)
     else:
         if lam_cfg is not None:
             lam = check_security_parameter(lam_cfg)
         else:
             design = design_from_traces(
-                tr_psi_u, tr_psi_w, m, n, sigma_u2=sigma_u2, sigma_w2=sigma_w2, sigma_x2=sigma_x2,
-                gamma_c=gamma_c, tau_c=tau_c, upsilon=upsilon,
+                tr_psi_u,
+                tr_psi_w,
+                m,
+                n,
+                sigma_u2=sigma_u2,
+                sigma_w2=sigma_w2,
+                sigma_x2=sigma_x2,
+                gamma_c=gamma_c,
+                tau_c=tau_c,
+                upsilon=upsilon,
             )
             lam = design.lam_star  # Theorem thm:opt_sec
         key_length = paper.key_length_for_security_parameter(lam)  # eq:opt_key
@@ -429,19 +430,42 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     if crypto_seed is not None:
         crypto_seed = check_int("crypto_seed", crypto_seed, minimum=0)
     return AttackParams(
-        A=A, B=B, sigma_w2=sigma_w2, sigma_x2=sigma_x2, sigma_u2=sigma_u2,
-        scheme=scheme, adversary=adversary, security_parameter=lam, key_length=key_length,
-        upsilon=upsilon, tau_c=tau_c, gamma_c=gamma_c, deciphering_model=model_name, cost=cost,
-        sample_cost=per_sample_cost(cost, upsilon), next_sample_cost=float(cost.next / decimal_fraction("upsilon", upsilon)),
-        budget_samples=budget, horizon=horizon, independent_keys=independent_keys(scheme, adversary),
-        budget_limited=budget_limited, decipher_delay=delay_v,
+        A=A,
+        B=B,
+        sigma_w2=sigma_w2,
+        sigma_x2=sigma_x2,
+        sigma_u2=sigma_u2,
+        scheme=scheme,
+        adversary=adversary,
+        security_parameter=lam,
+        key_length=key_length,
+        upsilon=upsilon,
+        tau_c=tau_c,
+        gamma_c=gamma_c,
+        deciphering_model=model_name,
+        cost=cost,
+        sample_cost=per_sample_cost(cost, upsilon),
+        next_sample_cost=float(cost.next / decimal_fraction("upsilon", upsilon)),
+        budget_samples=budget,
+        horizon=horizon,
+        independent_keys=independent_keys(scheme, adversary),
+        budget_limited=budget_limited,
+        decipher_delay=delay_v,
         warmup_steps=warmup,
-        estimator=estimator, reward=reward,
+        estimator=estimator,
+        reward=reward,
         logdet_regularization=check_positive("logdet_regularization", cfg["logdet_regularization"]),
-        crypto=crypto, delta=delta, x_bound=check_positive("x_bound", cfg["x_bound"]),
+        crypto=crypto,
+        delta=delta,
+        x_bound=check_positive("x_bound", cfg["x_bound"]),
         u_max=action_scale * math.sqrt(sigma_u2),
         input_history=check_int("input_history", cfg["input_history"], minimum=0),
-        gamma_opt=check_bool("gamma_opt", cfg["gamma_opt"]), crypto_seed=crypto_seed,
-        breaker=breaker, breaker_time_limit=breaker_limit, deciphering_clock=clock,
-        tr_psi_u=tr_psi_u, tr_psi_w=tr_psi_w, sources=sources,
+        gamma_opt=check_bool("gamma_opt", cfg["gamma_opt"]),
+        crypto_seed=crypto_seed,
+        breaker=breaker,
+        breaker_time_limit=breaker_limit,
+        deciphering_clock=clock,
+        tr_psi_u=tr_psi_u,
+        tr_psi_w=tr_psi_w,
+        sources=sources,
     )

@@ -33,9 +33,10 @@ same with or without it (tested).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 from dataclasses import dataclass
-from typing import Any, Callable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -96,9 +97,14 @@ def episode_bytes(params: AttackParams, num_envs: int, schedule: EpisodeSchedule
     per_copy = (
         N * d  # X, U
         + 2 * d * (d + n)  # GC, Q
-        + 3 * d + 2 * n + 2  # scratch
+        + 3 * d
+        + 2 * n
+        + 2  # scratch
         + 3 * sch.chunk * n  # noise: drawn, in use, ahead
-        + H * m + 4 * m + 2 * n + 8  # history, actions and buffers, energy, eps, reward
+        + H * m
+        + 4 * m
+        + 2 * n
+        + 8  # history, actions and buffers, energy, eps, reward
         + (ObservationLayout.of(params).dim + 8 * 2) // 2  # observation (float32) and info per step
     )
     generators = 2048  # a numpy Generator with its bit generator, per copy
@@ -268,8 +274,17 @@ class EpisodeCore:
         # what the compiled kernels take (see _kernels): built once, the arrays are never rebound
         self._consts = (self._A, self._B, np.ascontiguousarray(self._theta_true.T), float(self._c), p.u_max, self._budget)
         self._arrays = (
-            self.x, self.energy, self.X, self.U, self.hist, self.Q, self.eps, self._reward_out,
-            np.zeros((K, m)), np.zeros((K, m), dtype=np.int64), np.zeros((K, n), dtype=np.int64),
+            self.x,
+            self.energy,
+            self.X,
+            self.U,
+            self.hist,
+            self.Q,
+            self.eps,
+            self._reward_out,
+            np.zeros((K, m)),
+            np.zeros((K, m), dtype=np.int64),
+            np.zeros((K, n), dtype=np.int64),
             np.zeros((2 * self.d + n + 2, K)),
         )
         self._a = self._arrays[8]  # the energy-limited input of the current step (a_buf)
@@ -367,13 +382,7 @@ class EpisodeCore:
             raise ShapeError(f"{name} must have shape {want}, got {arr.shape}")
         return np.array(arr, dtype=np.float64)
 
-    def reset(
-        self,
-        rng: np.random.Generator | Sequence[np.random.Generator],
-        *,
-        x0: Any = None,
-        noise: Any = None,
-    ) -> np.ndarray:
+    def reset(self, rng: np.random.Generator | Sequence[np.random.Generator], *, x0: Any = None, noise: Any = None) -> np.ndarray:
         """Start new episodes for all copies; return the observations, shape (K, obs_dim).
 
         ``rng`` is one generator (K = 1) or one per copy; all draws of copy ``i`` come from
@@ -630,8 +639,21 @@ class EpisodeCore:
                 obs = np.empty(self._obs_shape, dtype=np.float32)
                 N, collected = (target if new else self.delivered), self.collected + 1
                 status = self._step_fused(
-                    self._dims, self._consts, self._arrays, self._quant, act, w, self.collected - 1, self.collected,
-                    first, target, obs, self._obs_at, N - 1, float(new), float(self._time_frac[collected]),
+                    self._dims,
+                    self._consts,
+                    self._arrays,
+                    self._quant,
+                    act,
+                    w,
+                    self.collected - 1,
+                    self.collected,
+                    first,
+                    target,
+                    obs,
+                    self._obs_at,
+                    N - 1,
+                    float(new),
+                    float(self._time_frac[collected]),
                 )
                 if status == kern.STATE_OVERFLOW:
                     self._overflow()
@@ -681,8 +703,17 @@ class EpisodeCore:
         if obs is None:
             obs = np.empty(self._obs_shape, dtype=np.float32)
             kern.fill_observation(
-                self._dims, obs, self._obs_at, self.X, self.U, self.delivered - 1, float(self.new), self.hist,
-                float(self._time_frac[self.collected]), self.energy, self._budget,
+                self._dims,
+                obs,
+                self._obs_at,
+                self.X,
+                self.U,
+                self.delivered - 1,
+                float(self.new),
+                self.hist,
+                float(self._time_frac[self.collected]),
+                self.energy,
+                self._budget,
             )
         return obs
 
@@ -690,8 +721,12 @@ class EpisodeCore:
         """The info entries all copies share (:func:`~encctl_gym.envs.layout.info_dict`)."""
         collected, N = self.collected, self.delivered
         return (
-            self._gamma_list[N], self._time_list[collected], float(max(collected, 1) * self.m),
-            self._gamma_opt_list[N], collected, N,
+            self._gamma_list[N],
+            self._time_list[collected],
+            float(max(collected, 1) * self.m),
+            self._gamma_opt_list[N],
+            collected,
+            N,
         )
 
     def info_arrays(self) -> dict[str, np.ndarray]:

@@ -16,14 +16,7 @@ import numpy as np
 
 from ..errors import ParameterError
 
-__all__ = [
-    "ObservationLayout",
-    "OBSERVATION_MODES",
-    "INFO_KEYS",
-    "SHARED_INFO",
-    "PRIVILEGED_INFO",
-    "info_dict",
-]
+__all__ = ["ObservationLayout", "OBSERVATION_MODES", "INFO_KEYS", "SHARED_INFO", "PRIVILEGED_INFO", "info_dict"]
 
 #: Column subsets of the observation for learned attackers (:meth:`ObservationLayout.columns`).
 OBSERVATION_MODES = ("full", "no_budget", "blind")
@@ -54,7 +47,7 @@ class ObservationLayout:
     H: int
 
     @classmethod
-    def of(cls, params: Any) -> "ObservationLayout":
+    def of(cls, params: Any) -> ObservationLayout:
         """The layout of an environment's resolved parameters (:class:`~encctl_gym.envs.config.AttackParams`)."""
         return cls(int(params.n), int(params.m), int(params.input_history))
 
@@ -143,9 +136,7 @@ class ObservationLayout:
         if mode == "blind":
             if self.H == 0:
                 raise ParameterError("observation mode 'blind' needs input_history >= 1")
-            return np.concatenate(
-                [np.arange(self.history.start, self.history.stop), [self.time_fraction, self.energy_fraction]]
-            )
+            return np.concatenate([np.arange(self.history.start, self.history.stop), [self.time_fraction, self.energy_fraction]])
         raise ParameterError(f"unknown observation mode {mode!r}; choose one of {', '.join(OBSERVATION_MODES)}")
 
 

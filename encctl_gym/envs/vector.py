@@ -97,13 +97,21 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         if not isinstance(parallel, bool):
             raise ParameterError(f"parallel must be a bool, got {parallel!r}")
         self._core = EpisodeCore(
-            p, make_loop(p), self.design, num_envs=self.num_envs, parallel=parallel, helper=self.helper, schedule=schedule,
+            p,
+            make_loop(p),
+            self.design,
+            num_envs=self.num_envs,
+            parallel=parallel,
+            helper=self.helper,
+            schedule=schedule,
             memory_limit=memory_limit,
         )
         self._rngs: list[np.random.Generator] | None = None
         self._needs_reset = False
 
-    def reset(self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+    def reset(
+        self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
         if seed is not None or self._rngs is None:
             if isinstance(seed, (list, tuple)):
                 if len(seed) != self.num_envs:

@@ -19,16 +19,20 @@ from __future__ import annotations
 
 import sys
 
-from .error import *  # noqa: F403
-from .least_squares import *  # noqa: F403
-from .estimator import *  # noqa: F403
-from .ordinary import *  # noqa: F403
 from .bayes import *  # noqa: F403
+from .error import *  # noqa: F403
+from .estimator import *  # noqa: F403
 from .forgetting import *  # noqa: F403
 from .instrumental import *  # noqa: F403
+from .least_squares import *  # noqa: F403
+from .ordinary import *  # noqa: F403
 from .registry import *  # noqa: F403
 
 #: The public names of the modules above, in their order (each module's ``__all__``).
-__all__ = list(dict.fromkeys(
-    name for module in ("error", "least_squares", "estimator", "ordinary", "bayes", "forgetting", "instrumental", "registry") for name in sys.modules[f"{__name__}.{module}"].__all__
-))
+__all__ = list(
+    dict.fromkeys(
+        name
+        for module in ("error", "least_squares", "estimator", "ordinary", "bayes", "forgetting", "instrumental", "registry")
+        for name in sys.modules[f"{__name__}.{module}"].__all__
+    )
+)

@@ -149,7 +149,9 @@ class BayesianLeastSquares(MomentEstimator):
             raise ShapeError(f"prior_mean must have shape ({n}, {d}) for n={n}, m={m}, got {self.prior_mean.shape}")
         v = self.prior_variance
         if v is not None and v.ndim and v.shape not in ((d,), (n, d)):
-            raise ShapeError(f"prior_variance must be a scalar or have shape ({d},) or ({n}, {d}) for n={n}, m={m}, got {v.shape}")
+            raise ShapeError(
+                f"prior_variance must be a scalar or have shape ({d},) or ({n}, {d}) for n={n}, m={m}, got {v.shape}"
+            )
 
     # ------------------------------------------------------------------ the prior
     def mean_matrix(self, n: int, m: int) -> np.ndarray:
@@ -198,8 +200,11 @@ class BayesianLeastSquares(MomentEstimator):
         g, Q = np.linalg.eigh(Gf[live])  # (L, d), (L, d, d)
         g = np.maximum(g, 0.0)
         ct = Cf[live] - Gf[live] @ m0.T  # D (y - D^T m0): (L, d, n)
-        S = (np.trace(YYf[live], axis1=1, axis2=2) - 2.0 * np.einsum("ij,lji->l", m0, Cf[live])
-             + np.einsum("ij,ljk,ik->l", m0, Gf[live], m0))
+        S = (
+            np.trace(YYf[live], axis1=1, axis2=2)
+            - 2.0 * np.einsum("ij,lji->l", m0, Cf[live])
+            + np.einsum("ij,ljk,ik->l", m0, Gf[live], m0)
+        )
         b = np.swapaxes(Q, -1, -2) @ ct  # (L, d, n)
         beta = np.sum(b**2, axis=2)  # (L, d)
         logv = EVIDENCE_GRID[None, :] - np.log10(gbar[live])[:, None]  # (L, P)

@@ -54,9 +54,7 @@ def estimation_error(A: Any, B: Any, A_hat: Any, B_hat: Any) -> float | np.ndarr
     try:
         batch = np.broadcast_shapes(A_hat.shape[:-2], B_hat.shape[:-2])
     except ValueError as exc:
-        raise ShapeError(
-            f"batch shapes of A_hat {A_hat.shape[:-2]} and B_hat {B_hat.shape[:-2]} do not broadcast"
-        ) from exc
+        raise ShapeError(f"batch shapes of A_hat {A_hat.shape[:-2]} and B_hat {B_hat.shape[:-2]} do not broadcast") from exc
     ea = np.sum((A_hat - A) ** 2, axis=(-2, -1))
     eb = np.sum((B_hat - B) ** 2, axis=(-2, -1))
     err = np.broadcast_to(ea + eb, batch) / (n * (n + m))

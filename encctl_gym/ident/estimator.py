@@ -428,8 +428,10 @@ def check_grid(estimator: Estimator, sample_sizes: Any, n: int, m: int, N_max: i
         arr = np.asarray(sample_sizes)
         if arr.ndim != 1 or arr.size == 0:
             raise ParameterError(f"sample_sizes must be a non-empty 1-D sequence of integers, got {sample_sizes!r}")
-        if arr.dtype == bool or arr.dtype.kind not in "iuf" or (
-            arr.dtype.kind == "f" and not (np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)))
+        if (
+            arr.dtype == bool
+            or arr.dtype.kind not in "iuf"
+            or (arr.dtype.kind == "f" and not (np.all(np.isfinite(arr)) and np.all(arr == np.round(arr))))
         ):
             raise ParameterError(f"sample_sizes must be integers, got {sample_sizes!r}")
         grid = arr.astype(np.int64)

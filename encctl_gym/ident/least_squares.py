@@ -75,9 +75,7 @@ def check_trajectory(x: Any, u: Any) -> tuple[np.ndarray, np.ndarray]:
     if N < 2:
         raise ParameterError(f"a trajectory needs N >= 2 pairs (u_t, x_t) for the data matrices of eq:data, got N={N}")
     if u.shape[:-2] != x.shape[:-2] or u.shape[-2] not in (N, N - 1):
-        raise ShapeError(
-            f"u must have shape (..., N or N-1, m) matching x of shape {x.shape} (N={N}), got {u.shape}"
-        )
+        raise ShapeError(f"u must have shape (..., N or N-1, m) matching x of shape {x.shape} (N={N}), got {u.shape}")
     return x, u[..., : N - 1, :]
 
 
@@ -205,7 +203,9 @@ def solve_normal_equations(G: Any, C: Any) -> tuple[np.ndarray, np.ndarray]:
             good = chol & ((ld.min(axis=1) / ld.max(axis=1)) ** 2 >= d * _EPS)
         if good.any():
             Lg, sg = L[good], s[good]
-            theta_T[idx[good]] = np.linalg.solve(np.swapaxes(Lg, -1, -2), np.linalg.solve(Lg, Cf[idx[good]] * sg[:, :, None])) * sg[:, :, None]
+            theta_T[idx[good]] = (
+                np.linalg.solve(np.swapaxes(Lg, -1, -2), np.linalg.solve(Lg, Cf[idx[good]] * sg[:, :, None])) * sg[:, :, None]
+            )
         ok[idx[~good]] = False
     theta = np.swapaxes(theta_T, -1, -2).reshape(*lead, k, d)
     return theta, ok.reshape(lead)
@@ -400,7 +400,7 @@ def _qr_prefix(V: np.ndarray, cols: np.ndarray, d: int, n: int) -> np.ndarray:
     R = np.zeros((runs, 0, d + n))
     start = 0
     for k, stop in enumerate(cols):
-        R = np.linalg.qr(np.concatenate([R, V[:, start:stop]], axis=1), mode="r")[:, : d + n]
+        R = np.asarray(np.linalg.qr(np.concatenate([R, V[:, start:stop]], axis=1), mode="r"))[:, : d + n]
         # R = [[R_zz, R_zy], [0, R_yy]] and R_zz theta^T = R_zy (back substitution: an LU of an
         # upper-triangular matrix does no pivoting).
         theta[:, k] = np.swapaxes(np.linalg.solve(R[:, :d, :d], R[:, :d, d:]), -1, -2)
@@ -437,13 +437,7 @@ def _gram_prefix(V: np.ndarray, cols: np.ndarray, d: int, n: int) -> tuple[np.nd
 GRAM_COND_LIMIT = 1e6
 
 
-def prefix_estimates(
-    x: Any,
-    u: Any,
-    sample_sizes: Any,
-    *,
-    method: Literal["auto", "gram", "qr"] = "auto",
-) -> np.ndarray:
+def prefix_estimates(x: Any, u: Any, sample_sizes: Any, *, method: Literal["auto", "gram", "qr"] = "auto") -> np.ndarray:
     """Estimates ``[A_hat B_hat]`` of eq:estimate on every prefix ``N`` of a grid, in one pass.
 
     For each ``N`` in ``sample_sizes`` the estimate uses the first ``N`` pairs of each
@@ -513,14 +507,7 @@ def prefix_estimates(
 
 
 def identification_errors(
-    x: Any,
-    u: Any,
-    A: Any,
-    B: Any,
-    sample_sizes: Any,
-    *,
-    method: Literal["auto", "gram", "qr"] = "auto",
-    estimator: Any = None,
+    x: Any, u: Any, A: Any, B: Any, sample_sizes: Any, *, method: Literal["auto", "gram", "qr"] = "auto", estimator: Any = None
 ) -> np.ndarray:
     """The estimation error ``epsilon(N)`` of Definition def:error on a grid of ``N``.
 
@@ -564,10 +551,7 @@ def identification_errors(
     u_arr = as_finite_array("u", u)
     n, m = A.shape[0], B.shape[1]
     if x_arr.shape[-1] != n or u_arr.shape[-1] != m:
-        raise ShapeError(
-            f"data dimensions (n={x_arr.shape[-1]}, m={u_arr.shape[-1]}) do not match the system "
-            f"(n={n}, m={m})"
-        )
+        raise ShapeError(f"data dimensions (n={x_arr.shape[-1]}, m={u_arr.shape[-1]}) do not match the system (n={n}, m={m})")
     if estimator is not None:
         from .estimator import estimate_errors
         from .registry import make_estimator

@@ -25,7 +25,8 @@ they mean nothing for this full-state problem.
 from __future__ import annotations
 
 import inspect
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 from ..errors import ParameterError
 from .bayes import BayesianLeastSquares
@@ -54,7 +55,7 @@ def estimator_names() -> list[str]:
 
 
 def _parameters(cls: type) -> list[str]:
-    return [p for p in inspect.signature(cls.__init__).parameters if p != "self"]
+    return list(inspect.signature(cls).parameters)
 
 
 def make_estimator(spec: Any = None, **params: Any) -> Estimator:
@@ -103,9 +104,7 @@ def make_estimator(spec: Any = None, **params: Any) -> Estimator:
     known = _parameters(cls)
     unknown = sorted(set(params) - set(known))
     if unknown:
-        raise ParameterError(
-            f"unknown parameter(s) {unknown} for estimator {spec!r}; it takes {', '.join(known) or 'none'}"
-        )
+        raise ParameterError(f"unknown parameter(s) {unknown} for estimator {spec!r}; it takes {', '.join(known) or 'none'}")
     return cls(**params)
 
 

@@ -23,7 +23,17 @@ from .elgamal import ElGamalLoop
 from .ideal import IdealLoop
 from .quantize import Quantization
 
-__all__ = ["LoopBackend", "BACKENDS", "make_loop", "IdealLoop", "ElGamalLoop", "Quantization", "loop_group", "lqr_gain", "table_limit"]
+__all__ = [
+    "LoopBackend",
+    "BACKENDS",
+    "make_loop",
+    "IdealLoop",
+    "ElGamalLoop",
+    "Quantization",
+    "loop_group",
+    "lqr_gain",
+    "table_limit",
+]
 
 #: Backends by the name the environment's ``crypto`` key gives.
 BACKENDS: dict[str, type] = {"ideal": IdealLoop, "elgamal": ElGamalLoop}

@@ -39,19 +39,35 @@ from __future__ import annotations
 
 import sys
 
-from .gramians import *  # noqa: F403
-from .exact import *  # noqa: F403
-from .complexity import *  # noqa: F403
+from .attack_design import *  # noqa: F403
 from .bayes_complexity import *  # noqa: F403
-from .sample_size import *  # noqa: F403
-from .records import *  # noqa: F403
+from .complexity import *  # noqa: F403
 from .cost_models import *  # noqa: F403
 from .deciphering import *  # noqa: F403
 from .design import *  # noqa: F403
+from .exact import *  # noqa: F403
+from .gramians import *  # noqa: F403
 from .key_length import *  # noqa: F403
-from .attack_design import *  # noqa: F403
+from .records import *  # noqa: F403
+from .sample_size import *  # noqa: F403
 
 #: The public names of the modules above, in their order (each module's ``__all__``).
-__all__ = list(dict.fromkeys(
-    name for module in ("gramians", "exact", "complexity", "bayes_complexity", "sample_size", "records", "cost_models", "deciphering", "design", "key_length", "attack_design") for name in sys.modules[f"{__name__}.{module}"].__all__
-))
+__all__ = list(
+    dict.fromkeys(
+        name
+        for module in (
+            "gramians",
+            "exact",
+            "complexity",
+            "bayes_complexity",
+            "sample_size",
+            "records",
+            "cost_models",
+            "deciphering",
+            "design",
+            "key_length",
+            "attack_design",
+        )
+        for name in sys.modules[f"{__name__}.{module}"].__all__
+    )
+)

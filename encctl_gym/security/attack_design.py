@@ -235,9 +235,7 @@ def _solve(prob: Any, solver: str | None) -> str:
     raise SolverError("the A-optimal design SDP was not solved (" + "; ".join(errors) + ")")
 
 
-def _validate(
-    Sigma: np.ndarray, A: np.ndarray, B: np.ndarray, r: float, kind: str, M: np.ndarray | None, tol: float
-) -> None:
+def _validate(Sigma: np.ndarray, A: np.ndarray, B: np.ndarray, r: float, kind: str, M: np.ndarray | None, tol: float) -> None:
     """Check the (normalised) constraints; raise SolverError naming the violated one."""
     n, m = B.shape
     G = np.hstack([A, B])
@@ -382,6 +380,7 @@ def optimal_attack_design(
         K, V = _policy(Sigma[:n, :n], Sigma[n:, :n], Sigma[n:, n:])
         S_u = None
     else:
+        assert M_n is not None  # the open-loop program solves for M
         Mv = sw * M_n
         K, V = _policy(Mv[:n, :n], Mv[n:, :n], Mv[n:, n:])
         S_u = Mv[:n, :n]
@@ -494,7 +493,17 @@ def robust_security_design(
         _check_design_fits(design, A, B, su, sw, kind)
     N_star = sample_size_for_rate(design.rate, gamma_c)
     return design_for_sample_size(
-        kind, N_star, design.gamma, m=m, n=n, sigma_u2=su, sigma_w2=sw, sigma_x2=sigma_x2,
-        tr_psi_u=float(np.trace(controllability_gramian(A, B))), tr_psi_w=float(np.trace(noise_gramian(A))),
-        gamma_c=gamma_c, tau_c=tau_c, upsilon=upsilon,
+        kind,
+        N_star,
+        design.gamma,
+        m=m,
+        n=n,
+        sigma_u2=su,
+        sigma_w2=sw,
+        sigma_x2=sigma_x2,
+        tr_psi_u=float(np.trace(controllability_gramian(A, B))),
+        tr_psi_w=float(np.trace(noise_gramian(A))),
+        gamma_c=gamma_c,
+        tau_c=tau_c,
+        upsilon=upsilon,
     )

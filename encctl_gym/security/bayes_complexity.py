@@ -97,9 +97,7 @@ def _gram(G: Any, d: int) -> np.ndarray:
     return G
 
 
-def bayesian_error_given_gram(
-    A: Any, B: Any, G: Any, *, prior_mean: Any, precision: Any, sigma_w2: float
-) -> float | np.ndarray:
+def bayesian_error_given_gram(A: Any, B: Any, G: Any, *, prior_mean: Any, precision: Any, sigma_w2: float) -> float | np.ndarray:
     """(F): the expected error of the posterior mean at the plant ``(A, B)``, given ``G = D D^T``.
 
     ``E[epsilon | D] = (1/c) sum_i [ ||P_i Lambda_i (theta_i - m0_i)||^2 + sigma_w2 tr(P_i G P_i) ]``,
@@ -129,7 +127,11 @@ def bayesian_error_given_gram(
     sw = check_positive("sigma_w2", sigma_w2)
     G = _gram(G, d)
     lam = _precision(precision, n, d)
-    m0 = np.broadcast_to(as_finite_array("prior_mean", prior_mean), (n, d)) if np.ndim(prior_mean) else np.full((n, d), float(prior_mean))
+    m0 = (
+        np.broadcast_to(as_finite_array("prior_mean", prior_mean), (n, d))
+        if np.ndim(prior_mean)
+        else np.full((n, d), float(prior_mean))
+    )
     delta = np.hstack([A, B]) - m0  # (n, d)
     P = np.linalg.inv(G[..., None, :, :] + lam)  # (..., n, d, d)
     bias = np.einsum("...ijk,ikl,il->...ij", P, lam, delta)  # P_i Lambda_i delta_i
@@ -246,7 +248,9 @@ def bayesian_sample_identifying_complexity(
     return bayesian_sic_from_traces(N, tr_u, tr_w, m, n, sigma_u2, sigma_w2, sigma_x2, tr_precision=tr_lam)
 
 
-def prior_sample_equivalent(tr_precision: Any, tr_psi_u: float, tr_psi_w: float, m: int, *, sigma_u2: float, sigma_w2: float) -> float:
+def prior_sample_equivalent(
+    tr_precision: Any, tr_psi_u: float, tr_psi_w: float, m: int, *, sigma_u2: float, sigma_w2: float
+) -> float:
     """Samples a prior is worth in (C): ``tr Lambda / [sigma_u2 (tr Psi_u + m) + sigma_w2 tr Psi_w]``.
 
     ``gamma_B(N) = gamma(N + s)`` with ``s`` this number (for one ``tr Lambda`` shared by the
@@ -267,5 +271,7 @@ def prior_sample_equivalent(tr_precision: Any, tr_psi_u: float, tr_psi_w: float,
     """
     t = float(_trace_per_row(tr_precision, 1)[0])
     m = check_int("m", m, minimum=1)
-    K = check_positive("sigma_u2", sigma_u2) * (float(tr_psi_u) + m) + check_positive("sigma_w2", sigma_w2) * check_positive("tr_psi_w", tr_psi_w)
+    K = check_positive("sigma_u2", sigma_u2) * (float(tr_psi_u) + m) + check_positive("sigma_w2", sigma_w2) * check_positive(
+        "tr_psi_w", tr_psi_w
+    )
     return t / K

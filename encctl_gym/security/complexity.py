@@ -28,14 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import (
-    as_finite_array,
-    check_int,
-    check_nonnegative,
-    check_positive,
-    check_system,
-    format_value,
-)
+from .._validation import as_finite_array, check_int, check_nonnegative, check_positive, check_system, format_value
 from ..errors import ParameterError
 from ..ident.error import estimation_error  # Definition def:error; its home is the identification layer
 from .gramians import controllability_gramian, noise_gramian
@@ -51,7 +44,6 @@ __all__ = [
     "noise_upper_bound",
     "check_sample_size",
 ]
-
 
 
 def check_sample_size(N: Any, name: str = "N") -> tuple[np.ndarray, bool]:
@@ -118,14 +110,7 @@ def sic2_denominator(tr_psi_u: float, tr_psi_w: float, m: int, r_sigma: float) -
 
 
 def sic_from_traces(
-    N: Any,
-    tr_psi_u: float,
-    tr_psi_w: float,
-    m: int,
-    n: int,
-    sigma_u2: float,
-    sigma_w2: float,
-    sigma_x2: float = 1.0,
+    N: Any, tr_psi_u: float, tr_psi_w: float, m: int, n: int, sigma_u2: float, sigma_w2: float, sigma_x2: float = 1.0
 ) -> float | np.ndarray:
     """Sample identifying complexity eq:sic (Theorem thm:sic) from the Gramian traces.
 
@@ -160,9 +145,7 @@ def sic_from_traces(
     return _out((m + n) * sw / den, scalar)
 
 
-def sic_asymptotic_from_traces(
-    N: Any, tr_psi_u: float, tr_psi_w: float, m: int, n: int, r_sigma: float
-) -> float | np.ndarray:
+def sic_asymptotic_from_traces(N: Any, tr_psi_u: float, tr_psi_w: float, m: int, n: int, r_sigma: float) -> float | np.ndarray:
     """Large-sample complexity eq:sic2 (Corollary of Theorem thm:sic) from the Gramian traces.
 
     ``gamma(N) = (m+n) / ((N-1) [R_sigma (tr Psi_u + m) + tr Psi_w])``, of the shape of ``N``.

@@ -117,9 +117,7 @@ def _key_lengths(k: Any, lo: int, hi: int, what: str) -> tuple[np.ndarray, bool]
     if np.ndim(k) == 0:
         kk = check_int("key length k", k.item() if isinstance(k, np.ndarray) else k)
         if not lo <= kk <= hi:
-            raise ModelRangeError(
-                f"key length k = {format_value(kk)} is outside the range {lo} ... {hi} bits where {what} holds"
-            )
+            raise ModelRangeError(f"key length k = {format_value(kk)} is outside the range {lo} ... {hi} bits where {what} holds")
         return np.asarray(float(kk)), True
     try:
         arr = np.asarray(k, dtype=np.float64)
@@ -328,8 +326,11 @@ class KeyBreakCost:
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict (costs as log2 bits)."""
         return {
-            "model": self.model, "key_length": self.key_length, "security_parameter": self.security_parameter,
-            "first_key_bits": self.first_bits, "next_key_bits": self.next_bits,
+            "model": self.model,
+            "key_length": self.key_length,
+            "security_parameter": self.security_parameter,
+            "first_key_bits": self.first_bits,
+            "next_key_bits": self.next_bits,
             "precomputation_bits": None if self.precomputation is None else log2_fraction(self.precomputation),
             "gnfs_correction": self.gnfs_correction,
         }
@@ -442,8 +443,9 @@ class PaperModel(CostModel):
     def break_cost(self, key_length: int) -> KeyBreakCost:
         lam = self.security_parameter_of_key_length(key_length)
         c = pow2(lam)
-        return KeyBreakCost("paper", c, c, key_length=int(key_length), security_parameter=lam,
-                            gnfs_correction=self.gnfs_correction)
+        return KeyBreakCost(
+            "paper", c, c, key_length=int(key_length), security_parameter=lam, gnfs_correction=self.gnfs_correction
+        )
 
     def cost_of_security_parameter(self, lam: Any) -> KeyBreakCost:
         """The cost ``2^lam`` per key for an explicit security parameter (exact for integer ``lam``)."""
@@ -560,8 +562,9 @@ class PrecomputationModel(CostModel):
         pre_bits = float(gnfs_log2_complexity(key_length, self.gnfs_correction))
         pre = pow2(pre_bits)
         key = max(Fraction(1), pow2(pre_bits - self.ratio_bits(key_length)))
-        return KeyBreakCost("precomputation", pre + key, key, key_length=int(key_length), precomputation=pre,
-                            gnfs_correction=self.gnfs_correction)
+        return KeyBreakCost(
+            "precomputation", pre + key, key, key_length=int(key_length), precomputation=pre, gnfs_correction=self.gnfs_correction
+        )
 
     def describe(self) -> dict[str, Any]:
         return {

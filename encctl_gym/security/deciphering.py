@@ -56,13 +56,7 @@ import numpy as np
 
 from .._validation import as_finite_array, check_int, format_value
 from ..errors import ParameterError
-from .cost_models import (
-    DECIPHERING_MODELS,
-    KeyBreakCost,
-    PaperModel,
-    check_security_parameter,
-    deciphering_model,
-)
+from .cost_models import DECIPHERING_MODELS, KeyBreakCost, PaperModel, check_security_parameter, deciphering_model
 from .exact import decimal_fraction, exact_number
 
 __all__ = [
@@ -132,9 +126,7 @@ def keys_to_break(N: int, scheme: str = "modified", adversary: str = "eavesdropp
     return N if independent_keys(scheme, adversary) else min(N, 1)
 
 
-def break_cost(
-    model: Any = "paper", *, key_length: Any = None, security_parameter: Any = None, **options: Any
-) -> KeyBreakCost:
+def break_cost(model: Any = "paper", *, key_length: Any = None, security_parameter: Any = None, **options: Any) -> KeyBreakCost:
     """The cost of breaking keys under a model, for a key length or (paper model) a security parameter.
 
     Parameters

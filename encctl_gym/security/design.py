@@ -31,8 +31,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -357,15 +358,24 @@ def design_from_traces(
         N_star = optimal_sample_size(tr_psi_u, tr_psi_w, m, n, r_sigma=su / sw, gamma_c=gamma_c)
         gamma = exact_sic_asymptotic_function(tr_psi_u, tr_psi_w, m, n, r_sigma=su / sw)
     elif method == "exact":
-        N_star = exact_optimal_sample_size(
-            tr_psi_u, tr_psi_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=sigma_x2, gamma_c=gamma_c
-        )
+        N_star = exact_optimal_sample_size(tr_psi_u, tr_psi_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=sigma_x2, gamma_c=gamma_c)
         gamma = exact_sic_function(tr_psi_u, tr_psi_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=sigma_x2)
     else:
         raise ParameterError(f"unknown method {format_value(method)}; expected 'asymptotic' or 'exact'")
     return design_for_sample_size(
-        method, N_star, gamma, m=m, n=n, sigma_u2=sigma_u2, sigma_w2=sigma_w2, sigma_x2=sigma_x2,
-        tr_psi_u=tr_psi_u, tr_psi_w=tr_psi_w, gamma_c=gamma_c, tau_c=tau_c, upsilon=upsilon,
+        method,
+        N_star,
+        gamma,
+        m=m,
+        n=n,
+        sigma_u2=sigma_u2,
+        sigma_w2=sigma_w2,
+        sigma_x2=sigma_x2,
+        tr_psi_u=tr_psi_u,
+        tr_psi_w=tr_psi_w,
+        gamma_c=gamma_c,
+        tau_c=tau_c,
+        upsilon=upsilon,
     )
 
 
@@ -399,8 +409,17 @@ def design_security_parameter(
     tr_u = float(np.trace(controllability_gramian(A, B)))
     tr_w = float(np.trace(noise_gramian(A)))
     return design_from_traces(
-        tr_u, tr_w, m, n, sigma_u2=sigma_u2, sigma_w2=sigma_w2, sigma_x2=sigma_x2,
-        gamma_c=gamma_c, tau_c=tau_c, upsilon=upsilon, method=method,
+        tr_u,
+        tr_w,
+        m,
+        n,
+        sigma_u2=sigma_u2,
+        sigma_w2=sigma_w2,
+        sigma_x2=sigma_x2,
+        gamma_c=gamma_c,
+        tau_c=tau_c,
+        upsilon=upsilon,
+        method=method,
     )
 
 
@@ -418,6 +437,4 @@ def paper_design_example(method: str = "asymptotic") -> SecurityDesign:
     SecurityDesign
     """
     p: dict[str, Any] = dict(PAPER_DESIGN_EXAMPLE)
-    return design_from_traces(
-        p.pop("tr_psi_u"), p.pop("tr_psi_w"), int(p.pop("m")), int(p.pop("n")), method=method, **p
-    )
+    return design_from_traces(p.pop("tr_psi_u"), p.pop("tr_psi_w"), int(p.pop("m")), int(p.pop("n")), method=method, **p)

@@ -36,7 +36,8 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -53,31 +54,26 @@ from ..errors import ConfigError, ParameterError, ResourceLimitError
 from ..plant_file import load_plant_file, load_system
 from ..presets import DESIGN_FIELDS, design_defaults, get_preset, preset_names
 from ..units import SECONDS_PER_UNIT, parse_duration
-from .attack_design import (
-    SDP_MAX_DIMENSION,
-    gaussian_attack_design,
-    optimal_attack_design,
-    robust_security_design,
-)
-from .complexity import (
-    input_upper_bound,
-    noise_upper_bound,
-    sic_asymptotic_from_traces,
-    sic_from_traces,
-)
-from .cost_models import (
-    DECIPHERING_MODELS,
-    GUILLEVIC_CORRECTION,
-    check_gnfs_correction,
-    gnfs_log2_complexity,
-)
+from .attack_design import SDP_MAX_DIMENSION, gaussian_attack_design, optimal_attack_design, robust_security_design
+from .complexity import input_upper_bound, noise_upper_bound, sic_asymptotic_from_traces, sic_from_traces
+from .cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION, check_gnfs_correction, gnfs_log2_complexity
 from .design import SecurityDesign, design_from_traces
 from .gramians import controllability_gramian, noise_gramian
 from .key_length import build_model, design_key_length, key_length_value
 from .records import RecordSet, default_records, load_records
 
-__all__ = ["add_arguments", "run", "parse_duration", "load_system", "DEFAULTS", "compute", "COMPLEXITIES",
-           "MAX_STATE_DIMENSION", "parse_cost_models", "parse_gnfs_correction"]
+__all__ = [
+    "add_arguments",
+    "run",
+    "parse_duration",
+    "load_system",
+    "DEFAULTS",
+    "compute",
+    "COMPLEXITIES",
+    "MAX_STATE_DIMENSION",
+    "parse_cost_models",
+    "parse_gnfs_correction",
+]
 
 #: Option defaults: the paper's design example (from :mod:`encctl_gym.presets`).
 DEFAULTS: dict[str, Any] = design_defaults()
@@ -107,37 +103,67 @@ LABELS = {
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the options of ``encctl-gym design``."""
-    parser.add_argument("system_file", nargs="?", metavar="SYSTEM_FILE",
-                        help="plant file: JSON/YAML ({'A': [[...]], 'B': [[...]]}, optional sigma_u2, sigma_w2, "
-                        "sigma_x2, gamma_c, tau_c, upsilon) or NPZ with the same names")
-    parser.add_argument("--preset", choices=preset_names(), metavar="NAME",
-                        help="use a preset plant (with its variances and design parameters) instead of a file: "
-                        + ", ".join(preset_names()))
-    parser.add_argument("--gamma-c", dest="gamma_c", metavar="G",
-                        help="acceptable estimation error gamma_c (default 1e-6)")
-    parser.add_argument("--tau-c", dest="tau_c", metavar="T",
-                        help="defense period: 10y, 5d, 2h, 30min, 3600s or seconds (default 10y)")
+    parser.add_argument(
+        "system_file",
+        nargs="?",
+        metavar="SYSTEM_FILE",
+        help="plant file: JSON/YAML ({'A': [[...]], 'B': [[...]]}, optional sigma_u2, sigma_w2, "
+        "sigma_x2, gamma_c, tau_c, upsilon) or NPZ with the same names",
+    )
+    parser.add_argument(
+        "--preset",
+        choices=preset_names(),
+        metavar="NAME",
+        help="use a preset plant (with its variances and design parameters) instead of a file: " + ", ".join(preset_names()),
+    )
+    parser.add_argument("--gamma-c", dest="gamma_c", metavar="G", help="acceptable estimation error gamma_c (default 1e-6)")
+    parser.add_argument(
+        "--tau-c", dest="tau_c", metavar="T", help="defense period: 10y, 5d, 2h, 30min, 3600s or seconds (default 10y)"
+    )
     parser.add_argument("--upsilon", metavar="FLOPS", help="adversary computing speed in FLOPS (default 442e15)")
     parser.add_argument("--sigma-u2", dest="sigma_u2", metavar="V", help="attack input variance (default 10)")
     parser.add_argument("--sigma-w2", dest="sigma_w2", metavar="V", help="noise variance (default 0.1)")
     parser.add_argument("--sigma-x2", dest="sigma_x2", metavar="V", help="initial-state variance (default 1)")
     parser.add_argument("--solver", metavar="NAME", help="cvxpy solver for the attack designs (default Clarabel, then SCS)")
-    parser.add_argument("--sdp-max-dim", dest="sdp_max_dim", metavar="P",
-                        help=f"largest n + m for the attack-design SDPs of rows (c), (d) (default {SDP_MAX_DIMENSION}; "
-                        "larger plants skip those rows with an estimate)")
-    parser.add_argument("--cost-model", dest="cost_model", metavar="MODEL",
-                        help="add the key length under deciphering-cost models: "
-                        + ", ".join(DECIPHERING_MODELS) + ", all, or a comma-separated list")
-    parser.add_argument("--gnfs-correction", dest="gnfs_correction", metavar="BITS",
-                        help="o(1) correction of the GNFS cost in bits for the paper and precomputation models "
-                        f"(default 0, the paper's numbers; 'guillevic' = {GUILLEVIC_CORRECTION:g})")
-    parser.add_argument("--complexity", choices=list(COMPLEXITIES), default="sic2",
-                        help="which N* the cost-model rows protect (default sic2, the paper's)")
-    parser.add_argument("--key-length", dest="key_length", metavar="K",
-                        help="key length whose worth the cost-model section shows (default: the paper's k*)")
-    parser.add_argument("--calibration", metavar="FILE",
-                        help="records file (layout of security/data/deciphering_records.json) for the "
-                        "precomputation model's per-key ratio")
+    parser.add_argument(
+        "--sdp-max-dim",
+        dest="sdp_max_dim",
+        metavar="P",
+        help=f"largest n + m for the attack-design SDPs of rows (c), (d) (default {SDP_MAX_DIMENSION}; "
+        "larger plants skip those rows with an estimate)",
+    )
+    parser.add_argument(
+        "--cost-model",
+        dest="cost_model",
+        metavar="MODEL",
+        help="add the key length under deciphering-cost models: "
+        + ", ".join(DECIPHERING_MODELS)
+        + ", all, or a comma-separated list",
+    )
+    parser.add_argument(
+        "--gnfs-correction",
+        dest="gnfs_correction",
+        metavar="BITS",
+        help="o(1) correction of the GNFS cost in bits for the paper and precomputation models "
+        f"(default 0, the paper's numbers; 'guillevic' = {GUILLEVIC_CORRECTION:g})",
+    )
+    parser.add_argument(
+        "--complexity",
+        choices=list(COMPLEXITIES),
+        default="sic2",
+        help="which N* the cost-model rows protect (default sic2, the paper's)",
+    )
+    parser.add_argument(
+        "--key-length",
+        dest="key_length",
+        metavar="K",
+        help="key length whose worth the cost-model section shows (default: the paper's k*)",
+    )
+    parser.add_argument(
+        "--calibration",
+        metavar="FILE",
+        help="records file (layout of security/data/deciphering_records.json) for the precomputation model's per-key ratio",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
 
 
@@ -180,8 +206,15 @@ def _check_size(n: int, m: int) -> None:
 
 # --------------------------------------------------------------------------- computation
 def _cost_model_section(
-    designs: dict[str, SecurityDesign], *, models: Sequence[str], complexity: str, gnfs_correction: float,
-    key_length: Any, records: RecordSet, tau_c: float, upsilon: float,
+    designs: dict[str, SecurityDesign],
+    *,
+    models: Sequence[str],
+    complexity: str,
+    gnfs_correction: float,
+    key_length: Any,
+    records: RecordSet,
+    tau_c: float,
+    upsilon: float,
 ) -> dict[str, Any]:
     key = COMPLEXITIES[complexity]
     if key not in designs:
@@ -189,19 +222,22 @@ def _cost_model_section(
     N_star = designs[key].N_star
     out_designs = {}
     for name in models:
-        d = design_key_length(name, N_star, tau_c=tau_c, upsilon=upsilon, gnfs_correction=gnfs_correction,
-                              calibration=records)
+        d = design_key_length(name, N_star, tau_c=tau_c, upsilon=upsilon, gnfs_correction=gnfs_correction, calibration=records)
         out_designs[name] = d.to_dict()
     k_val = designs[key].k_star if key_length is None else check_int("key_length", key_length)
     values = {
-        name: key_length_value(name, k_val, N_star=N_star, tau_c=tau_c, upsilon=upsilon,
-                               gnfs_correction=gnfs_correction, calibration=records).to_dict()
+        name: key_length_value(
+            name, k_val, N_star=N_star, tau_c=tau_c, upsilon=upsilon, gnfs_correction=gnfs_correction, calibration=records
+        ).to_dict()
         for name in models
     }
     first = next(iter(out_designs.values()))
     return {
-        "complexity": complexity, "N_star": N_star, "budget_bits": first["budget_bits"],
-        "gnfs_correction": gnfs_correction, "designs": out_designs,
+        "complexity": complexity,
+        "N_star": N_star,
+        "budget_bits": first["budget_bits"],
+        "gnfs_correction": gnfs_correction,
+        "designs": out_designs,
         "key_value": {"key_length": k_val, "models": values},
     }
 
@@ -218,10 +254,22 @@ def _records_section(records: RecordSet) -> dict[str, Any]:
 
 
 def compute(
-    A: Any, B: Any, *, gamma_c: float, tau_c: float, upsilon: float, sigma_u2: float, sigma_w2: float,
-    sigma_x2: float = 1.0, solver: str | None = None, sdp_max_dimension: int | None = None,
-    cost_models: Sequence[str] | None = None, gnfs_correction: Any = 0.0, complexity: str = "sic2",
-    key_length: Any = None, calibration: RecordSet | None = None,
+    A: Any,
+    B: Any,
+    *,
+    gamma_c: float,
+    tau_c: float,
+    upsilon: float,
+    sigma_u2: float,
+    sigma_w2: float,
+    sigma_x2: float = 1.0,
+    solver: str | None = None,
+    sdp_max_dimension: int | None = None,
+    cost_models: Sequence[str] | None = None,
+    gnfs_correction: Any = 0.0,
+    complexity: str = "sic2",
+    key_length: Any = None,
+    calibration: RecordSet | None = None,
 ) -> dict[str, Any]:
     """All quantities of the ``design`` output as a JSON-ready dict.
 
@@ -277,8 +325,9 @@ def compute(
     skipped: dict[str, str] = {}
     for kind, feedback in (("closed_loop", True), ("open_loop", False)):
         try:
-            attacks[kind] = optimal_attack_design(A, B, sigma_u2=su, sigma_w2=sw, feedback=feedback, solver=solver,
-                                                  max_dimension=sdp_max_dimension)
+            attacks[kind] = optimal_attack_design(
+                A, B, sigma_u2=su, sigma_w2=sw, feedback=feedback, solver=solver, max_dimension=sdp_max_dimension
+            )
         except ResourceLimitError as exc:
             skipped[kind] = str(exc)
     attacks["gaussian"] = gaussian_attack_design(A, B, sigma_u2=su, sigma_w2=sw)
@@ -301,8 +350,7 @@ def compute(
         out_designs[name] = entry
     res: dict[str, Any] = {
         "system": {"n": n, "m": m, "spectral_radius": rho, "tr_psi_u": tr_u, "tr_psi_w": tr_w, "r_sigma": su / sw},
-        "parameters": {"gamma_c": gamma_c, "tau_c": tau_c, "upsilon": upsilon,
-                       "sigma_u2": su, "sigma_w2": sw, "sigma_x2": sx},
+        "parameters": {"gamma_c": gamma_c, "tau_c": tau_c, "upsilon": upsilon, "sigma_u2": su, "sigma_w2": sw, "sigma_x2": sx},
         "bounds": {
             "N": N_ref,
             "input_upper_bound": float(input_upper_bound(N_ref, m, n, su / sw)),
@@ -314,8 +362,14 @@ def compute(
     if cost_models:
         records = calibration if calibration is not None else default_records()
         res["cost_models"] = _cost_model_section(
-            designs, models=cost_models, complexity=complexity, gnfs_correction=c, key_length=key_length,
-            records=records, tau_c=tau_c, upsilon=upsilon,
+            designs,
+            models=cost_models,
+            complexity=complexity,
+            gnfs_correction=c,
+            key_length=key_length,
+            records=records,
+            tau_c=tau_c,
+            upsilon=upsilon,
         )
         res["models"] = {name: _describe(name, c, records) for name in cost_models}
         res["records"] = _records_section(records)
@@ -377,9 +431,12 @@ def _format_cost_models(res: dict[str, Any]) -> list[str]:
     ]
     if "records" in res:
         rec = res["records"]
-        lines += ["", f"  Records ({rec['path']}; one operation = one core clock cycle):",
-                  f"  {'name':<12}{'bits':>6}  {'problem':<10}{'total':<18}{'per key':<14}{'ratio':>7}{'ops':>8}"
-                  f"{'formula':>9}{'diff':>7}  used"]
+        lines += [
+            "",
+            f"  Records ({rec['path']}; one operation = one core clock cycle):",
+            f"  {'name':<12}{'bits':>6}  {'problem':<10}{'total':<18}{'per key':<14}{'ratio':>7}{'ops':>8}"
+            f"{'formula':>9}{'diff':>7}  used",
+        ]
         for r in rec["records"]:
             basis = "" if r["time_basis"] == "core" else " (wall)"
             lines.append(
@@ -387,13 +444,19 @@ def _format_cost_models(res: dict[str, Any]) -> list[str]:
                 f"{_bits(r['log2_ratio'], 7, 2)}{_bits(r['log2_operations'], 8, 2)}{_bits(r['formula_bits'], 9, 2)}"
                 f"{_bits(r['formula_minus_record_bits'], 7, 2)}  {'ratio' if r['use_for_ratio'] else '-'}"
             )
-        lines.append("  ratio: log2(total / per-key time); ops: log2 cycles of the total; formula: log2 Omega(k); "
-                     "diff: formula - ops.")
-        lines += ["", "  NIST SP 800-57 comparable strengths against the GNFS formula (bits):",
-                  f"  {'key length':>12}{'NIST':>8}{'formula':>10}{'formula - ' + format(GUILLEVIC_CORRECTION, 'g'):>18}"]
+        lines.append(
+            "  ratio: log2(total / per-key time); ops: log2 cycles of the total; formula: log2 Omega(k); diff: formula - ops."
+        )
+        lines += [
+            "",
+            "  NIST SP 800-57 comparable strengths against the GNFS formula (bits):",
+            f"  {'key length':>12}{'NIST':>8}{'formula':>10}{'formula - ' + format(GUILLEVIC_CORRECTION, 'g'):>18}",
+        ]
         for row in rec["nist_sp800_57"]["rows"]:
-            lines.append(f"  {row['key_length']:>12d}{row['strength']:>8d}{row['formula_bits']:>10.2f}"
-                         f"{row['formula_guillevic_bits']:>18.2f}")
+            lines.append(
+                f"  {row['key_length']:>12d}{row['strength']:>8d}{row['formula_bits']:>10.2f}"
+                f"{row['formula_guillevic_bits']:>18.2f}"
+            )
     return lines
 
 
@@ -473,16 +536,33 @@ def run(args: argparse.Namespace) -> int:
         names = {"file": "from the file", "option": "from the command line", "default": "defaults (the paper's design example)"}
         sources_line = "; ".join(f"{', '.join(v)} {names[k]}" for k, v in groups.items())
     models = parse_cost_models(args.cost_model) if args.cost_model is not None else None
-    extra_given = [opt for opt, v in (("--gnfs-correction", args.gnfs_correction), ("--key-length", args.key_length),
-                                      ("--calibration", args.calibration)) if v is not None]
+    extra_given = [
+        opt
+        for opt, v in (
+            ("--gnfs-correction", args.gnfs_correction),
+            ("--key-length", args.key_length),
+            ("--calibration", args.calibration),
+        )
+        if v is not None
+    ]
     if models is None and (extra_given or args.complexity != "sic2"):
         raise ConfigError(f"{', '.join(extra_given) or '--complexity'} only applies with --cost-model")
     correction = 0.0 if args.gnfs_correction is None else parse_gnfs_correction(args.gnfs_correction)
     key_length = None if args.key_length is None else check_int("key_length", parse_number("key_length", args.key_length))
     records = None if args.calibration is None else load_records(args.calibration)
     sdp = None if args.sdp_max_dim is None else check_int("sdp_max_dim", parse_number("sdp_max_dim", args.sdp_max_dim), 2)
-    res = compute(A, B, solver=args.solver, sdp_max_dimension=sdp, cost_models=models, gnfs_correction=correction,
-                  complexity=args.complexity, key_length=key_length, calibration=records, **values)
+    res = compute(
+        A,
+        B,
+        solver=args.solver,
+        sdp_max_dimension=sdp,
+        cost_models=models,
+        gnfs_correction=correction,
+        complexity=args.complexity,
+        key_length=key_length,
+        calibration=records,
+        **values,
+    )
     if args.json:
         res["title"] = title
         res["sources"] = sources

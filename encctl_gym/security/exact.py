@@ -34,15 +34,7 @@ import numpy as np
 from .._validation import FLOAT_MAX, format_value
 from ..errors import ModelRangeError, ParameterError
 
-__all__ = [
-    "decimal_fraction",
-    "binary_fraction",
-    "exact_number",
-    "floor_log2",
-    "log2_fraction",
-    "pow2",
-    "POW2_MAX_EXPONENT",
-]
+__all__ = ["decimal_fraction", "binary_fraction", "exact_number", "floor_log2", "log2_fraction", "pow2", "POW2_MAX_EXPONENT"]
 
 #: Largest exponent :func:`pow2` accepts: 2^(2^17) is a 131073-bit integer, cheap to handle;
 #: no cost model of this package gets near it for key lengths up to 65536 bits.
@@ -52,8 +44,7 @@ POW2_MAX_EXPONENT: float = float(2**17)
 def _check_magnitude(name: str, value: Any, frac: Fraction) -> None:
     if abs(frac) > FLOAT_MAX:
         raise ParameterError(
-            f"{name} must be a finite real number within the float64 range (|x| <= {FLOAT_MAX:.4g}), "
-            f"got {format_value(value)}"
+            f"{name} must be a finite real number within the float64 range (|x| <= {FLOAT_MAX:.4g}), got {format_value(value)}"
         )
 
 

@@ -56,7 +56,7 @@ def solve_gramian(A: np.ndarray, Q: np.ndarray) -> np.ndarray:
     if not np.all(np.isfinite(X)):
         raise SolverError("the discrete Lyapunov solution is not finite (A too close to instability?)")
     resid = np.linalg.norm(A @ X @ A.T - X + Q)
-    scale = max(1.0, np.linalg.norm(X), np.linalg.norm(Q))
+    scale = max(1.0, float(np.linalg.norm(X)), float(np.linalg.norm(Q)))
     if resid > 1e-8 * scale:
         raise SolverError(f"the discrete Lyapunov solve is inaccurate: residual {resid:.3g}")
     return X

@@ -204,12 +204,21 @@ def design_key_length(
     work = log2_fraction(cost.operations(keys))
     lam_star = paper_security_parameter(keys, budget) if isinstance(m, PaperModel) else None
     return KeyLengthDesign(
-        model=m.name, N_star=N_star, keys=keys, k_star=k_star, lam_star=lam_star,
-        budget_bits=log2_fraction(budget), work_bits=work, first_key_bits=cost.first_bits,
-        next_key_bits=cost.next_bits, dynamic_key_bits=work - cost.first_bits,
+        model=m.name,
+        N_star=N_star,
+        keys=keys,
+        k_star=k_star,
+        lam_star=lam_star,
+        budget_bits=log2_fraction(budget),
+        work_bits=work,
+        first_key_bits=cost.first_bits,
+        next_key_bits=cost.next_bits,
+        dynamic_key_bits=work - cost.first_bits,
         paper_k_star=PaperModel().minimum_key_length(keys, budget),
         nist_key_length=nist_key_length(cost.first_bits),
-        gnfs_correction=float(getattr(m, "gnfs_correction", 0.0)), scheme=scheme, adversary=adversary,
+        gnfs_correction=float(getattr(m, "gnfs_correction", 0.0)),
+        scheme=scheme,
+        adversary=adversary,
     )
 
 
@@ -252,8 +261,14 @@ def key_length_value(
     else:
         log_n = log2_fraction(Fraction(int(n_max)))
     return KeyValue(
-        model=m.name, key_length=int(key_length), first_key_bits=cost.first_bits, next_key_bits=cost.next_bits,
-        affordable_samples=n_max, log2_affordable_samples=log_n, work_bits=work,
-        dynamic_key_bits=work - cost.first_bits, secure=bool(n_max < N_star),
+        model=m.name,
+        key_length=int(key_length),
+        first_key_bits=cost.first_bits,
+        next_key_bits=cost.next_bits,
+        affordable_samples=n_max,
+        log2_affordable_samples=log_n,
+        work_bits=work,
+        dynamic_key_bits=work - cost.first_bits,
+        secure=bool(n_max < N_star),
         nist_strength=nist_strength(int(key_length)),
     )

@@ -24,10 +24,11 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Iterable, Mapping
+from typing import Any
 
 from .._validation import check_bool, check_int, check_positive, format_value
 from ..errors import ConfigError, ParameterError, ResourceLimitError
@@ -131,11 +132,19 @@ class Record:
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict, with the derived ``log2_ratio`` and ``log2_operations``."""
         return {
-            "name": self.name, "problem": self.problem, "key_length": self.key_length, "year": self.year,
-            "total": self.total_text, "per_key": self.per_key_text or None, "time_basis": self.time_basis,
-            "clock_hz": self.clock_hz, "use_for_ratio": self.use_for_ratio,
-            "log2_ratio": self.log2_ratio, "log2_operations": self.log2_operations,
-            "source": self.source, "note": self.note,
+            "name": self.name,
+            "problem": self.problem,
+            "key_length": self.key_length,
+            "year": self.year,
+            "total": self.total_text,
+            "per_key": self.per_key_text or None,
+            "time_basis": self.time_basis,
+            "clock_hz": self.clock_hz,
+            "use_for_ratio": self.use_for_ratio,
+            "log2_ratio": self.log2_ratio,
+            "log2_operations": self.log2_operations,
+            "source": self.source,
+            "note": self.note,
         }
 
 
@@ -194,8 +203,10 @@ class RecordSet:
             "path": self.path,
             "records": [r.to_dict() for r in self.records],
             "ratio_points": [{"key_length": p.key_length, "ratio_bits": p.ratio_bits} for p in self.ratio_points],
-            "nist_sp800_57": {"source": self.nist_source,
-                              "rows": [{"strength": r.strength, "key_length": r.key_length} for r in self.nist]},
+            "nist_sp800_57": {
+                "source": self.nist_source,
+                "rows": [{"strength": r.strength, "key_length": r.key_length} for r in self.nist],
+            },
             "gnfs_corrections": {k: {"bits": b, "source": s} for k, (b, s) in self.corrections.items()},
         }
 
@@ -206,10 +217,12 @@ def _duration(where: str, spec: Any, basis: str) -> tuple[float, str]:
     unit = spec["unit"]
     if not isinstance(unit, str):
         raise ConfigError(f"{where}: unit must be a string, got {format_value(unit)}")
-    base = unit[len("core-"):] if unit.startswith("core-") else unit
+    base = unit[len("core-") :] if unit.startswith("core-") else unit
     if base not in _UNIT_SECONDS:
-        raise ConfigError(f"{where}: unknown unit {format_value(unit)}; use second, minute, hour, day, week or year "
-                          "(with a 'core-' prefix for core time)")
+        raise ConfigError(
+            f"{where}: unknown unit {format_value(unit)}; use second, minute, hour, day, week or year "
+            "(with a 'core-' prefix for core time)"
+        )
     if unit.startswith("core-") != (basis == "core"):
         raise ConfigError(f"{where}: unit {unit!r} does not match time_basis {basis!r}")
     value = check_positive(f"{where}.value", spec["value"])
@@ -224,8 +237,19 @@ def _record(i: int, raw: Any) -> Record:
     where = f"records[{i}]"
     if not isinstance(raw, Mapping):
         raise ConfigError(f"{where} must be an object, got {format_value(raw)}")
-    known = {"name", "problem", "key_length", "year", "total", "per_key", "time_basis", "clock_ghz",
-             "use_for_ratio", "source", "note"}
+    known = {
+        "name",
+        "problem",
+        "key_length",
+        "year",
+        "total",
+        "per_key",
+        "time_basis",
+        "clock_ghz",
+        "use_for_ratio",
+        "source",
+        "note",
+    }
     unknown = sorted(set(map(str, raw)) - known)
     if unknown:
         raise ConfigError(f"{where} has unknown field(s) {unknown}; known: {sorted(known)}")
@@ -258,8 +282,21 @@ def _record(i: int, raw: Any) -> Record:
     for field in ("source", "note"):
         if not isinstance(raw.get(field, ""), str):
             raise ConfigError(f"{where}.{field} must be a string, got {format_value(raw.get(field))}")
-    return Record(name, raw["problem"], k, year, total, per_key, basis, clock_hz, use, total_text, per_key_text,
-                  raw["source"], raw.get("note", ""))
+    return Record(
+        name,
+        raw["problem"],
+        k,
+        year,
+        total,
+        per_key,
+        basis,
+        clock_hz,
+        use,
+        total_text,
+        per_key_text,
+        raw["source"],
+        raw.get("note", ""),
+    )
 
 
 def check_increasing(what: str, key_lengths: Iterable[int]) -> None:
@@ -288,8 +325,9 @@ def parse_records(data: Any, path: str = "<data>") -> RecordSet:
     if not isinstance(raw_records, list):
         raise ConfigError(f"{path}: records must be a list, got {format_value(raw_records)}")
     records = tuple(_record(i, r) for i, r in enumerate(raw_records))
-    check_increasing(f"{path}: the ratio calibration points (records with use_for_ratio)",
-                     [r.key_length for r in records if r.use_for_ratio])
+    check_increasing(
+        f"{path}: the ratio calibration points (records with use_for_ratio)", [r.key_length for r in records if r.use_for_ratio]
+    )
     nist_raw = data.get("nist_sp800_57", {"source": "", "rows": []})
     if not isinstance(nist_raw, Mapping) or not isinstance(nist_raw.get("rows"), list):
         raise ConfigError(f"{path}: nist_sp800_57 must be an object with a list 'rows', got {format_value(nist_raw)}")
@@ -298,8 +336,11 @@ def parse_records(data: Any, path: str = "<data>") -> RecordSet:
         if not isinstance(r, Mapping) or set(r) != {"strength", "key_length"}:
             raise ConfigError(f"{path}: nist_sp800_57 row {i} must have 'strength' and 'key_length', got {format_value(r)}")
         try:
-            rows.append(NistRow(check_int("nist strength", r["strength"], minimum=1),
-                                check_int("nist key_length", r["key_length"], minimum=2)))
+            rows.append(
+                NistRow(
+                    check_int("nist strength", r["strength"], minimum=1), check_int("nist key_length", r["key_length"], minimum=2)
+                )
+            )
         except ParameterError as exc:
             raise ConfigError(f"{path}: {exc}") from None
     nist = tuple(rows)

@@ -28,8 +28,9 @@ of a numerical design) by the binary rule.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from fractions import Fraction
-from typing import Any, Callable
+from typing import Any
 
 from .._validation import check_int, check_nonnegative, format_value
 from ..errors import ParameterError
@@ -113,15 +114,7 @@ def optimal_sample_size(tr_psi_u: Any, tr_psi_w: Any, m: int, n: int, *, r_sigma
 
 
 def exact_optimal_sample_size(
-    tr_psi_u: Any,
-    tr_psi_w: Any,
-    m: int,
-    n: int,
-    *,
-    sigma_u2: Any,
-    sigma_w2: Any,
-    sigma_x2: Any = 1.0,
-    gamma_c: Any,
+    tr_psi_u: Any, tr_psi_w: Any, m: int, n: int, *, sigma_u2: Any, sigma_w2: Any, sigma_x2: Any = 1.0, gamma_c: Any
 ) -> int:
     """Smallest ``N >= 2`` with the exact complexity eq:sic below ``gamma_c`` (closed form).
 
@@ -158,9 +151,7 @@ def exact_optimal_sample_size(
     return max(2, math.floor(q) + 2)
 
 
-def minimum_sample_size(
-    gamma: Callable[[int], Any], gamma_c: Any, *, n_min: int = 2, n_max: int = 2**256
-) -> int:
+def minimum_sample_size(gamma: Callable[[int], Any], gamma_c: Any, *, n_min: int = 2, n_max: int = 2**256) -> int:
     """Smallest integer ``N >= n_min`` with ``gamma(N) < gamma_c``, by exponential and binary search.
 
     ``gamma`` must be nonincreasing in ``N`` (every sample identifying complexity of this
@@ -235,9 +226,7 @@ def exact_sic_function(
     return gamma
 
 
-def exact_sic_asymptotic_function(
-    tr_psi_u: Any, tr_psi_w: Any, m: int, n: int, *, r_sigma: Any
-) -> Callable[[int], Fraction]:
+def exact_sic_asymptotic_function(tr_psi_u: Any, tr_psi_w: Any, m: int, n: int, *, r_sigma: Any) -> Callable[[int], Fraction]:
     """eq:sic2 as an exact function ``N -> Fraction``.
 
     Returns

@@ -9,13 +9,12 @@ version (their home is :mod:`encctl_gym.ident`).
 
 from __future__ import annotations
 
-from . import montecarlo, plant
-from .montecarlo import *  # noqa: F403
-from .plant import *  # noqa: F403
-
 # the least-squares and task names this package gave before they had homes of their own
 from ..ident.least_squares import RecursiveLeastSquares, data_matrices, identification_errors, least_squares, prefix_estimates  # noqa: E501
 from ..parallel import child_seeds, run_tasks
+from . import montecarlo, plant
+from .montecarlo import *  # noqa: F403
+from .plant import *  # noqa: F403
 
 __all__ = [
     *plant.__all__,

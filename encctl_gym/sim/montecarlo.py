@@ -10,8 +10,9 @@ child seed per system.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Literal, Sequence
+from typing import Any, Literal
 
 import numpy as np
 
@@ -123,7 +124,12 @@ def _task(job: tuple[AttackSpec, np.ndarray, int, str, Any], seed: np.random.See
     spec, grid, runs, method, estimator = job
     plant = LinearPlant(spec.A, spec.B, sigma_w2=spec.sigma_w2, sigma_x2=spec.sigma_x2)
     return gaussian_attack_errors(
-        plant, sample_sizes=grid, runs=runs, sigma_u2=spec.sigma_u2, seed=seed, method=method,  # type: ignore[arg-type]
+        plant,
+        sample_sizes=grid,
+        runs=runs,
+        sigma_u2=spec.sigma_u2,
+        seed=seed,
+        method=method,  # type: ignore[arg-type]
         estimator=estimator,
     )
 
@@ -179,7 +185,6 @@ def sweep_gaussian_attack(
             grid = check_grid(estimator, sample_sizes, plant.n, plant.m)
         jobs.append((s, grid, runs, method, estimator))
     out = run_tasks(
-        _task, jobs, seed=seed, n_jobs=n_jobs, scheduler=scheduler,
-        cluster_kwargs=cluster_kwargs, progress=progress, desc=desc,
+        _task, jobs, seed=seed, n_jobs=n_jobs, scheduler=scheduler, cluster_kwargs=cluster_kwargs, progress=progress, desc=desc
     )
     return np.stack(out)

@@ -29,19 +29,16 @@ from .._validation import as_finite_array, check_int, check_nonnegative, check_p
 from ..errors import ParameterError, ShapeError
 from ..parallel import SeedLike, as_seed_sequence
 
-__all__ = [
-    "LinearPlant",
-    "SimulationResult",
-    "SeedLike",
-    "as_seed_sequence",
-    "simulate",
-    "simulate_gaussian_attack",
-]
+Size = int | tuple[int, ...] | None
+"""A batch shape for drawn states and noise (``None``: one draw)."""
+
+__all__ = ["LinearPlant", "SimulationResult", "SeedLike", "as_seed_sequence", "simulate", "simulate_gaussian_attack"]
+
 
 def _size_tuple(size: Size) -> tuple[int, ...]:
     if size is None:
         return ()
-    if isinstance(size, (int, np.integer)) and not isinstance(size, bool):
+    if isinstance(size, (int, np.integer)):  # check_int refuses a bool
         return (check_int("size", size, minimum=0),)
     return tuple(check_int("size", s, minimum=0) for s in size)
 
@@ -94,10 +91,7 @@ class LinearPlant:
         self._sx = float(np.sqrt(self.sigma_x2))
 
     def __repr__(self) -> str:
-        return (
-            f"LinearPlant(n={self.n}, m={self.m}, sigma_w2={self.sigma_w2:g}, "
-            f"sigma_x2={self.sigma_x2:g})"
-        )
+        return f"LinearPlant(n={self.n}, m={self.m}, sigma_w2={self.sigma_w2:g}, sigma_x2={self.sigma_x2:g})"
 
     def initial_state(self, rng: np.random.Generator, size: Size = None) -> np.ndarray:
         """Draw ``x_0 ~ N(0, sigma_x2 I)`` (eq:system): shape ``(*size, n)``, one state for ``size=None``."""
@@ -171,13 +165,7 @@ def _propagate(plant: LinearPlant, x0: np.ndarray, inputs: np.ndarray, noises: n
     return states
 
 
-def simulate(
-    plant: LinearPlant,
-    inputs: Any,
-    rng: np.random.Generator | SeedLike,
-    *,
-    x0: Any | None = None,
-) -> SimulationResult:
+def simulate(plant: LinearPlant, inputs: Any, rng: np.random.Generator | SeedLike, *, x0: Any | None = None) -> SimulationResult:
     """Simulate eq:system driven by given inputs, batched over runs.
 
     Parameters
@@ -225,14 +213,7 @@ def simulate(
     return SimulationResult(states=_propagate(plant, x_init, u, w), inputs=u, noises=w)
 
 
-def simulate_gaussian_attack(
-    plant: LinearPlant,
-    *,
-    N: int,
-    runs: int,
-    sigma_u2: float,
-    seed: SeedLike,
-) -> SimulationResult:
+def simulate_gaussian_attack(plant: LinearPlant, *, N: int, runs: int, sigma_u2: float, seed: SeedLike) -> SimulationResult:
     """Simulate the paper's attacker: i.i.d. Gaussian inputs ``u_t ~ N(0, sigma_u2 I)``.
 
     This is the data-collection step of Definition def:adversary under the input
