@@ -20,7 +20,7 @@ mean) and ``N*`` (or the cap).
 Security consequence. For every attacker and estimator, the sample size that reaches the
 preset's ``gamma_c`` is ``floor(c / gamma_c) + 2`` for the rate ``c`` of a fit
 ``E[epsilon] ~ c / (N - 1)`` to the upper half of the grid
-(:func:`experiments.attackers_vs_bounds.fit_rate`), flagged as inside the grid or extrapolated
+(:func:`experiments.compare.statistics.fit_rate`), flagged as inside the grid or extrapolated
 (and how far), and as transient where the log-log slope there is outside [-1.1, -0.9]; where the
 curve does not fall like ``1/N`` (slope above -0.8, e.g. least squares with forgetting) it is
 reported as not reached. Then ``lambda = floor(log2(Upsilon tau_c / N_c)) + 1`` (Theorem thm:opt_sec) and the
@@ -56,12 +56,16 @@ import numpy as np
 
 from agents import Attacker
 from agents.evaluate import budget_config
+from agents.runs import RunInfo, find_runs
 from encctl_gym.errors import ParameterError
 from encctl_gym.ident.estimator import Estimator, estimate_errors
 from encctl_gym.ident.registry import estimator_names, make_estimator
 from encctl_gym.security.design import minimum_key_length, optimal_security_parameter, sample_size_for_rate
 from encctl_gym.sim.montecarlo import log_grid
-from experiments.attackers_vs_bounds import Setting, attackers_for, bound_rows, find_runs, fit_rate, make_setting
+from experiments.compare.attackers import ATTACKERS, learned_attackers, make_attackers
+from experiments.compare.settings import Setting, make_setting
+from experiments.compare.statistics import fit_rate
+from experiments.compare.tables import bound_rows
 from experiments.common import add_common_arguments, ensure_out_dir, entry_point
 
 __all__ = [
@@ -210,7 +214,7 @@ def compute(
     seed: int = 0,
     cap: int | None = DEFAULT_CAP,
     points: int = DEFAULT_POINTS,
-    runs: Sequence[Path] = (),
+    runs: Sequence[RunInfo] = (),
     which: str = "best",
     progress: bool = False,
 ) -> Result:
@@ -230,7 +234,7 @@ def compute(
         p = s.params
         for est in ests:
             est.check_dimensions(p.n, p.m)  # type: ignore[attr-defined]
-        atts = attackers_for(s, runs, which)
+        atts = make_attackers(s, tuple(ATTACKERS)) + learned_attackers(s, list(runs), which)
         curves[system] = []
         worst = 0.0
         for att in atts:
@@ -269,7 +273,7 @@ def security_rows(result: Result) -> list[dict[str, Any]]:
     """Per system, attacker and estimator: samples to reach gamma_c, lambda and k (module docstring).
 
     ``N_to_gamma_c`` is ``floor(c / gamma_c) + 2`` for the rate ``c`` fitted to the upper half of
-    the grid (:func:`experiments.attackers_vs_bounds.fit_rate`; finer than the grid where the
+    the grid (:func:`experiments.compare.statistics.fit_rate`; finer than the grid where the
     curve crosses gamma_c inside it), or None where the curve does not fall like 1/N (slope
     above :data:`ONE_OVER_N_SLOPE`). ``N_how`` says which, how far beyond the grid, and whether
     the slope is still away from -1 (a transient, so the extrapolation is not a measurement).

@@ -11,7 +11,7 @@ import pytest
 from encctl_gym.errors import ParameterError
 from experiments import identification_strategies as strat
 from experiments import reproduce
-from experiments.attackers_vs_bounds import make_setting
+from experiments.compare.settings import make_setting
 
 
 def test_table_sizes_and_grid_reach_n_star_of_the_design_example() -> None:
