@@ -1,67 +1,20 @@
 """Probe: inputs that used to hang or exhaust memory, each run in a forked child with a memory cap
-and a timeout. Every case must end quickly with an error of the package's hierarchy (or a
-correct result), never a hang, an out-of-memory kill or another exception.
+and a timeout (the shared harness, :func:`probe.harness.run_bounded`). Every case must end quickly
+with an error of the package's hierarchy (or a correct result), never a hang, an out-of-memory
+kill or another exception. The whole probe of issue 16 is ``tests/test_probe.py``.
 """
 
 from __future__ import annotations
 
-import multiprocessing as mp
-import os
-import resource
-import sys
-import traceback
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 import pytest
 
-pytestmark = pytest.mark.skipif(sys.platform != "linux" or "fork" not in mp.get_all_start_methods(),
-                                reason="needs fork and /proc (Linux)")
+from probe.harness import fork_available, run_bounded
 
-TIMEOUT_S = 60.0  # generous for a loaded machine; every case takes well under a second alone
-EXTRA_MEMORY = 512 * 2**20  # address space a case may add to what the test process already maps
-
-
-def _vm_size() -> int:
-    for line in Path("/proc/self/status").read_text().splitlines():
-        if line.startswith("VmSize:"):
-            return int(line.split()[1]) * 1024
-    raise RuntimeError("no VmSize")  # pragma: no cover
-
-
-def _child(fn: Callable[[], Any], conn: Any, limit: int) -> None:
-    try:
-        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
-        fn()
-        conn.send(("ok", ""))
-    except MemoryError:
-        conn.send(("MemoryError", ""))
-    except BaseException as exc:  # noqa: BLE001 - the parent classifies it
-        from encctl_gym.errors import EncctlError
-
-        kind = "package" if isinstance(exc, EncctlError) else type(exc).__name__
-        conn.send((kind, str(exc)[:500] + ("" if kind == "package" else traceback.format_exc()[-800:])))
-    finally:
-        conn.close()
-        os._exit(0)
-
-
-def run_bounded(fn: Callable[[], Any]) -> tuple[str, str]:
-    """Run ``fn`` in a forked child capped at the current address space + 512 MB; ``("hang", "")``
-    if it is still running after the timeout (then it is killed)."""
-    ctx = mp.get_context("fork")
-    parent, child = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_child, args=(fn, child, _vm_size() + EXTRA_MEMORY))
-    proc.start()
-    child.close()
-    if not parent.poll(TIMEOUT_S):
-        proc.kill()
-        proc.join()
-        return ("hang", "")
-    result = parent.recv()
-    proc.join()
-    return result
+pytestmark = pytest.mark.skipif(not fork_available(), reason="needs fork and /proc (Linux)")
 
 
 def _cases(tmp: Path) -> dict[str, Callable[[], Any]]:

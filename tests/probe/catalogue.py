@@ -1,0 +1,57 @@
+"""Every probe case, and the failures known on this branch that belong to other layers' owners.
+
+:data:`KNOWN_FAILURES` lists cases that fail in code this branch does not own (the lead's
+``encctl_gym/envs/episode.py``; the agents' ``agents/**`` and ``experiments/compare/**``): the
+tests mark them as expected failures, strictly, so a fix there shows up as a test to update.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+from . import cases_cli, cases_crypto, cases_envs, cases_numeric, cases_security
+from .harness import Case
+
+__all__ = ["all_cases", "KNOWN_FAILURES", "MODULES"]
+
+MODULES = (cases_crypto, cases_security, cases_envs, cases_numeric, cases_cli)
+
+
+@lru_cache(maxsize=1)
+def all_cases() -> tuple[Case, ...]:
+    """Every case, in a fixed order (crypto, security analysis, environments, breakers and
+    estimators, command line); names are unique."""
+    out: list[Case] = []
+    for module in MODULES:
+        out.extend(module.cases())
+    names = [c.name for c in out]
+    if len(set(names)) != len(names):
+        dup = sorted({n for n in names if names.count(n) > 1})
+        raise ValueError(f"duplicate probe case names: {dup[:5]}")
+    return tuple(out)
+
+
+_EPISODE = "lead: encctl_gym/envs/episode.py (EpisodeCore.check_actions)"
+_AGENTS = "agents' engineer: agents/** or experiments/compare/**"
+
+#: Case name -> who owns the fix (see the module docstring).
+KNOWN_FAILURES: dict[str, str] = {
+    "envs/step(action=array(2,):bool=[True,False])": _EPISODE,
+    "vector/vector.step(actions=array(2, 2):complex128=[0.+1.j,0.+1.j,0.+1.j,0.+1.j])": _EPISODE,
+    "vector/vector.step(actions=array(2, 2):<U1=['a','b','c','d'])": _EPISODE,
+    "agents/train --n-timesteps '999999999999'": _AGENTS,
+    "agents/train --verbose '7'": _AGENTS,
+    "agents/train --verbose '-1'": _AGENTS,
+    "agents/train --config deep_nesting_yaml": _AGENTS,
+    "agents/train --set hyperparams.batch_size=99999999999999999": _AGENTS,
+    "agents/train --out an existing file": _AGENTS,
+    "agents/evaluate RUN_DIR=run.json 5000 digits": _AGENTS,
+    "agents/evaluate RUN_DIR=run.json deep nesting": _AGENTS,
+    "agents/compare --delays ''": _AGENTS,
+    "agents/compare --systems ''": _AGENTS,
+    "agents/compare --attackers ''": _AGENTS,
+    "agents/compare --max-samples '999999999999'": _AGENTS,
+    "agents/compare --runs corrupt model.zip": _AGENTS,
+    "agents/compare --runs run.json deep nesting": _AGENTS,
+    "agents/compare --out an existing file": _AGENTS,
+}
