@@ -29,6 +29,7 @@ import numpy as np
 
 from .._validation import check_int
 from ..errors import EncodingOverflowError, GroupError, ParameterError, ResourceLimitError
+from ..resources import memory_headroom
 from . import arith
 from .group import GroupParams
 
@@ -126,18 +127,22 @@ class ResidueTable:
     ParameterError
         If ``limit`` is out of range, or a gap between residues exceeds the search pad.
     ResourceLimitError
-        If building the table would need more than ``max_bytes`` (the message gives both).
+        If building the table would need more than ``max_bytes``, or more than the address space
+        the process may still map under a limit (:func:`encctl_gym.resources.memory_headroom`);
+        the message gives both.
     """
 
     def __init__(self, p: GroupParams | int, limit: int, max_bytes: int = DEFAULT_MAX_TABLE_BYTES) -> None:
         limit = check_int("limit", limit)
         max_bytes = check_int("max_bytes", max_bytes, minimum=1)
         need = residue_table_bytes(max(limit, 0))
-        if need > max_bytes:
+        room = memory_headroom()
+        if need > max_bytes or (room is not None and need > room):
+            bound, name = (max_bytes, "max_bytes") if need > max_bytes else (room, "the address space left under this process's limit")
             raise ResourceLimitError(
                 f"a residue table for |v| <= limit = {arith.format_int(limit)} needs about "
-                f"{arith.format_int(need >> 20)} MiB to build, more than max_bytes = "
-                f"{max_bytes >> 20} MiB; use a smaller Delta or a smaller declared range "
+                f"{arith.format_int(need >> 20)} MiB to build, more than {name} = "
+                f"{bound >> 20} MiB; use a smaller Delta or a smaller declared range "
                 "(x_bound), or raise max_bytes"
             )
         p = _safe_prime(p)
