@@ -138,7 +138,11 @@ class ResidueTable:
         need = residue_table_bytes(max(limit, 0))
         room = memory_headroom()
         if need > max_bytes or (room is not None and need > room):
-            bound, name = (max_bytes, "max_bytes") if need > max_bytes else (room, "the address space left under this process's limit")
+            bound, name = (
+                (max_bytes, "max_bytes")
+                if need > max_bytes or room is None
+                else (room, "the address space left under this process's limit")
+            )
             raise ResourceLimitError(
                 f"a residue table for |v| <= limit = {arith.format_int(limit)} needs about "
                 f"{arith.format_int(need >> 20)} MiB to build, more than {name} = "
