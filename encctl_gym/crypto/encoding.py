@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_int, check_positive
+from .._validation import check_int, check_positive, format_value
 from ..errors import EncodingOverflowError, ParameterError, PlaintextError
 from . import arith
 from .arith import format_int as fmt
@@ -144,7 +144,7 @@ def encode_int(group: GroupParams, v: int, max_shift: int | None = None) -> int:
     :class:`EncodingOverflowError` if ``|w| > (p - 1)/2`` (it would not decode back).
     """
     v = _as_int("v", v)
-    group.verify()
+    _check_group(group).verify()
     ms = default_max_shift(group) if max_shift is None else check_int("max_shift", max_shift, 0)
     w, _ = nearest_member(group, v, ms)
     if abs(w) > group.half:
@@ -166,7 +166,7 @@ def decode_int(group: GroupParams, m: int) -> int:
         If ``m`` is not an integer in [0, p).
     """
     m = _as_int("m", m, PlaintextError)
-    if not 0 <= m < group.p:
+    if not 0 <= m < _check_group(group).p:
         raise PlaintextError(f"plaintext m = {fmt(m)} is outside [0, p) for p = {fmt(group.p)}")
     return lift(group, m)
 
@@ -179,18 +179,46 @@ def _check_power(power: Any) -> int:
     return int(power)
 
 
+def _check_delta_ratio(delta_ratio: Any) -> tuple[int, int]:
+    if type(delta_ratio) is tuple and len(delta_ratio) == 2:  # fast path (every decode)
+        num, den = delta_ratio
+        if type(num) is int and type(den) is int and num > 0 and den > 0:
+            return num, den
+    if not isinstance(delta_ratio, (tuple, list)) or len(delta_ratio) != 2:
+        raise ParameterError(
+            f"delta_ratio must be a pair (num, den) of integers > 0 with Delta = num / den, got {format_value(delta_ratio)}"
+        )
+    num, den = (arith.check_integer(f"delta_ratio[{i}]", v) for i, v in enumerate(delta_ratio))
+    if num <= 0 or den <= 0:
+        raise ParameterError(f"delta_ratio = ({fmt(num)}, {fmt(den)}) must have num > 0 and den > 0 (Delta = num / den > 0)")
+    return int(num), int(den)
+
+
 def decode_scaled(w: int, delta_ratio: tuple[int, int], power: int = 1) -> float:
     """Return ``w / Delta**power`` correctly rounded, with ``Delta = num/den`` given exactly.
+
+    Parameters
+    ----------
+    w : int
+        The signed integer to decode (``int``, ``gmpy2.mpz`` or a NumPy integer).
+    delta_ratio : tuple of int
+        ``(num, den)`` with ``num, den > 0``: Delta as an exact fraction
+        (``float.as_integer_ratio``).
+    power : int, default 1
+        One of :data:`DECODE_POWERS`.
 
     Raises
     ------
     ParameterError
-        If ``power`` is not in :data:`DECODE_POWERS`.
+        If ``w`` is not an integer, ``delta_ratio`` is not a pair of integers > 0, or
+        ``power`` is not in :data:`DECODE_POWERS`.
     EncodingOverflowError
         If the quotient does not fit in a double.
     """
     power = _check_power(power)
-    num, den = delta_ratio
+    num, den = _check_delta_ratio(delta_ratio)
+    if type(w) is not int:
+        w = _as_int("w", w)
     try:
         return (w * den**power) / num**power
     except OverflowError as exc:
@@ -202,7 +230,13 @@ def _as_int(name: str, value: Any, err: type = ParameterError) -> int:
         raise err(f"{name} must be an integer, got {value!r}")
     if isinstance(value, (numbers.Integral, np.integer)) or type(value).__name__ == "mpz":
         return int(value)
-    raise err(f"{name} must be an integer, got {value!r}")
+    raise err(f"{name} must be an integer, got {format_value(value)}")
+
+
+def _check_group(group: Any) -> GroupParams:
+    if not isinstance(group, GroupParams):
+        raise ParameterError(f"group must be a GroupParams, got {format_value(group)}")
+    return group
 
 
 def _as_finite(name: str, x: Any) -> float:
@@ -283,9 +317,7 @@ class Encoder:
     """
 
     def __init__(self, group: GroupParams, delta: float, x_bound: float | None = None, max_shift: int | None = None) -> None:
-        if not isinstance(group, GroupParams):
-            raise ParameterError(f"group must be a GroupParams, got {group!r}")
-        self.group = group.verify()  # membership tests are only meaningful in a verified group
+        self.group = _check_group(group).verify()  # membership tests are only meaningful in a verified group
         self.delta = check_positive("delta", delta)
         self.delta_ratio: tuple[int, int] = self.delta.as_integer_ratio()
         self.max_shift = default_max_shift(group) if max_shift is None else check_int("max_shift", max_shift, 0)
@@ -369,8 +401,19 @@ class Encoder:
         return (0.5 + s) / self.delta
 
     def max_abs_signed(self, x_bound: float) -> int:
-        """Upper bound on ``|w|`` over all ``|x| <= x_bound``: ``round(Delta x_bound) + max_shift``."""
-        return abs(self._round(_as_finite("x_bound", x_bound))) + self.max_shift
+        """Upper bound on ``|w|`` over all ``|x| <= x_bound``: ``round(Delta x_bound) + max_shift``.
+
+        Raises
+        ------
+        ParameterError
+            If ``x_bound`` is not a finite real number >= 0 (a bound on ``|x|``).
+        EncodingOverflowError
+            If ``Delta x_bound`` overflows a float.
+        """
+        xb = _as_finite("x_bound", x_bound)
+        if xb < 0:
+            raise ParameterError(f"x_bound must be >= 0 (a bound on |x|), got {format_value(x_bound)}")
+        return self._round(xb) + self.max_shift
 
     # ------------------------------------------------------------------ arrays
     def quantize_array(self, x: Any) -> np.ndarray:
