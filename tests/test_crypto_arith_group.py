@@ -351,6 +351,33 @@ def test_from_json_refuses_non_text_and_deep_nesting(text, match):
         GroupParams.from_json(text)
 
 
+def test_group_methods_check_their_argument_types(tmp_path):
+    grp = shipped_group(64)
+    assert grp.contains(np.int64(4)) and grp.contains(gmpy2.mpz(4)) and not grp.contains(0)  # 4 = g is in G
+    for bad in ("4", 2.5, None, [4]):
+        with pytest.raises(ParameterError, match=r"m must be an integer.*got " + re.escape(format_value(bad))):
+            grp.contains(bad)
+    for bad in ("no", 1, None):
+        with pytest.raises(ParameterError, match=r"recheck must be True or False, got " + re.escape(format_value(bad))):
+            grp.verify(recheck=bad)
+    assert grp.verify(recheck=np.bool_(True)) is grp
+    path = tmp_path / "g.json"
+    grp.save(str(path))
+    assert GroupParams.load(str(path)) == grp
+    for bad in (42, None, ["g.json"]):
+        with pytest.raises(ParameterError, match=r"path must be a str or a path, got " + re.escape(format_value(bad))):
+            GroupParams.load(bad)
+        with pytest.raises(ParameterError, match="path must be a str or a path"):
+            grp.save(bad)
+    with pytest.raises(ParameterError, match="verify must be True or False, got 'no'"):
+        GroupParams.load(path, verify="no")
+    for bad in (np.array([23, 11, 4]), [23, 11, 4], "abc", None):
+        with pytest.raises(GroupError, match="group data must be a mapping with fields p, q, g"):
+            GroupParams.from_dict(bad)
+    with pytest.raises(ParameterError, match="progress must be True or False, got 'no'"):
+        generate_safe_prime_group(32, rng=1, progress="no")
+
+
 def test_from_json_reads_utf8_bytes():
     grp = shipped_group(128)
     assert GroupParams.from_json(grp.to_json().encode("utf-8")) == grp

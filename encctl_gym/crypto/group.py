@@ -28,6 +28,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
 import sys
 import time
 from collections.abc import Mapping
@@ -37,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_int, check_positive, format_value
+from .._validation import check_bool, check_int, check_positive, format_value
 from ..errors import ConfigError, GroupError, ParameterError, ResourceLimitError
 from . import arith
 from .arith import RngLike
@@ -87,6 +88,8 @@ SHIPPED_BITS: tuple[int, ...] = (64, 128, 256, 512, 712, 1024, 2048)
 
 _DATA_FILE = Path(__file__).with_name("data") / "groups.json"
 
+_MPZ = type(arith.mpz(0))
+
 # (p, q, g) triples that passed GroupParams.verify() in this process.
 _VERIFIED: set[tuple[int, int, int]] = set()
 
@@ -104,6 +107,12 @@ def _as_int(name: str, value: Any) -> int:
         return check_int(name, value)
     except ParameterError as exc:
         raise GroupError(str(exc)) from exc
+
+
+def _as_path(path: Any) -> Path:
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"path must be a str or a path, got {format_value(path)}")
+    return Path(path)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -192,7 +201,15 @@ class GroupParams:
 
         For safe-prime groups this is one Jacobi symbol (no modular exponentiation); for
         another cofactor it is ``pow(m, q, p) == 1`` (one exponentiation).
+
+        Raises
+        ------
+        ParameterError
+            If ``m`` is not an integer (a float or a string is not "not a member": it is no
+            residue at all).
         """
+        if type(m) is not int and type(m) is not _MPZ:
+            m = arith.check_integer("m", m)
         if not 0 < m < self.p:
             return False
         if self.is_safe_prime:
@@ -218,7 +235,11 @@ class GroupParams:
         ------
         GroupError
             Naming the failed condition and the offending value.
+        ParameterError
+            If ``recheck`` is not a bool.
         """
+        if recheck is not False:
+            recheck = check_bool("recheck", recheck)
         key = (self.p, self.q, self.g)
         if key in _VERIFIED and not recheck:
             return self
@@ -250,6 +271,8 @@ class GroupParams:
         GroupError
             If a field is missing or the declared ``bits``/``cofactor`` do not match.
         """
+        if not isinstance(data, Mapping):
+            raise GroupError(f"group data must be a mapping with fields p, q, g, got {format_value(data)}")
         try:
             group = cls(data["p"], data["q"], data["g"])
         except (KeyError, TypeError) as exc:
@@ -295,10 +318,12 @@ class GroupParams:
 
         Raises
         ------
+        ParameterError
+            If ``path`` is not a str or a path.
         ConfigError
             If the file cannot be written (a directory, a missing parent, no permission, ...).
         """
-        target = Path(path)
+        target = _as_path(path)
         try:
             target.write_text(self.to_json() + "\n", encoding="utf-8")
         except OSError as exc:
@@ -313,13 +338,17 @@ class GroupParams:
 
         Raises
         ------
+        ParameterError
+            If ``path`` is not a str or a path, or ``verify`` is not a bool.
         ConfigError
             If the file cannot be read, is larger than :data:`MAX_GROUP_FILE_BYTES` or is not
             UTF-8 text.
         GroupError
             If its content is not a valid group (:meth:`from_json`, :meth:`verify`).
         """
-        source = Path(path)
+        source = _as_path(path)
+        if verify is not True:
+            verify = check_bool("verify", verify)
         shown = format_value(str(source))
         try:
             with source.open("rb") as f:
@@ -405,7 +434,7 @@ def _inverses_of_two(limit: int) -> tuple[int, ...]:
 
 def _check_bits(bits: Any) -> int:
     if isinstance(bits, bool) or not isinstance(bits, (int, np.integer)):
-        raise ParameterError(f"bits must be an integer, got {bits!r}")
+        raise ParameterError(f"bits must be an integer, got {format_value(bits)}")
     bits = int(bits)
     if bits < MIN_GENERATE_BITS:
         raise ParameterError(
@@ -566,13 +595,16 @@ def generate_safe_prime_group(
     Raises
     ------
     ParameterError
-        If ``bits`` is not an integer or is below :data:`MIN_GENERATE_BITS`, or
-        ``max_seconds`` is not finite and > 0.
+        If ``bits`` is not an integer or is below :data:`MIN_GENERATE_BITS`, ``max_seconds``
+        is not finite and > 0, ``progress`` is not a bool, or ``window`` is not an integer in
+        ``[16, MAX_SIEVE_WINDOW]``.
     ResourceLimitError
         If the estimated time exceeds ``max_seconds`` (the message gives both).
     """
     bits = _check_bits(bits)
     max_seconds = check_positive("max_seconds", max_seconds)
+    if progress is not False:
+        progress = check_bool("progress", progress)
     window, limit = _search_plan(bits, window)
     estimate = estimate_generation_seconds(bits, window)
     if estimate > max_seconds:
