@@ -22,6 +22,7 @@ from encctl_gym.crypto.encoding import (
     decode_scaled,
     default_max_shift,
     encode_int,
+    lift,
     nearest_member,
 )
 from encctl_gym.crypto.group import GroupParams, shipped_group
@@ -342,3 +343,35 @@ def test_max_abs_signed_known_answers():
     assert enc.max_abs_signed(0.25 / 1024) == 0 + 64  # round(0.25) = 0
     with pytest.raises(EncodingOverflowError, match="overflows a float"):
         Encoder(G64, 1e300).max_abs_signed(1e300)
+
+
+@pytest.mark.parametrize("call", [
+    lambda g: nearest_member(g, 5, 64), lambda g: default_max_shift(g), lambda g: lift(g, 5),
+], ids=["nearest_member", "default_max_shift", "lift"])
+@pytest.mark.parametrize("group", ["abc", 64, None], ids=repr)
+def test_group_functions_need_a_group(call, group):
+    with pytest.raises(ParameterError, match=r"group must be a GroupParams, got " + re.escape(format_value(group))):
+        call(group)
+
+
+def test_nearest_member_and_lift_check_their_integers():
+    for bad in (2.5, "5", None, True):
+        with pytest.raises(ParameterError, match=r"v must be an integer"):
+            nearest_member(TOY, bad, 2)
+        with pytest.raises(ParameterError, match=r"m must be an integer"):
+            lift(TOY, bad)
+    for bad in (-1, 2.5, "a"):
+        with pytest.raises(ParameterError, match=r"max_shift must be"):
+            nearest_member(TOY, 5, bad)
+    # in TOY, 5 is not in G = {1, 2, 3, 4, 6, ...}: 6 is tried before 4; 7 -> 8 (+1), 10 -> 9 (-1)
+    assert nearest_member(TOY, np.int64(5), np.int64(1)) == (6, 1)
+    assert nearest_member(TOY, 7, 1) == (8, 1) and nearest_member(TOY, 10, 1) == (9, 1)
+    assert lift(TOY, np.int64(12)) == -11 and lift(TOY, 11) == 11 and lift(TOY, gmpy2.mpz(22)) == -1
+
+
+def test_max_shift_must_leave_representable_values():
+    # TOY: (p - 1)/2 = 11; a shift of 11 or more leaves no |round(Delta x)| + max_shift <= 11
+    assert Encoder(TOY, 1.0, max_shift=10).max_shift == 10
+    for bad in (11, 12, 10**400):
+        with pytest.raises(ParameterError, match=r"max_shift must be <= 10, got "):
+            Encoder(TOY, 1.0, max_shift=bad)

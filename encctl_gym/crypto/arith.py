@@ -325,7 +325,7 @@ class RandomSource:
         if type(n) is int and n >= 1:  # fast path
             return n
         if isinstance(n, bool) or not isinstance(n, (numbers.Integral, type(mpz(0)))):
-            raise ParameterError(f"the bound n must be an integer, got {n!r}")
+            raise ParameterError(f"the bound n must be an integer, got {format_value(n)}")
         if n < 1:
             raise ParameterError(f"the bound n must be >= 1, got {format_int(n)}")
         return n
@@ -354,7 +354,7 @@ def _length_prefixed(data: bytes) -> bytes:
 
 def _check_purpose(purpose: Any) -> str:
     if not isinstance(purpose, str):
-        raise ParameterError(f"the purpose of a random stream must be a string, got {purpose!r}")
+        raise ParameterError(f"the purpose of a random stream must be a string, got {format_value(purpose)}")
     return purpose
 
 
