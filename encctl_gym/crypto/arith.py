@@ -243,11 +243,14 @@ def jacobi(a: int, n: int) -> int:
         If ``a`` or ``n`` is not an integer, or ``n`` is not odd and positive (the symbol is
         undefined there).
     """
-    if not (type(a) in _INT_TYPES and type(n) in _INT_TYPES and n > 0 and n & 1):
+    if not (type(a) in _INT_TYPES and type(n) in _INT_TYPES and n > 0):
         a, n = check_integer("a", a), check_integer("n", n)
-        if n <= 0 or n % 2 == 0:
+        if n <= 0:  # gmpy2 would return a symbol for a negative odd n
             raise ParameterError(f"the Jacobi symbol (a/n) needs an odd n > 0, got n = {format_int(n)}")
-    return int(gmpy2.jacobi(a, n))
+    try:
+        return int(gmpy2.jacobi(a, n))
+    except ValueError:  # gmpy2 refuses an even n
+        raise ParameterError(f"the Jacobi symbol (a/n) needs an odd n > 0, got n = {format_int(n)}") from None
 
 
 def legendre(a: int, p: int) -> int:
