@@ -6,12 +6,13 @@ is the set of quadratic residues, so membership of an integer ``v`` is its Legen
 ``chi(v) = (v / p) = 1``; and because ``p = 3 (mod 4)``, ``chi(-v) = -chi(v)``.
 
 ``chi`` is completely multiplicative, so a table of ``chi(v)`` for ``0 <= v <= V`` needs the
-Legendre symbol (one call of :func:`~.arith.legendre`) only at the primes below ``V``: start
-from ``chi = 1`` and, for every prime ``l`` with ``chi(l) = -1``, flip the sign at the
-multiples of each power of ``l``. From ``chi`` a table of offsets to the nearest member (with
-the encoder's tie-break: ``+d`` before ``-d``) turns the quantisation of a whole batch into
-one gather. This is what lets the environment's ``crypto="ideal"`` backend and its vector
-environment apply *exactly* the encoder's quantisation at numpy speed;
+Legendre symbol only at the primes below ``V`` (one call of :func:`~.arith.jacobi` each, which
+equals it for the verified prime p): start from ``chi = 1`` and, for every prime ``l`` with
+``chi(l) = -1``, flip the sign at the multiples of each power of ``l``. From ``chi`` a table of
+offsets to the nearest member (with the encoder's tie-break: ``+d`` before ``-d``) turns the
+quantisation of a whole batch into one gather. This is what lets the environment's
+``crypto="ideal"`` backend and its vector environment apply *exactly* the encoder's quantisation
+at numpy speed;
 :func:`~.encoding.nearest_member` is the reference it is tested against.
 
 Memory is estimated before anything is allocated (:func:`residue_table_bytes`: about
@@ -79,7 +80,7 @@ def _legendre_table(p: int, n: int) -> np.ndarray:
     mp = arith.mpz(p)
     for start in range(0, primes.size, _BLOCK):
         for ell in primes[start : start + _BLOCK].tolist():
-            if arith.legendre(ell, mp) == -1:
+            if arith.jacobi(ell, mp) == -1:  # the Legendre symbol: p is a verified prime
                 power = ell
                 while power < n:  # chi(ell^k m) = (-1)^k chi(m): flip once per power dividing v
                     chi[power::power] *= -1
