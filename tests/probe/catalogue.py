@@ -34,7 +34,6 @@ def all_cases() -> tuple[Case, ...]:
 
 _EPISODE = "lead: encctl_gym/envs/episode.py (EpisodeCore.check_actions)"
 _AGENTS = "agents' engineer: agents/** or experiments/compare/**"
-_FORMAT = "lead: encctl_gym/_validation.py (format_value shows a 2-D array on several lines)"
 
 #: Case name -> who owns the fix (see the module docstring).
 KNOWN_FAILURES: dict[str, str] = {
@@ -56,8 +55,4 @@ KNOWN_FAILURES: dict[str, str] = {
     "agents/compare --runs corrupt model.zip": _AGENTS,
     "agents/compare --runs run.json deep nesting": _AGENTS,
     "agents/compare --out an existing file": _AGENTS,
-    "crypto/EncryptedLinearController(Phi=array(2, 2):complex128=[0.5+0.j,0.1+0.j,0.+0.j,0.3+1.j])": _FORMAT,
-    "crypto/EncryptedLinearController(Phi=array(2, 2):bool=[True,False,False,True])": _FORMAT,
-    "crypto/QuantizedLinearController(Phi=array(2, 2):complex128=[1.+1.j,0.+0.j,0.+0.j,1.+0.j])": _FORMAT,
-    "crypto/QuantizedLinearController(Phi=array(2, 2):float64=[nan,0.,0.,1.])": _FORMAT,
 }
