@@ -381,38 +381,35 @@ def _cross_group_decrypt(_: Path) -> None:
     prop()
 
 
+def _refused(call: Any, finding: str) -> None:
+    """``call()`` must raise KeyMismatchError; a result is a :class:`SecurityFinding`."""
+    try:
+        out = call()
+    except api("encctl_gym.errors:KeyMismatchError"):
+        return
+    raise SecurityFinding(f"{finding} returned {out!r}")
+
+
 def _cross_group_modified(_: Path) -> None:
-    errors = api("encctl_gym.errors:KeyMismatchError")
     (pk_a, sk_a), (_, sk_b) = _other_group_keys()
     enc = api("encctl_gym.crypto.elgamal:encrypt")
     ct = api("encctl_gym.crypto.modified:modified_eval")(pk_a, enc(pk_a, 4, rng=_stream(1)), enc(pk_a, 9, rng=_stream(2)))
-    try:
-        out = api("encctl_gym.crypto.modified:modified_decrypt")(sk_a, sk_b, ct)
-    except errors:
-        return
-    raise SecurityFinding(f"modified_decrypt with keys of two groups returned {out}")
+    _refused(lambda: api("encctl_gym.crypto.modified:modified_decrypt")(sk_a, sk_b, ct),
+             "modified_decrypt with keys of two groups")
 
 
 def _cross_group_mult(_: Path) -> None:
-    errors = api("encctl_gym.errors:KeyMismatchError")
     (pk_a, _), (pk_b, _) = _other_group_keys()
     enc = api("encctl_gym.crypto.elgamal:encrypt")
-    try:
-        out = api("encctl_gym.crypto.elgamal:mult")(pk_a, enc(pk_a, 4, rng=_stream(1)), enc(pk_b, 9, rng=_stream(2)))
-    except errors:
-        return
-    raise SecurityFinding(f"mult of ciphertexts of two groups returned {out!r}")
+    _refused(lambda: api("encctl_gym.crypto.elgamal:mult")(pk_a, enc(pk_a, 4, rng=_stream(1)), enc(pk_b, 9, rng=_stream(2))),
+             "mult of ciphertexts of two groups")
 
 
 def _cross_group_token(_: Path) -> None:
-    errors = api("encctl_gym.errors:KeyMismatchError")
     (pk_a, sk_a), (pk_b, sk_b) = _other_group_keys()
     _, _, tok_b = api("encctl_gym.crypto.dyn_elgamal:key_update")(pk_b, sk_b, rng=_stream(3))
-    try:
-        out = api("encctl_gym.crypto.dyn_elgamal:recover_next_secret_key")(sk_a, tok_b)
-    except errors:
-        return
-    raise SecurityFinding(f"a token of another group updated a secret key: {out!r}")
+    _refused(lambda: api("encctl_gym.crypto.dyn_elgamal:recover_next_secret_key")(sk_a, tok_b),
+             "recover_next_secret_key with a token of another group")
 
 
 def _seeded_secret_far_from_q(bits: int, seed: int) -> Any:
