@@ -263,6 +263,8 @@ def compute(
         cfgs = dict(configs or {})
         settings = [make_setting(s, d, cap, config=cfgs.get(s)) for s in systems for d in delays]
     settings = list(settings)
+    for s in settings:  # the grid of every setting is checked before any attacker is built or loaded
+        length_grid(s.params, points)
     plan = [(s, [*make_attackers(s, attackers), *learned_attackers(s, infos, which, deterministic=deterministic),
                  *(players(s) if players is not None else ())]) for s in settings]
     total = sum(planned_steps(s, len(a), episodes, points) for s, a in plan)
