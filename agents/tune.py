@@ -41,6 +41,7 @@ import yaml
 from encctl_gym.errors import ConfigError, EncctlError
 
 from .config import CONFIG_DIR, apply_override, load_config
+from .runs import check_output_dir
 from .sb3 import ALGORITHMS  # the [rl] extra: without it the CLI says which extra to install
 
 __all__ = ["SEARCH_SPACES", "TUNED_KEYS", "objective_ratio", "tuned_config", "tune", "add_arguments", "run"]
@@ -209,8 +210,7 @@ def tune(
     algo = cfg["algo"]
     if algo not in SEARCH_SPACES:
         raise ConfigError(f"no search space for algorithm {algo!r}; tunable: {', '.join(SEARCH_SPACES)}")
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = check_output_dir(out, "the tuning directory (--out)")
     name = study_name or f"{algo}_{cfg['system']}"
     url = storage or f"sqlite:///{(out / 'study.db').resolve()}"
     optuna.logging.set_verbosity(optuna.logging.WARNING)
@@ -288,7 +288,7 @@ def run(args: argparse.Namespace) -> int:
     if args.save_config and not args.preset:
         raise ConfigError("--save-config writes agents/configs/{algo}_{preset}.yaml and needs --preset")
     cfg = load_config(args.algo, args.preset, path=args.config, system=args.system, quick=args.quick)
-    cfg["seed"] = int(args.seed)
+    apply_override(cfg, f"seed={args.seed}")  # checked like any seed (0 <= seed <= MAX_SEED)
     if args.n_timesteps is not None:
         apply_override(cfg, f"n_timesteps={args.n_timesteps}")
     for item in args.overrides:
