@@ -38,9 +38,10 @@ from typing import Any, Callable
 import numpy as np
 import yaml
 
+from encctl_gym._validation import format_value
 from encctl_gym.errors import ConfigError, EncctlError
 
-from .config import CONFIG_DIR, apply_override, load_config
+from .config import CONFIG_DIR, MAX_STEPS, apply_override, load_config
 from .runs import check_output_dir
 from .sb3 import ALGORITHMS  # the [rl] extra: without it the CLI says which extra to install
 
@@ -284,7 +285,9 @@ def run(args: argparse.Namespace) -> int:
     """Tune; print the best trial and where its configuration went."""
     for flag, value, minimum in (("trials", args.trials, 1), ("episodes", args.episodes, 2)):
         if value < minimum:
-            raise ConfigError(f"--{flag} must be >= {minimum}, got {value}")
+            raise ConfigError(f"--{flag} must be >= {minimum}, got {format_value(value)}")
+        if value > MAX_STEPS:
+            raise ConfigError(f"--{flag} must be <= {MAX_STEPS}, got {format_value(value)}")
     if args.save_config and not args.preset:
         raise ConfigError("--save-config writes agents/configs/{algo}_{preset}.yaml and needs --preset")
     cfg = load_config(args.algo, args.preset, path=args.config, system=args.system, quick=args.quick)
