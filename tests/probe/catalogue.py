@@ -1,7 +1,7 @@
 """Every probe case, and the failures known on this branch that belong to other layers' owners.
 
-:data:`KNOWN_FAILURES` lists cases that fail in code this branch does not own (the lead's
-``encctl_gym/envs/episode.py``; the agents' ``agents/**`` and ``experiments/compare/**``): the
+:data:`KNOWN_FAILURES` lists cases that fail in code this branch does not own (the shared
+``encctl_gym/_validation.py``; the agents' ``agents/**`` and ``experiments/compare/**``): the
 tests mark them as expected failures, strictly, so a fix there shows up as a test to update.
 """
 
@@ -31,14 +31,34 @@ def all_cases() -> tuple[Case, ...]:
     return tuple(out)
 
 
-_EPISODE = "lead: encctl_gym/envs/episode.py (EpisodeCore.check_actions)"
+_FORMAT = ("shared: encctl_gym/_validation.py (format_value puts the rows of a 2-D array, or a wrapped row of "
+           "complex entries, on separate lines, so the refusal's message is not one line; the value is refused)")
 _AGENTS = "agents' engineer: agents/** or experiments/compare/**"
 
 #: Case name -> who owns the fix (see the module docstring).
 KNOWN_FAILURES: dict[str, str] = {
-    "envs/step(action=array(2,):bool=[True,False])": _EPISODE,
-    "vector/vector.step(actions=array(2, 2):complex128=[0.+1.j,0.+1.j,0.+1.j,0.+1.j])": _EPISODE,
-    "vector/vector.step(actions=array(2, 2):<U1=['a','b','c','d'])": _EPISODE,
+    "vector/vector.step(actions=array(2, 2):complex128=[0.+1.j,0.+1.j,0.+1.j,0.+1.j])": _FORMAT,
+    "vector/vector.step(actions=array(2, 2):<U1=['a','b','c','d'])": _FORMAT,
+    'envs/config(A=array(2, 2):complex128=[0.5+0.j,0.1+0.j,0.+0.j,0.3+1.j])': _FORMAT,
+    'envs/config(A=array(2, 2):float64=[0.5,nan,0.,0.3])': _FORMAT,
+    'envs/config(A=array(2, 2):float64=[0.5,inf,0.,0.3])': _FORMAT,
+    'envs/config(A=array(2, 2):bool=[True,False,False,True])': _FORMAT,
+    'envs/config(B=array(2, 2):complex128=[1.+1.j,0.+0.j,0.+0.j,1.+0.j])': _FORMAT,
+    'envs/config(B=array(2, 2):float64=[nan,0.,0.,1.])': _FORMAT,
+    "vector/vector.reset(options={'x0': array(2, 2):complex128=[0.+1.j,0.+1.j,0.+1.j,0.+1.j]})": _FORMAT,
+    'ident/least_squares(x=array(40, 2):complex128#5864)': _FORMAT,
+    'ident/data_matrices(x=array(40, 2):complex128#5864)': _FORMAT,
+    'ident/identification_errors(A=array(2, 2):complex128=[0.5+1.j,0.1+1.j,0.+1.j,0.3+1.j])': _FORMAT,
+    'ident/ls.fit(x=array(40, 2):complex128#5864)': _FORMAT,
+    'ident/bayes.fit(x=array(40, 2):complex128#5864)': _FORMAT,
+    'ident/forgetting.fit(x=array(40, 2):complex128#5864)': _FORMAT,
+    'ident/iv.fit(x=array(40, 2):complex128#5864)': _FORMAT,
+    'ident/estimation_error(A_hat=array(2, 2):complex128=[0.5+1.j,0.1+1.j,0.+1.j,0.3+1.j])': _FORMAT,
+    'ident/solve_normal_equations(C=array(3, 2):complex128#0799)': _FORMAT,
+    'sim/LinearPlant(A=array(2, 2):complex128=[0.5+0.j,0.1+0.j,0.+0.j,0.3+1.j])': _FORMAT,
+    'sim/LinearPlant(A=array(2, 2):float64=[0.5,nan,0.,0.3])': _FORMAT,
+    'sim/LinearPlant(A=array(2, 2):float64=[0.5,inf,0.,0.3])': _FORMAT,
+    'sim/LinearPlant(A=array(2, 2):bool=[True,False,False,True])': _FORMAT,
     "agents/train --n-timesteps '999999999999'": _AGENTS,
     "agents/train --verbose '7'": _AGENTS,
     "agents/train --verbose '-1'": _AGENTS,
