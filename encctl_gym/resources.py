@@ -9,7 +9,7 @@ never a process killed for memory.
 
 from __future__ import annotations
 
-from ._validation import check_int
+from ._validation import check_int, format_value
 from .errors import ResourceLimitError
 
 __all__ = ["MEMORY_LIMIT", "check_memory"]
@@ -34,5 +34,13 @@ def check_memory(what: str, need: int, limit: int | None = None, advice: str = "
     """
     cap = MEMORY_LIMIT if limit is None else check_int("memory_limit", limit, minimum=1)
     if need > cap:
-        msg = f"{what} needs about {need / 2**30:.3g} GiB, above the limit of {cap / 2**30:.3g} GiB (memory_limit)"
+        msg = f"{what} needs about {_gib(need)} GiB, above the limit of {_gib(cap)} GiB (memory_limit)"
         raise ResourceLimitError(msg + (f"; {advice}" if advice else ""))
+
+
+def _gib(nbytes: int) -> str:
+    """``nbytes`` in GiB for a message, also beyond the float range (an estimate of 10^400 bytes)."""
+    try:
+        return f"{nbytes / 2**30:.3g}"
+    except OverflowError:
+        return format_value(int(nbytes) // 2**30)
