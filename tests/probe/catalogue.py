@@ -38,7 +38,6 @@ _AGENTS = "agents' engineer: agents/** or experiments/compare/**"
 #: Case name -> who owns the fix (see the module docstring).
 KNOWN_FAILURES: dict[str, str] = {
     "vector/vector.step(actions=array(2, 2):complex128=[0.+1.j,0.+1.j,0.+1.j,0.+1.j])": _FORMAT,
-    "vector/vector.step(actions=array(2, 2):<U1=['a','b','c','d'])": _FORMAT,
     'envs/config(A=array(2, 2):complex128=[0.5+0.j,0.1+0.j,0.+0.j,0.3+1.j])': _FORMAT,
     'envs/config(A=array(2, 2):float64=[0.5,nan,0.,0.3])': _FORMAT,
     'envs/config(A=array(2, 2):float64=[0.5,inf,0.,0.3])': _FORMAT,
