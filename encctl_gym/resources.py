@@ -77,5 +77,5 @@ def check_memory(what: str, need: int, limit: int | None = None, advice: str = "
     else:
         cap, which = check_int("memory_limit", limit, minimum=1), "memory_limit"
     if need > cap:
-        msg = f"{what} needs about {_gib(need)} GiB, above the limit of {cap / 2**30:.3g} GiB ({which})"
+        msg = f"{what} needs about {_gib(need)} GiB, above the limit of {_gib(cap)} GiB ({which})"
         raise ResourceLimitError(msg + (f"; {advice}" if advice else ""))

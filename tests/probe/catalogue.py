@@ -1,8 +1,8 @@
 """Every probe case, and the failures known on this branch that belong to other layers' owners.
 
-:data:`KNOWN_FAILURES` lists cases that fail in code this branch does not own (the lead's
-``encctl_gym/envs/episode.py``; the residue table of the ideal loop, reached from ``train``): the
-tests mark them as expected failures, strictly, so a fix there shows up as a test to update.
+:data:`KNOWN_FAILURES` lists cases that fail in code outside the probe's reach of fixes (a
+layer whose owner has been told): the tests mark them as expected failures, strictly, so a fix
+there shows up as a test to update. It is empty when every case passes.
 """
 
 from __future__ import annotations
@@ -31,14 +31,5 @@ def all_cases() -> tuple[Case, ...]:
     return tuple(out)
 
 
-_EPISODE = "lead: encctl_gym/envs/episode.py (EpisodeCore.check_actions)"
-_TABLE = ("library: encctl_gym/crypto/residue_table.py and encctl_gym/loop/ideal.py (the ideal loop builds a 517 MiB table for "
-          "x_bound = 2e4, under its 1 GiB limit; envs/config(x_bound=20000.0) fails the same way)")
-
 #: Case name -> who owns the fix (see the module docstring).
-KNOWN_FAILURES: dict[str, str] = {
-    "envs/step(action=array(2,):bool=[True,False])": _EPISODE,
-    "vector/vector.step(actions=array(2, 2):complex128=[0.+1.j,0.+1.j,0.+1.j,0.+1.j])": _EPISODE,
-    "vector/vector.step(actions=array(2, 2):<U1=['a','b','c','d'])": _EPISODE,
-    "agents/train --set env.x_bound=2e4": _TABLE,
-}
+KNOWN_FAILURES: dict[str, str] = {}
