@@ -30,7 +30,7 @@ from encctl_gym._validation import (
 from encctl_gym.errors import ConfigError, EncctlError, ParameterError, ResourceLimitError
 from encctl_gym.plant_file import MAX_YAML_NODES, PLANT_FIELDS, load_plant_file
 from encctl_gym.presets import PAPER_DESIGN_EXAMPLE, design_defaults, get_preset
-from encctl_gym.security.exact import binary_fraction, decimal_fraction, floor_log2, pow2
+from encctl_gym.security.exact import binary_fraction, decimal_fraction, floor_log2, log2_fraction, pow2
 from encctl_gym.units import SECONDS_PER_UNIT, parse_duration
 
 
@@ -155,6 +155,23 @@ def test_decimal_and_binary_rules() -> None:
     assert floor_log2(Fraction(1024)) == 10 and floor_log2(Fraction(1023)) == 9 and floor_log2(Fraction(1, 3)) == -2
     assert pow2(74) == 2**74 and pow2(0.5) == Fraction(2.0**0.5)
     assert pow2(5000.25) == Fraction(2.0**0.25) * 2**5000  # beyond the float range, still exact
+
+
+@pytest.mark.parametrize("bad,match", [(1.5, "exact number.*1.5"), ("a", "exact number.*'a'"), (None, "exact number.*None"),
+                                       (True, "exact number.*True"), (0, "positive.*0"), (Fraction(-1, 2), r"positive.*Fraction\(-1, 2\)")])
+def test_exact_logarithms_take_exact_positive_numbers(bad: object, match: str) -> None:
+    # a float is refused: whether 1.5 stands for its decimal or its binary value is the caller's rule
+    for fn in (floor_log2, log2_fraction):
+        with pytest.raises(ParameterError, match=match):
+            fn(bad)  # type: ignore[arg-type]
+
+
+def test_exact_logarithms_of_integers_and_huge_fractions() -> None:
+    assert floor_log2(1) == 0 and floor_log2(np.int64(1025)) == 10
+    assert log2_fraction(8) == 3.0
+    # 2^5000 / 3 is beyond the float range: log2 = 5000 - log2(3), by hand
+    assert log2_fraction(Fraction(2**5000, 3)) == pytest.approx(5000 - math.log2(3), abs=1e-9)
+    assert floor_log2(Fraction(2**5000, 3)) == 4998
 
 
 # --------------------------------------------------------------------------- plant files
