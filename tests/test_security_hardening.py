@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from fractions import Fraction
 from pathlib import Path
 
@@ -129,6 +130,14 @@ def test_parse_duration_rejects(bad: object) -> None:
     with pytest.raises(ParameterError, match="tau_c") as info:
         parse_duration(bad)
     assert len(str(info.value)) < 400
+
+
+@pytest.mark.parametrize("text", ["0y", "0.0 h", "1e-400s"])
+def test_a_zero_duration_names_the_text(text: str) -> None:
+    # "1e-400s" underflows to 0 s: the message shows what was typed, not the float 0.0
+    with pytest.raises(ParameterError, match=f"tau_c must be > 0 s, got {re.escape(repr(text))}"):
+        parse_duration(text)
+    assert parse_duration("1e-300s") == 1e-300  # tiny but positive: valid
 
 
 # --------------------------------------------------------------------------- presets and the paper's constants
