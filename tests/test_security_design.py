@@ -284,3 +284,14 @@ def test_n_max_is_checked() -> None:
         minimum_sample_size(lambda N: Fraction(1, N), 1e-3, n_max=1000)  # the answer 1001 lies beyond n_max
     with pytest.raises(ParameterError, match="up to N = 5"):
         minimum_sample_size(lambda N: Fraction(1, N), 1e-3, n_min=5, n_max=5)
+
+
+def test_huge_sample_sizes_in_messages_are_shown_by_size() -> None:
+    # str() of an integer over 4300 digits raises ValueError; the messages show its size instead
+    with pytest.raises(ParameterError, match="up to N = <integer of 16610 bits, about 5001 digits>"):
+        minimum_sample_size(lambda N: 1.0, 0.5, n_max=10**5000)
+    # gamma_c = 1e-300 gives N* of 299 digits and lam* = 1, below the GNFS range: one short line
+    with pytest.raises(ModelRangeError, match=r"N\* = <integer of 991 bits, about 299 digits>") as info:
+        design_from_traces(EX["tr_psi_u"], EX["tr_psi_w"], EX["m"], EX["n"], sigma_u2=EX["sigma_u2"], sigma_w2=EX["sigma_w2"],
+                           gamma_c=1e-300, tau_c=EX["tau_c"], upsilon=EX["upsilon"])
+    assert "\n" not in str(info.value) and len(str(info.value)) < 600

@@ -299,7 +299,7 @@ def design_for_sample_size(
         k_star = minimum_key_length(lam_star)
     except ModelRangeError as exc:
         raise ModelRangeError(
-            f"Theorem thm:opt_sec gives lam* = {lam_star} for N* = {N_star} (tau_c = {format_value(tau_c)} s, "
+            f"Theorem thm:opt_sec gives lam* = {lam_star} for N* = {format_value(N_star)} (tau_c = {format_value(tau_c)} s, "
             f"Upsilon = {format_value(upsilon)} FLOPS), and eq:opt_key cannot turn it into a key length: {exc}"
         ) from None
     return SecurityDesign(

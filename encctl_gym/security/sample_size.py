@@ -69,9 +69,10 @@ def complexity_value(gamma: Callable[[int], Any], N: int) -> Fraction:
     value is a :class:`ParameterError` naming it, never compared as if it were a number.
     """
     value = gamma(N)
-    v = binary_fraction(f"gamma({N})", value)
+    label = f"gamma({format_value(N)})"  # N may have thousands of digits (n_max = 10**5000)
+    v = binary_fraction(label, value)
     if v < 0:
-        raise ParameterError(f"gamma({N}) must be >= 0 (a sample identifying complexity), got {format_value(value)}")
+        raise ParameterError(f"{label} must be >= 0 (a sample identifying complexity), got {format_value(value)}")
     return v
 
 
