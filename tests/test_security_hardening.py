@@ -243,3 +243,53 @@ def test_every_plant_file_error_is_a_package_error(tmp_path: Path) -> None:
         with pytest.raises(EncctlError) as info:
             load_plant_file(path)
         assert str(path) in str(info.value), text
+
+
+# --------------------------------------------------------------------------- plant files: entries, YAML floats, duplicates (issue 16)
+@pytest.mark.parametrize("text,match", [
+    ('{"A": [[0.5, 0], [0, NaN]], "B": [[1], [0]]}', r"A must hold finite numbers, got nan at A\[1\]\[1\]"),
+    ('{"A": [[0.5, Infinity], [0, 0.3]], "B": [[1], [0]]}', r"A must hold finite numbers, got inf at A\[0\]\[1\]"),
+    ('{"A": [[0.5, 0], [0, 0.3]], "B": [[1], ["x"]]}', r"B must hold real numbers, got 'x' at B\[1\]\[0\]"),
+])
+def test_plant_file_names_the_bad_entry(tmp_path: Path, text: str, match: str) -> None:
+    path = tmp_path / "p.json"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=match) as info:
+        load_plant_file(path)
+    assert "\n" not in str(info.value)
+
+
+def test_plant_file_npz_entries(tmp_path: Path) -> None:
+    path = tmp_path / "p.npz"
+    np.savez(path, A=np.array([[0.5, 0.0], [0.1j, 0.3]]), B=np.ones((2, 1)))
+    with pytest.raises(ConfigError, match=r"A must be real, got the complex entry 0.1j at A\[1\]\[0\]"):
+        load_plant_file(path)
+    np.savez(path, A=np.array([[0.5, 0.0], [0.0, 0.3]], dtype=complex), B=np.ones((2, 1)))  # a zero imaginary part
+    with pytest.raises(ConfigError, match="A must be real, got an array of dtype complex128"):
+        load_plant_file(path)
+    np.savez(path, A=np.array([[0.5, 0.0], [0.0, 0.3]]), B=np.array([[1.0], [np.nan]]))
+    with pytest.raises(ConfigError, match=r"B must hold finite numbers, got nan at B\[1\]\[0\]") as info:
+        load_plant_file(path)
+    assert "\n" not in str(info.value)
+
+
+def test_plant_file_yaml_reads_exponents_as_numbers(tmp_path: Path) -> None:
+    # YAML 1.1 (PyYAML) would read 1e-6 and 442e15 as strings and refuse them; JSON and the CLI read numbers
+    path = tmp_path / "p.yaml"
+    path.write_text("A: [[5e-1]]\nB: [[1E0]]\nsigma_w2: 1e-6\nupsilon: 442e15\ngamma_c: 1.5e-3\nsigma_u2: '10'\n")
+    with pytest.raises(ConfigError, match="sigma_u2 must be a number, got '10'"):  # a quoted value stays a string
+        load_plant_file(path)
+    path.write_text("A: [[5e-1]]\nB: [[1E0]]\nsigma_w2: 1e-6\nupsilon: 442e15\ngamma_c: 1.5e-3\n")
+    spec = load_plant_file(path)
+    assert spec.A[0, 0] == 0.5 and spec.B[0, 0] == 1.0
+    assert (spec.preset.sigma_w2, spec.preset.upsilon, spec.preset.gamma_c) == (1e-6, 442e15, 1.5e-3)
+
+
+@pytest.mark.parametrize("name,text", [("p.json", '{"A": [[0.5]], "B": [[1]], "A": [[0.9]]}'),
+                                       ("p.yaml", "A: [[0.5]]\nB: [[1]]\nA: [[0.9]]\n")])
+def test_plant_file_refuses_a_field_given_twice(tmp_path: Path, name: str, text: str) -> None:
+    # the readers would keep the last A silently
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(ConfigError, match="field 'A' is given more than once"):
+        load_plant_file(path)
