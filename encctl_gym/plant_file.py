@@ -18,14 +18,16 @@ field        required  meaning
 
 A missing optional field takes its default (the paper's design example unless the caller passes
 others), and :class:`PlantSpec` records which values came from the file and which from the
-defaults. Unknown fields are an error naming them.
+defaults. Unknown fields, and a field given twice, are an error naming them. In YAML a number
+with an exponent but no dot (``1e-6``, ``442e15``) is a number, as in JSON and on the command line
+(PyYAML's YAML 1.1 would read it as a string); a quoted value stays a string.
 
 Reading is bounded: files over :data:`MAX_FILE_BYTES` are refused before they are read; YAML
 aliases are expanded in a node count (:data:`MAX_YAML_NODES`) before any Python object is built
 (a few hundred bytes of nested aliases would otherwise take gigabytes); NPZ members are checked
 for their uncompressed size and loaded without pickles. Numbers must be real and finite in
-float64: booleans, strings, complex data and integers beyond the float range (``10**400``) are
-refused, naming the field.
+float64: booleans, strings, NaN, infinities, complex data and integers beyond the float range
+(``10**400``) are refused, naming the field and the position of the first bad entry (``A[1][0]``).
 """
 
 from __future__ import annotations
