@@ -312,3 +312,12 @@ def test_what_a_712_bit_key_is_worth() -> None:
     assert pre.log2_affordable_samples == pytest.approx(math.log2(2 ** (budget_bits() - omega_bits(712) + r) - 2**r), abs=1e-6)
     generic = key_length_value("generic", 712, N_star=N_STAR, tau_c=TAU_C, upsilon=UPSILON)
     assert generic.secure and generic.affordable_samples == 0 and generic.first_key_bits > 355
+
+
+@pytest.mark.parametrize("year,match", [(-1, ">= 0"), (10**400, "<= 9999, got <integer of 1329 bits"), (2015.5, "2015.5"), ("2015", "'2015'")])
+def test_record_years_are_bounded(tmp_path: Path, year: object, match: str) -> None:
+    def mutate(d: dict) -> None:
+        d["records"][0]["year"] = year
+
+    with pytest.raises(ConfigError, match=f"year must be .*{match}"):
+        load_records(_records_file(tmp_path, mutate))

@@ -82,7 +82,7 @@ class Record:
     key_length : int
         Bits of p (or of the modulus).
     year : int
-        Year of the computation.
+        Year of the computation (0 to 9999; 0: not given).
     total_seconds : float
         Total time (core-seconds or wall-clock seconds, see ``time_basis``).
     per_key_seconds : float or None
@@ -267,7 +267,7 @@ def _record(i: int, raw: Any) -> Record:
     basis = raw["time_basis"]
     try:
         k = check_int(f"{where}.key_length", raw["key_length"], minimum=2, maximum=1 << 20)
-        year = check_int(f"{where}.year", raw.get("year", 0), minimum=0)
+        year = check_int(f"{where}.year", raw.get("year", 0), minimum=0, maximum=9999)  # a publication year (0: unknown)
         total, total_text = _duration(f"{where}.total", raw["total"], basis)
         per_key, per_key_text = (None, "") if raw.get("per_key") is None else _duration(f"{where}.per_key", raw["per_key"], basis)
         clock = raw.get("clock_ghz")
