@@ -347,7 +347,8 @@ def load_plant_file(path: str | Path, *, defaults: Mapping[str, Any] | SystemPre
     ResourceLimitError
         If the file, its uncompressed arrays or its expanded YAML aliases exceed the bounds.
     ParameterError, ShapeError
-        For values out of their domain (a negative variance) or shapes that do not fit.
+        For values out of their domain (a negative variance), shapes that do not fit, or
+        ``defaults`` that is not a mapping of design values (or holds unknown fields).
     """
     p = Path(path)
     if not p.is_file():
@@ -371,18 +372,24 @@ def load_plant_file(path: str | Path, *, defaults: Mapping[str, Any] | SystemPre
         base: dict[str, Any] = design_defaults()
     elif isinstance(defaults, SystemPreset):
         base = {key: getattr(defaults, key) for key in DESIGN_FIELDS}
-    else:
+    elif isinstance(defaults, Mapping):
         base = dict(defaults)
+        extra = sorted(str(k) for k in base if k not in DESIGN_FIELDS)
+        if extra:
+            raise ParameterError(f"defaults has unknown field(s) {extra}; design values are {', '.join(DESIGN_FIELDS)}")
+    else:
+        raise ParameterError(f"defaults must be a mapping of design values or a SystemPreset, got {format_value(defaults)}")
+    missing = [key for key in DESIGN_FIELDS if key not in data and key not in base]
+    if missing:
+        raise _fail(p, f"{', '.join(missing)} {'is' if len(missing) == 1 else 'are'} neither in the file nor in the defaults")
     values: dict[str, float] = {}
     from_file: list[str] = ["A", "B"]
     from_defaults: list[str] = []
     for key in DESIGN_FIELDS:
         if key in data:
             raw, from_file_ = _scalar(p, key, data[key]), True
-        elif key in base:
-            raw, from_file_ = base[key], False
         else:
-            raise _fail(p, f"{key} is neither in the file nor in the defaults")
+            raw, from_file_ = base[key], False
         try:
             values[key] = _design_value(key, raw)
         except ParameterError as exc:

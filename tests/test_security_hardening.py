@@ -293,3 +293,20 @@ def test_plant_file_refuses_a_field_given_twice(tmp_path: Path, name: str, text:
     path.write_text(text)
     with pytest.raises(ConfigError, match="field 'A' is given more than once"):
         load_plant_file(path)
+
+
+@pytest.mark.parametrize("bad,match", [(42, "defaults must be a mapping.*got 42"), ("abc", "defaults must be a mapping.*got 'abc'"),
+                                       ({"bogus": 1}, r"defaults has unknown field\(s\) \['bogus'\]")])
+def test_plant_file_defaults_are_checked(tmp_path: Path, bad: object, match: str) -> None:
+    path = _write(tmp_path, "p.json", {"A": [[0.5]], "B": [[1.0]]})
+    with pytest.raises(ParameterError, match=match):
+        load_plant_file(path, defaults=bad)  # type: ignore[arg-type]
+
+
+def test_plant_file_reports_every_missing_field_at_once(tmp_path: Path) -> None:
+    path = _write(tmp_path, "p.json", {"A": [[0.5]], "B": [[1.0]], "sigma_u2": 2.0})
+    with pytest.raises(ConfigError, match="sigma_w2, sigma_x2, gamma_c, tau_c, upsilon are neither in the file nor in the defaults"):
+        load_plant_file(path, defaults={})
+    spec = load_plant_file(path, defaults={"sigma_w2": 0.5, "sigma_x2": 0, "gamma_c": 0.1, "tau_c": "2h", "upsilon": 1e9})
+    assert spec.values() == {"sigma_u2": 2.0, "sigma_w2": 0.5, "sigma_x2": 0.0, "gamma_c": 0.1, "tau_c": 7200.0, "upsilon": 1e9}
+    assert spec.from_file == ("A", "B", "sigma_u2") and spec.from_defaults == ("sigma_w2", "sigma_x2", "gamma_c", "tau_c", "upsilon")
