@@ -18,19 +18,23 @@ field        required  meaning
 
 A missing optional field takes its default (the paper's design example unless the caller passes
 others), and :class:`PlantSpec` records which values came from the file and which from the
-defaults. Unknown fields are an error naming them.
+defaults. Unknown fields, and a field given twice, are an error naming them. In YAML a number
+with an exponent but no dot (``1e-6``, ``442e15``) is a number, as in JSON and on the command line
+(PyYAML's YAML 1.1 would read it as a string); a quoted value stays a string.
 
 Reading is bounded: files over :data:`MAX_FILE_BYTES` are refused before they are read; YAML
 aliases are expanded in a node count (:data:`MAX_YAML_NODES`) before any Python object is built
 (a few hundred bytes of nested aliases would otherwise take gigabytes); NPZ members are checked
 for their uncompressed size and loaded without pickles. Numbers must be real and finite in
-float64: booleans, strings, complex data and integers beyond the float range (``10**400``) are
-refused, naming the field.
+float64: booleans, strings, NaN, infinities, complex data and integers beyond the float range
+(``10**400``) are refused, naming the field and the position of the first bad entry (``A[1][0]``).
 """
 
 from __future__ import annotations
 
+import functools
 import json
+import math
 import numbers
 import zipfile
 from collections.abc import Mapping
@@ -40,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import as_finite_array, check_nonnegative, check_positive, check_system, format_value
+from ._validation import FLOAT_MAX, as_finite_array, check_nonnegative, check_positive, check_system, format_value
 from .errors import ConfigError, ParameterError, ResourceLimitError
 from .presets import DESIGN_FIELDS, SystemPreset, design_defaults
 from .units import parse_duration
@@ -106,10 +110,31 @@ def _fail(path: Path, msg: str) -> ConfigError:
 
 
 # --------------------------------------------------------------------------- bounded decoding
+# YAML 1.1 (PyYAML) reads ``1e-6`` and ``442e15`` as strings, since its floats need a dot; YAML 1.2,
+# JSON and the command line read them as numbers, and so do plant files
+_YAML_EXPONENT_FLOAT = r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"
+
+
+@functools.lru_cache(maxsize=1)
 def _yaml_loader_class() -> Any:
+    """The safe YAML loader (the C one when available) that also reads ``1e-6`` as a float."""
+    import re
+
     import yaml
 
-    return getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+    base = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+    loader: Any = type("PlantFileLoader", (base,), {})
+    loader.add_implicit_resolver("tag:yaml.org,2002:float", re.compile(_YAML_EXPONENT_FLOAT), list("-+0123456789"))
+    return loader
+
+
+def _refuse_duplicate_keys(path: Path, keys: list[Any]) -> None:
+    """A field given twice is an error: the reader would otherwise keep the last one silently."""
+    seen: set[Any] = set()
+    for k in keys:
+        if k in seen:
+            raise _fail(path, f"field {format_value(k)} is given more than once")
+        seen.add(k)
 
 
 def _expanded_yaml_nodes(root: Any, limit: int) -> int:
@@ -148,11 +173,15 @@ def _expanded_yaml_nodes(root: Any, limit: int) -> int:
 
 
 def _load_yaml(path: Path, text: str) -> Any:
+    import yaml
+
     loader = _yaml_loader_class()(text)
     try:
         node = loader.get_single_node()
         if node is None:
             return None
+        if isinstance(node, yaml.MappingNode):
+            _refuse_duplicate_keys(path, [k.value for k, _ in node.value if isinstance(k, yaml.ScalarNode)])
         try:
             count = _expanded_yaml_nodes(node, MAX_YAML_NODES)
         except ValueError as exc:
@@ -187,6 +216,11 @@ def _load_npz(path: Path) -> dict[str, Any]:
         raise _fail(path, f"cannot load its arrays without pickles ({format_value(str(exc))})") from None
 
 
+def _json_object(path: Path, pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    _refuse_duplicate_keys(path, [k for k, _ in pairs])
+    return dict(pairs)
+
+
 def _decode(path: Path) -> Any:
     suffix = path.suffix.lower()
     if suffix not in SUFFIXES:
@@ -199,7 +233,7 @@ def _decode(path: Path) -> Any:
     try:
         text = path.read_text(encoding="utf-8")
         if suffix == ".json":
-            return json.loads(text)
+            return json.loads(text, object_pairs_hook=lambda pairs: _json_object(path, pairs))
         return _load_yaml(path, text)
     except (ConfigError, ResourceLimitError):
         raise
@@ -209,30 +243,51 @@ def _decode(path: Path) -> Any:
 
 
 # --------------------------------------------------------------------------- field checks
+def _where(key: str, index: tuple[int, ...]) -> str:
+    return key + "".join(f"[{i}]" for i in index)
+
+
 def _check_leaves(path: Path, key: str, value: Any) -> None:
-    """Walk nested lists (iteratively) and refuse anything but real numbers within float64."""
-    stack = [value]
+    """Walk nested lists (iteratively) and refuse anything but finite real numbers within float64,
+    naming the first bad entry and where it is (``A[0][1]``)."""
+    stack: list[tuple[Any, tuple[int, ...]]] = [(value, ())]
     while stack:
-        v = stack.pop()
+        v, index = stack.pop()
         if isinstance(v, (list, tuple)):
-            stack.extend(v)
+            stack.extend((item, (*index, i)) for i, item in reversed(list(enumerate(v))))
         elif isinstance(v, bool) or v is None or isinstance(v, (str, bytes, dict, complex)):
-            raise _fail(path, f"{key} must hold real numbers, got {format_value(v)}")
+            raise _fail(path, f"{key} must hold real numbers, got {format_value(v)} at {_where(key, index)}")
         elif isinstance(v, numbers.Integral):
-            try:
-                float(v)
-            except OverflowError:
-                raise _fail(path, f"{key} holds a number beyond the float64 range: {format_value(v)}") from None
+            if abs(int(v)) > FLOAT_MAX:
+                raise _fail(path, f"{key} holds a number beyond the float64 range: {format_value(v)} at {_where(key, index)}")
         elif not isinstance(v, numbers.Real):
-            raise _fail(path, f"{key} must hold real numbers, got {format_value(v)}")
+            raise _fail(path, f"{key} must hold real numbers, got {format_value(v)} at {_where(key, index)}")
+        elif not math.isfinite(v):
+            raise _fail(path, f"{key} must hold finite numbers, got {format_value(v)} at {_where(key, index)}")
+
+
+def _check_array(path: Path, key: str, value: np.ndarray) -> None:
+    """An array read from an NPZ file: real numeric entries, all finite; the first bad one is named."""
+    if value.dtype.kind == "c":
+        bad = np.argwhere(value.imag != 0)
+        if bad.size == 0:
+            raise _fail(path, f"{key} must be real, got an array of dtype {value.dtype}")
+        index = tuple(int(i) for i in bad[0])
+        raise _fail(
+            path, f"{key} must be real, got the complex entry {format_value(value[index].item())} at {_where(key, index)}"
+        )
+    if value.dtype.kind not in "iuf":
+        raise _fail(path, f"{key} must be a numeric matrix, got an array of dtype {value.dtype}")
+    if value.dtype.kind == "f":
+        bad = np.argwhere(~np.isfinite(value))
+        if bad.size:
+            index = tuple(int(i) for i in bad[0])
+            raise _fail(path, f"{key} must hold finite numbers, got {format_value(value[index].item())} at {_where(key, index)}")
 
 
 def _matrix(path: Path, key: str, value: Any) -> np.ndarray:
     if isinstance(value, np.ndarray):
-        if value.dtype.kind == "c":
-            raise _fail(path, f"{key} must be real, got a complex array {format_value(value)}")
-        if value.dtype.kind not in "iuf":
-            raise _fail(path, f"{key} must be a numeric matrix, got an array of dtype {value.dtype}")
+        _check_array(path, key, value)
     else:
         if not isinstance(value, (list, tuple)):
             raise _fail(path, f"{key} must be a matrix (a list of rows), got {format_value(value)}")
@@ -292,7 +347,8 @@ def load_plant_file(path: str | Path, *, defaults: Mapping[str, Any] | SystemPre
     ResourceLimitError
         If the file, its uncompressed arrays or its expanded YAML aliases exceed the bounds.
     ParameterError, ShapeError
-        For values out of their domain (a negative variance) or shapes that do not fit.
+        For values out of their domain (a negative variance), shapes that do not fit, or
+        ``defaults`` that is not a mapping of design values (or holds unknown fields).
     """
     p = Path(path)
     if not p.is_file():
@@ -316,18 +372,24 @@ def load_plant_file(path: str | Path, *, defaults: Mapping[str, Any] | SystemPre
         base: dict[str, Any] = design_defaults()
     elif isinstance(defaults, SystemPreset):
         base = {key: getattr(defaults, key) for key in DESIGN_FIELDS}
-    else:
+    elif isinstance(defaults, Mapping):
         base = dict(defaults)
+        extra = sorted(str(k) for k in base if k not in DESIGN_FIELDS)
+        if extra:
+            raise ParameterError(f"defaults has unknown field(s) {extra}; design values are {', '.join(DESIGN_FIELDS)}")
+    else:
+        raise ParameterError(f"defaults must be a mapping of design values or a SystemPreset, got {format_value(defaults)}")
+    missing = [key for key in DESIGN_FIELDS if key not in data and key not in base]
+    if missing:
+        raise _fail(p, f"{', '.join(missing)} {'is' if len(missing) == 1 else 'are'} neither in the file nor in the defaults")
     values: dict[str, float] = {}
     from_file: list[str] = ["A", "B"]
     from_defaults: list[str] = []
     for key in DESIGN_FIELDS:
         if key in data:
             raw, from_file_ = _scalar(p, key, data[key]), True
-        elif key in base:
-            raw, from_file_ = base[key], False
         else:
-            raise _fail(p, f"{key} is neither in the file nor in the defaults")
+            raw, from_file_ = base[key], False
         try:
             values[key] = _design_value(key, raw)
         except ParameterError as exc:

@@ -101,4 +101,6 @@ def parse_duration(value: Any, name: str = "tau_c") -> float:
     seconds = float(number) * SECONDS_PER_UNIT[canonical]
     if not math.isfinite(seconds):
         raise ParameterError(f"{name} must be finite in seconds, got {format_value(value)}")
-    return check_positive(name, seconds)
+    if seconds <= 0:  # "0y", or "1e-400s" that underflows to 0: name the text that was typed
+        raise ParameterError(f"{name} must be > 0 s, got {format_value(value)}")
+    return seconds

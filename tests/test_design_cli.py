@@ -254,7 +254,7 @@ def test_hostile_files_are_bounded(tmp_path: Path, capsys: pytest.CaptureFixture
     _fails(capsys, ["design", str(tags)], "cannot read")
     cplx = tmp_path / "complex.npz"
     np.savez(cplx, A=np.array([[0.5 + 0.1j]]), B=np.array([[1.0]]))
-    _fails(capsys, ["design", str(cplx)], "A must be real, got a complex array")
+    _fails(capsys, ["design", str(cplx)], "A must be real, got the complex entry (0.5+0.1j) at A[0][0]")
     deep = tmp_path / "deep.json"
     deep.write_text("[" * 100000 + "]" * 100000)
     _fails(capsys, ["design", str(deep)], "cannot read")

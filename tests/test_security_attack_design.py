@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 import scipy.linalg
@@ -267,3 +269,17 @@ def test_large_sdp_refused_before_solving_with_an_estimate() -> None:
         optimal_attack_design(A, B, sigma_u2=1, sigma_w2=1, max_dimension=1)
     # the closed-form Gaussian design has no such limit
     assert gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1).Sigma.shape == (60, 60)
+
+
+@pytest.mark.parametrize("bad,match", [(10**400, "<= 9007199254740992, got <integer of 1329 bits"), (2**53 + 1, "<= 9007199254740992"),
+                                       (1, ">= 2"), ("a", "'a'")])
+def test_sdp_estimate_is_bounded(bad: object, match: str) -> None:
+    with pytest.raises(ParameterError, match=f"^dimension must be .*{match}"):
+        sdp_estimate(bad)  # type: ignore[arg-type]
+
+
+def test_sdp_estimate_by_hand() -> None:
+    # 40 s (p / 56)^4.75 and 1.6 GB (p / 56)^4: at p = 112 that is 40 * 2^4.75 s and 1.6 * 16 GB
+    seconds, gb = sdp_estimate(112)
+    assert seconds == pytest.approx(40 * 2**4.75) and gb == pytest.approx(25.6)
+    assert all(math.isfinite(v) for v in sdp_estimate(2**53))

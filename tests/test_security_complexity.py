@@ -145,3 +145,31 @@ def test_bad_parameters_named() -> None:
         noise_upper_bound(5, 0, 1)
     with pytest.raises(UnstableSystemError):
         sample_identifying_complexity(5, 1.5 * np.eye(2), np.eye(2), sigma_u2=1.0, sigma_w2=1.0)
+
+
+# --------------------------------------------------------------------------- counts beyond the float range (issue 16)
+@pytest.mark.parametrize("big", [10**400, 10**5000], ids=["10^400", "10^5000"])
+def test_counts_beyond_the_float_range_are_named(big: int) -> None:
+    # a ParameterError that names the size, never an OverflowError from float(N) or (m + n) * sigma_w2
+    for call in (
+        lambda: sic_from_traces(big, 1.0, 2.0, 1, 1, 1.0, 1.0),
+        lambda: sample_identifying_complexity(big, 0.5 * np.eye(1), np.eye(1), sigma_u2=1.0, sigma_w2=1.0),
+        lambda: input_upper_bound(big, 1, 1, 1.0),
+    ):
+        with pytest.raises(ParameterError, match="N must lie within the float64 range") as info:
+            call()
+        assert "bits" in str(info.value)
+    for name, args in (("m", (5, 1.0, 2.0, big, 1, 1.0, 1.0)), ("n", (5, 1.0, 2.0, 1, big, 1.0, 1.0))):
+        with pytest.raises(ParameterError, match=f"^{name} must lie within the float64 range"):
+            sic_from_traces(*args)
+
+
+def test_a_large_sample_size_inside_the_float_range_is_valid() -> None:
+    # eq:sic2 by hand for N = 10**300: (m+n) / ((N-1) [R (tr_u + m) + tr_w]) = 2 / (1e300 * (1 * 2 + 2))
+    assert sic_asymptotic_from_traces(10**300, 1.0, 2.0, 1, 1, 1.0) == pytest.approx(0.5e-300, rel=1e-12)
+
+
+def test_an_overflowing_complexity_is_refused_not_nan() -> None:
+    # m + n = 1.6e308 is a float, but (m+n) sigma_w2 = 1.6e309 is not: refused rather than inf / inf = nan
+    with pytest.raises(ParameterError, match="overflows float64"):
+        sic_from_traces(10**300, 1.0, 2.0, 8 * 10**307, 8 * 10**307, 1.0, 10.0)

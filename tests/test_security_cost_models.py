@@ -147,6 +147,24 @@ def test_nist_lookups() -> None:
     assert nist_strength(712) is None and nist_strength(1024) == 80 and nist_strength(3000) == 112
 
 
+
+@pytest.mark.parametrize("bad,match", [(math.nan, "finite"), (-1.0, ">= 0"), ("a", "'a'"), (None, "None"), (10**400, "1329 bits"), (2 + 1j, "2")])
+def test_nist_key_length_checks_its_strength(bad: object, match: str) -> None:
+    with pytest.raises(ParameterError, match=f"^bits .*{match}"):
+        nist_key_length(bad)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("bad,match", [(math.nan, "integer"), (-1, ">= 2"), (2.5, "2.5"), ("a", "'a'"), (None, "None")])
+def test_nist_strength_checks_its_key_length(bad: object, match: str) -> None:
+    with pytest.raises(ParameterError, match=f"^key_length .*{match}"):
+        nist_strength(bad)  # type: ignore[arg-type]
+
+
+def test_nist_edges() -> None:
+    # the table's first row is (80 bits, 1024): 0 bits needs the smallest row, 1023 bits is below it
+    assert nist_key_length(0) == 1024 and nist_strength(1023) is None and nist_strength(2) is None
+
+
 @pytest.mark.parametrize("bad", [-1.0, -1e-9, math.nan, math.inf, 18.7, 10**400, True, "11.9", None])
 def test_bad_gnfs_correction(bad: object) -> None:
     with pytest.raises(ParameterError, match="gnfs_correction") as info:
@@ -224,6 +242,9 @@ def test_calibration_interpolates_linearly() -> None:
         ([(768.5, 19.0)], "key_length"),
         ([(20, 5.0)], "40"),
         (["768"], "'768'"),
+        (42, "list of .* points, got 42"),
+        ("abc", "list of .* points, got 'abc'"),
+        ({"records": []}, "list of .* points, got {'records'"),
     ],
 )
 def test_bad_calibration(points: list, match: str) -> None:
@@ -291,3 +312,12 @@ def test_what_a_712_bit_key_is_worth() -> None:
     assert pre.log2_affordable_samples == pytest.approx(math.log2(2 ** (budget_bits() - omega_bits(712) + r) - 2**r), abs=1e-6)
     generic = key_length_value("generic", 712, N_star=N_STAR, tau_c=TAU_C, upsilon=UPSILON)
     assert generic.secure and generic.affordable_samples == 0 and generic.first_key_bits > 355
+
+
+@pytest.mark.parametrize("year,match", [(-1, ">= 0"), (10**400, "<= 9999, got <integer of 1329 bits"), (2015.5, "2015.5"), ("2015", "'2015'")])
+def test_record_years_are_bounded(tmp_path: Path, year: object, match: str) -> None:
+    def mutate(d: dict) -> None:
+        d["records"][0]["year"] = year
+
+    with pytest.raises(ConfigError, match=f"year must be .*{match}"):
+        load_records(_records_file(tmp_path, mutate))

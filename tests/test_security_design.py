@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from fractions import Fraction
 
 import numpy as np
@@ -238,3 +239,59 @@ def test_bad_inputs() -> None:
         minimum_sample_size(lambda N: 1.0, 0.5, n_max=1000)
     with pytest.raises(ParameterError, match="tau_c"):
         is_secure(10, gamma=lambda N: 1.0, gamma_c=0.1, tau_c=-1, upsilon=1)
+
+
+# --------------------------------------------------------------------------- the complexity gamma is checked (issue 16)
+@pytest.mark.parametrize("bad", ["abc", None, 3])
+def test_gamma_must_be_callable(bad: object) -> None:
+    with pytest.raises(ParameterError, match=f"gamma must be a callable.*got {re.escape(format_value(bad))}"):
+        is_secure(10, gamma=bad, gamma_c=0.1, tau_c=1, upsilon=1)  # type: ignore[arg-type]
+    with pytest.raises(ParameterError, match=f"gamma must be a callable.*got {re.escape(format_value(bad))}"):
+        minimum_sample_size(bad, 0.1)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("value,match", [(-1.0, r"gamma\(\d+\) must be >= 0.*-1.0"), (math.nan, "NaN"), ("x", "'x'"), (1j, "1j")])
+def test_gamma_values_must_be_real_and_nonnegative(value: object, match: str) -> None:
+    # tau(N) = 2^lam N / Upsilon = 2N here, tau_c = 1000: N_max = 500, so is_secure reaches gamma(500)
+    with pytest.raises(ParameterError, match=match):
+        is_secure(1, gamma=lambda N: value, gamma_c=1e-6, tau_c=1000, upsilon=1)
+    with pytest.raises(ParameterError, match=match):
+        minimum_sample_size(lambda N: value if N > 2 else 1.0, 1e-3)
+
+
+def test_a_negative_complexity_is_not_taken_as_below_gamma_c() -> None:
+    # -1/N < gamma_c for every N: it used to give N* = 2 (and is_secure said False)
+    with pytest.raises(ParameterError, match=r"gamma\(2\) must be >= 0"):
+        minimum_sample_size(lambda N: -1.0 / N, 1e-3)
+
+
+@pytest.mark.parametrize("bad,match", [(-1.0, ">= 0"), (math.nan, "finite"), ("a", "real number")])
+def test_gamma_infimum_is_checked_on_every_path(bad: object, match: str) -> None:
+    # the modified scheme against an eavesdropper never has N_max = inf, yet the value is checked
+    with pytest.raises(ParameterError, match=f"gamma_infimum must be .*{match}"):
+        is_secure(74, gamma=lambda N: 1.0 / N, gamma_c=1e-6, tau_c=3.1536e8, upsilon=442e15, gamma_infimum=bad)
+
+
+def test_n_max_is_checked() -> None:
+    with pytest.raises(ParameterError, match="n_max must be an integer, got 'a'"):
+        minimum_sample_size(lambda N: 1.0 / N, 1e-3, n_max="a")  # type: ignore[arg-type]
+    with pytest.raises(ParameterError, match="n_max must be >= 2, got 1"):
+        minimum_sample_size(lambda N: 1.0 / N, 1e-3, n_max=1)
+    # valid: 1/N < 1e-3 first at N = 1001 (by hand), with the search bounded just above it
+    assert minimum_sample_size(lambda N: Fraction(1, N), 1e-3, n_max=1001) == 1001
+    assert minimum_sample_size(lambda N: Fraction(1, N), 1e-3, n_max=1025) == 1001
+    with pytest.raises(ParameterError, match="up to N = 1000"):
+        minimum_sample_size(lambda N: Fraction(1, N), 1e-3, n_max=1000)  # the answer 1001 lies beyond n_max
+    with pytest.raises(ParameterError, match="up to N = 5"):
+        minimum_sample_size(lambda N: Fraction(1, N), 1e-3, n_min=5, n_max=5)
+
+
+def test_huge_sample_sizes_in_messages_are_shown_by_size() -> None:
+    # str() of an integer over 4300 digits raises ValueError; the messages show its size instead
+    with pytest.raises(ParameterError, match="up to N = <integer of 16610 bits, about 5001 digits>"):
+        minimum_sample_size(lambda N: 1.0, 0.5, n_max=10**5000)
+    # gamma_c = 1e-300 gives N* of 299 digits and lam* = 1, below the GNFS range: one short line
+    with pytest.raises(ModelRangeError, match=r"N\* = <integer of 991 bits, about 299 digits>") as info:
+        design_from_traces(EX["tr_psi_u"], EX["tr_psi_w"], EX["m"], EX["n"], sigma_u2=EX["sigma_u2"], sigma_w2=EX["sigma_w2"],
+                           gamma_c=1e-300, tau_c=EX["tau_c"], upsilon=EX["upsilon"])
+    assert "\n" not in str(info.value) and len(str(info.value)) < 600

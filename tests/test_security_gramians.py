@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from encctl_gym.errors import ShapeError, UnstableSystemError
+from encctl_gym.errors import ParameterError, ShapeError, UnstableSystemError
 from encctl_gym.security.gramians import controllability_gramian, noise_gramian, solve_gramian
 
 
@@ -63,3 +63,11 @@ def test_bad_shapes() -> None:
         controllability_gramian(0.5 * np.eye(2), np.ones((3, 1)))
     with pytest.raises(ShapeError):
         solve_gramian(0.5 * np.eye(2), np.eye(3))
+
+
+def test_an_overflowing_input_gramian_is_refused() -> None:
+    # B B^T = 1e400 is beyond float64: a ParameterError naming the size of B, not inf in a Lyapunov solve
+    with pytest.raises(ParameterError, match=r"B B\^T overflows float64: B has entries up to 1e\+200"):
+        controllability_gramian(np.array([[0.5]]), np.array([[1e200]]))
+    # 1e150^2 / (1 - 0.25) = 1.333e300 is still a float: valid, by hand
+    assert controllability_gramian(np.array([[0.5]]), np.array([[1e150]]))[0, 0] == pytest.approx(1e300 / 0.75, rel=1e-12)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from fractions import Fraction
 from pathlib import Path
 
@@ -30,7 +31,7 @@ from encctl_gym._validation import (
 from encctl_gym.errors import ConfigError, EncctlError, ParameterError, ResourceLimitError
 from encctl_gym.plant_file import MAX_YAML_NODES, PLANT_FIELDS, load_plant_file
 from encctl_gym.presets import PAPER_DESIGN_EXAMPLE, design_defaults, get_preset
-from encctl_gym.security.exact import binary_fraction, decimal_fraction, floor_log2, pow2
+from encctl_gym.security.exact import binary_fraction, decimal_fraction, floor_log2, log2_fraction, pow2
 from encctl_gym.units import SECONDS_PER_UNIT, parse_duration
 
 
@@ -131,6 +132,14 @@ def test_parse_duration_rejects(bad: object) -> None:
     assert len(str(info.value)) < 400
 
 
+@pytest.mark.parametrize("text", ["0y", "0.0 h", "1e-400s"])
+def test_a_zero_duration_names_the_text(text: str) -> None:
+    # "1e-400s" underflows to 0 s: the message shows what was typed, not the float 0.0
+    with pytest.raises(ParameterError, match=f"tau_c must be > 0 s, got {re.escape(repr(text))}"):
+        parse_duration(text)
+    assert parse_duration("1e-300s") == 1e-300  # tiny but positive: valid
+
+
 # --------------------------------------------------------------------------- presets and the paper's constants
 @pytest.mark.parametrize("bad", [["small"], None, 3, "figure1"])
 def test_unknown_presets(bad: object) -> None:
@@ -155,6 +164,23 @@ def test_decimal_and_binary_rules() -> None:
     assert floor_log2(Fraction(1024)) == 10 and floor_log2(Fraction(1023)) == 9 and floor_log2(Fraction(1, 3)) == -2
     assert pow2(74) == 2**74 and pow2(0.5) == Fraction(2.0**0.5)
     assert pow2(5000.25) == Fraction(2.0**0.25) * 2**5000  # beyond the float range, still exact
+
+
+@pytest.mark.parametrize("bad,match", [(1.5, "exact number.*1.5"), ("a", "exact number.*'a'"), (None, "exact number.*None"),
+                                       (True, "exact number.*True"), (0, "positive.*0"), (Fraction(-1, 2), r"positive.*Fraction\(-1, 2\)")])
+def test_exact_logarithms_take_exact_positive_numbers(bad: object, match: str) -> None:
+    # a float is refused: whether 1.5 stands for its decimal or its binary value is the caller's rule
+    for fn in (floor_log2, log2_fraction):
+        with pytest.raises(ParameterError, match=match):
+            fn(bad)  # type: ignore[arg-type]
+
+
+def test_exact_logarithms_of_integers_and_huge_fractions() -> None:
+    assert floor_log2(1) == 0 and floor_log2(np.int64(1025)) == 10
+    assert log2_fraction(8) == 3.0
+    # 2^5000 / 3 is beyond the float range: log2 = 5000 - log2(3), by hand
+    assert log2_fraction(Fraction(2**5000, 3)) == pytest.approx(5000 - math.log2(3), abs=1e-9)
+    assert floor_log2(Fraction(2**5000, 3)) == 4998
 
 
 # --------------------------------------------------------------------------- plant files
@@ -217,3 +243,70 @@ def test_every_plant_file_error_is_a_package_error(tmp_path: Path) -> None:
         with pytest.raises(EncctlError) as info:
             load_plant_file(path)
         assert str(path) in str(info.value), text
+
+
+# --------------------------------------------------------------------------- plant files: entries, YAML floats, duplicates (issue 16)
+@pytest.mark.parametrize("text,match", [
+    ('{"A": [[0.5, 0], [0, NaN]], "B": [[1], [0]]}', r"A must hold finite numbers, got nan at A\[1\]\[1\]"),
+    ('{"A": [[0.5, Infinity], [0, 0.3]], "B": [[1], [0]]}', r"A must hold finite numbers, got inf at A\[0\]\[1\]"),
+    ('{"A": [[0.5, 0], [0, 0.3]], "B": [[1], ["x"]]}', r"B must hold real numbers, got 'x' at B\[1\]\[0\]"),
+])
+def test_plant_file_names_the_bad_entry(tmp_path: Path, text: str, match: str) -> None:
+    path = tmp_path / "p.json"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=match) as info:
+        load_plant_file(path)
+    assert "\n" not in str(info.value)
+
+
+def test_plant_file_npz_entries(tmp_path: Path) -> None:
+    path = tmp_path / "p.npz"
+    np.savez(path, A=np.array([[0.5, 0.0], [0.1j, 0.3]]), B=np.ones((2, 1)))
+    with pytest.raises(ConfigError, match=r"A must be real, got the complex entry 0.1j at A\[1\]\[0\]"):
+        load_plant_file(path)
+    np.savez(path, A=np.array([[0.5, 0.0], [0.0, 0.3]], dtype=complex), B=np.ones((2, 1)))  # a zero imaginary part
+    with pytest.raises(ConfigError, match="A must be real, got an array of dtype complex128"):
+        load_plant_file(path)
+    np.savez(path, A=np.array([[0.5, 0.0], [0.0, 0.3]]), B=np.array([[1.0], [np.nan]]))
+    with pytest.raises(ConfigError, match=r"B must hold finite numbers, got nan at B\[1\]\[0\]") as info:
+        load_plant_file(path)
+    assert "\n" not in str(info.value)
+
+
+def test_plant_file_yaml_reads_exponents_as_numbers(tmp_path: Path) -> None:
+    # YAML 1.1 (PyYAML) would read 1e-6 and 442e15 as strings and refuse them; JSON and the CLI read numbers
+    path = tmp_path / "p.yaml"
+    path.write_text("A: [[5e-1]]\nB: [[1E0]]\nsigma_w2: 1e-6\nupsilon: 442e15\ngamma_c: 1.5e-3\nsigma_u2: '10'\n")
+    with pytest.raises(ConfigError, match="sigma_u2 must be a number, got '10'"):  # a quoted value stays a string
+        load_plant_file(path)
+    path.write_text("A: [[5e-1]]\nB: [[1E0]]\nsigma_w2: 1e-6\nupsilon: 442e15\ngamma_c: 1.5e-3\n")
+    spec = load_plant_file(path)
+    assert spec.A[0, 0] == 0.5 and spec.B[0, 0] == 1.0
+    assert (spec.preset.sigma_w2, spec.preset.upsilon, spec.preset.gamma_c) == (1e-6, 442e15, 1.5e-3)
+
+
+@pytest.mark.parametrize("name,text", [("p.json", '{"A": [[0.5]], "B": [[1]], "A": [[0.9]]}'),
+                                       ("p.yaml", "A: [[0.5]]\nB: [[1]]\nA: [[0.9]]\n")])
+def test_plant_file_refuses_a_field_given_twice(tmp_path: Path, name: str, text: str) -> None:
+    # the readers would keep the last A silently
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(ConfigError, match="field 'A' is given more than once"):
+        load_plant_file(path)
+
+
+@pytest.mark.parametrize("bad,match", [(42, "defaults must be a mapping.*got 42"), ("abc", "defaults must be a mapping.*got 'abc'"),
+                                       ({"bogus": 1}, r"defaults has unknown field\(s\) \['bogus'\]")])
+def test_plant_file_defaults_are_checked(tmp_path: Path, bad: object, match: str) -> None:
+    path = _write(tmp_path, "p.json", {"A": [[0.5]], "B": [[1.0]]})
+    with pytest.raises(ParameterError, match=match):
+        load_plant_file(path, defaults=bad)  # type: ignore[arg-type]
+
+
+def test_plant_file_reports_every_missing_field_at_once(tmp_path: Path) -> None:
+    path = _write(tmp_path, "p.json", {"A": [[0.5]], "B": [[1.0]], "sigma_u2": 2.0})
+    with pytest.raises(ConfigError, match="sigma_w2, sigma_x2, gamma_c, tau_c, upsilon are neither in the file nor in the defaults"):
+        load_plant_file(path, defaults={})
+    spec = load_plant_file(path, defaults={"sigma_w2": 0.5, "sigma_x2": 0, "gamma_c": 0.1, "tau_c": "2h", "upsilon": 1e9})
+    assert spec.values() == {"sigma_u2": 2.0, "sigma_w2": 0.5, "sigma_x2": 0.0, "gamma_c": 0.1, "tau_c": 7200.0, "upsilon": 1e9}
+    assert spec.from_file == ("A", "B", "sigma_u2") and spec.from_defaults == ("sigma_w2", "sigma_x2", "gamma_c", "tau_c", "upsilon")

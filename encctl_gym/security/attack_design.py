@@ -80,6 +80,9 @@ SDP_MAX_DIMENSION: int = 48
 
 # reference point of the estimate (n + m = 56: 40 s and 1.6 GB above the 0.1 GB baseline)
 _SDP_REF_DIM, _SDP_REF_SECONDS, _SDP_REF_GB = 56, 40.0, 1.6
+# the estimate's domain: beyond 2^53 a dimension is no longer an exact float (and (p/56)^4.75
+# would overflow float64 long before any real plant gets there)
+_SDP_ESTIMATE_MAX_DIMENSION = 2**53
 
 
 def sdp_estimate(dimension: int) -> tuple[float, float]:
@@ -88,8 +91,13 @@ def sdp_estimate(dimension: int) -> tuple[float, float]:
     Extrapolated from the measurements quoted at :data:`SDP_MAX_DIMENSION` (2-core machine,
     Clarabel): time ``~ 40 s (p / 56)^4.75``, memory ``~ 1.6 GB (p / 56)^4``. An estimate for
     deciding before the solve starts, not a promise.
+
+    Raises
+    ------
+    ParameterError
+        If ``dimension`` is not an integer in ``[2, 2^53]``.
     """
-    p = check_int("dimension", dimension, 2)
+    p = check_int("dimension", dimension, 2, _SDP_ESTIMATE_MAX_DIMENSION)
     ratio = p / _SDP_REF_DIM
     return _SDP_REF_SECONDS * ratio**4.75, _SDP_REF_GB * ratio**4
 

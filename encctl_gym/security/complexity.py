@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import as_finite_array, check_int, check_nonnegative, check_positive, check_system, format_value
+from .._validation import FLOAT_MAX, as_finite_array, check_int, check_nonnegative, check_positive, check_system, format_value
 from ..errors import ParameterError
 from ..ident.error import estimation_error  # Definition def:error; its home is the identification layer
 from .gramians import controllability_gramian, noise_gramian
@@ -64,10 +64,10 @@ def check_sample_size(N: Any, name: str = "N") -> tuple[np.ndarray, bool]:
     Raises
     ------
     ParameterError
-        If any entry is not an integer or is smaller than 2.
+        If any entry is not an integer, is smaller than 2 or lies beyond the float64 range.
     """
     if np.ndim(N) == 0:
-        return np.asarray(float(check_int(name, N if not isinstance(N, np.ndarray) else N.item(), 2))), True
+        return np.asarray(float(_check_count(name, N if not isinstance(N, np.ndarray) else N.item(), 2))), True
     arr = as_finite_array(name, N)
     if not np.all(arr == np.round(arr)):
         raise ParameterError(f"{name} must contain integers, got {format_value(np.asarray(N))}")
@@ -76,12 +76,28 @@ def check_sample_size(N: Any, name: str = "N") -> tuple[np.ndarray, bool]:
     return arr, False
 
 
+def _check_count(name: str, value: Any, minimum: int) -> int:
+    """An integer count ``>= minimum`` (a sample size, a dimension) that converts to a float; a
+    count beyond the float64 range is a :class:`ParameterError` naming it, never an ``OverflowError``."""
+    v = check_int(name, value, minimum)
+    if v > FLOAT_MAX:
+        raise ParameterError(f"{name} must lie within the float64 range (<= {FLOAT_MAX:.4g}), got {format_value(v)}")
+    return v
+
+
 def _out(value: np.ndarray, scalar: bool) -> float | np.ndarray:
+    """The result, as a float for a scalar ``N``; inputs so large that float64 overflows
+    (``inf / inf``) are refused rather than returned as NaN."""
+    if not np.all(np.isfinite(value)):
+        raise ParameterError("the complexity overflows float64 for these inputs (a dimension, a variance or N near 1e308)")
     return float(value) if scalar else value
 
 
 def _check_dims(m: Any, n: Any) -> tuple[int, int]:
-    return check_int("m", m, 1), check_int("n", n, 1)
+    """The dimensions m and n: integers >= 1 whose sum lies within the float64 range."""
+    m, n = _check_count("m", m, 1), _check_count("n", n, 1)
+    _check_count("m + n", m + n, 2)
+    return m, n
 
 
 def sic2_denominator(tr_psi_u: float, tr_psi_w: float, m: int, r_sigma: float) -> float:
@@ -104,7 +120,7 @@ def sic2_denominator(tr_psi_u: float, tr_psi_w: float, m: int, r_sigma: float) -
     """
     tr_u = check_nonnegative("tr_psi_u", tr_psi_u)
     tr_w = check_positive("tr_psi_w", tr_psi_w)
-    m = check_int("m", m, 1)
+    m = _check_count("m", m, 1)
     r = check_positive("r_sigma", r_sigma)
     return r * (tr_u + m) + tr_w
 
@@ -141,8 +157,10 @@ def sic_from_traces(
     su = check_positive("sigma_u2", sigma_u2)
     sw = check_positive("sigma_w2", sigma_w2)
     sx = check_nonnegative("sigma_x2", sigma_x2)
-    den = sx * tr_w + (Nf - 1.0) * (su * (tr_u + m) + sw * tr_w)
-    return _out((m + n) * sw / den, scalar)
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused by _out
+        den = sx * tr_w + (Nf - 1.0) * (su * (tr_u + m) + sw * tr_w)
+        value = (m + n) * sw / den
+    return _out(value, scalar)
 
 
 def sic_asymptotic_from_traces(N: Any, tr_psi_u: float, tr_psi_w: float, m: int, n: int, r_sigma: float) -> float | np.ndarray:

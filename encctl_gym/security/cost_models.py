@@ -399,13 +399,13 @@ class CostModel(ABC):
 
         if not safe(hi):
             raise ModelRangeError(
-                f"under the {self.name} model no key length up to {hi} bits makes {keys} key(s) cost more than "
-                f"2^{log2_fraction(budget):.3f} operations ({keys} key(s) at {hi} bits cost "
+                f"under the {self.name} model no key length up to {hi} bits makes {format_value(keys)} key(s) cost more than "
+                f"2^{log2_fraction(budget):.3f} operations ({format_value(keys)} key(s) at {hi} bits cost "
                 f"2^{log2_fraction(self.break_cost(hi).operations(keys)):.3f})"
             )
         if safe(lo):
             raise ModelRangeError(
-                f"under the {self.name} model even the smallest key length of its range ({lo} bits) makes {keys} "
+                f"under the {self.name} model even the smallest key length of its range ({lo} bits) makes {format_value(keys)} "
                 f"key(s) cost more than 2^{log2_fraction(budget):.3f} operations; the answer lies below {lo} bits, "
                 "where the model does not hold (any key of at least that length meets the requirement)"
             )

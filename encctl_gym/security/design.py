@@ -53,6 +53,8 @@ from .deciphering import max_affordable_samples
 from .exact import binary_fraction, decimal_fraction
 from .gramians import controllability_gramian, noise_gramian
 from .sample_size import (
+    check_complexity,
+    complexity_value,
     exact_optimal_sample_size,
     exact_sic_asymptotic_function,
     exact_sic_function,
@@ -221,16 +223,25 @@ def is_secure(
     Returns
     -------
     bool
+
+    Raises
+    ------
+    ParameterError
+        For a bad ``lam``, ``gamma_c``, ``tau_c``, ``upsilon`` or ``gamma_infimum`` (checked on
+        every path), a ``gamma`` that is not callable, or a ``gamma(N)`` that is not a finite
+        real >= 0.
     """
     if not isinstance(lam, KeyBreakCost):
         check_security_parameter(lam)
+    check_complexity(gamma)
+    g_inf = binary_fraction("gamma_infimum", check_nonnegative("gamma_infimum", gamma_infimum))
     g_c = decimal_fraction("gamma_c", gamma_c)
     n_max = max_affordable_samples(tau_c, lam, upsilon, scheme=scheme, adversary=adversary)
     if n_max == math.inf:
-        return binary_fraction("gamma_infimum", check_nonnegative("gamma_infimum", gamma_infimum)) >= g_c
+        return g_inf >= g_c
     if n_max < 2:
         return True
-    return not (binary_fraction(f"gamma({n_max})", gamma(int(n_max))) < g_c)
+    return not (complexity_value(gamma, int(n_max)) < g_c)
 
 
 # --------------------------------------------------------------------------- full designs
@@ -288,7 +299,7 @@ def design_for_sample_size(
         k_star = minimum_key_length(lam_star)
     except ModelRangeError as exc:
         raise ModelRangeError(
-            f"Theorem thm:opt_sec gives lam* = {lam_star} for N* = {N_star} (tau_c = {format_value(tau_c)} s, "
+            f"Theorem thm:opt_sec gives lam* = {lam_star} for N* = {format_value(N_star)} (tau_c = {format_value(tau_c)} s, "
             f"Upsilon = {format_value(upsilon)} FLOPS), and eq:opt_key cannot turn it into a key length: {exc}"
         ) from None
     return SecurityDesign(

@@ -111,10 +111,29 @@ def binary_fraction(name: str, value: Any) -> Fraction:
     return _to_fraction(name, value, "binary")
 
 
-def floor_log2(x: Fraction) -> int:
-    """Exact ``floor(log2 x)`` for a positive fraction."""
-    if x <= 0:
-        raise ParameterError(f"floor_log2 needs a positive number, got {format_value(x)}")
+def _exact_positive(what: str, x: Any) -> Fraction:
+    """``x`` as a Fraction if it is an exact positive number (a Fraction or an integer, not a bool).
+
+    Floats are refused: which rational a float stands for is the caller's choice
+    (:func:`decimal_fraction` or :func:`binary_fraction`), never made here silently.
+    """
+    if isinstance(x, bool) or not isinstance(x, (Fraction, numbers.Integral, np.integer)):
+        raise ParameterError(f"{what} needs an exact number (a Fraction or an integer), got {format_value(x)}")
+    frac = Fraction(int(x)) if not isinstance(x, Fraction) else x
+    if frac <= 0:
+        raise ParameterError(f"{what} needs a positive number, got {format_value(x)}")
+    return frac
+
+
+def floor_log2(x: Fraction | int) -> int:
+    """Exact ``floor(log2 x)`` for a positive fraction or integer.
+
+    Raises
+    ------
+    ParameterError
+        If ``x`` is not a Fraction or an integer, or is not > 0.
+    """
+    x = _exact_positive("floor_log2", x)
     p, q = x.numerator, x.denominator
     k = p.bit_length() - q.bit_length()
     # now 2^(k-1) < p/q < 2^(k+1); decide between k-1 and k
@@ -123,10 +142,16 @@ def floor_log2(x: Fraction) -> int:
     return k - 1
 
 
-def log2_fraction(x: Fraction) -> float:
-    """``log2 x`` of a positive fraction in double precision, for any size (no float overflow)."""
-    if x <= 0:
-        raise ParameterError(f"log2 needs a positive number, got {format_value(x)}")
+def log2_fraction(x: Fraction | int) -> float:
+    """``log2 x`` of a positive fraction or integer in double precision, for any size (no float
+    overflow).
+
+    Raises
+    ------
+    ParameterError
+        If ``x`` is not a Fraction or an integer, or is not > 0.
+    """
+    x = _exact_positive("log2", x)
     p, q = x.numerator, x.denominator
     sp, sq = max(p.bit_length() - 60, 0), max(q.bit_length() - 60, 0)
     return math.log2(p >> sp) - math.log2(q >> sq) + sp - sq

@@ -18,8 +18,8 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
-from .._validation import as_finite_array, check_schur_stable, check_system
-from ..errors import ShapeError, SolverError
+from .._validation import as_finite_array, check_schur_stable, check_system, format_value
+from ..errors import ParameterError, ShapeError, SolverError
 
 __all__ = ["controllability_gramian", "noise_gramian", "solve_gramian"]
 
@@ -55,10 +55,13 @@ def solve_gramian(A: np.ndarray, Q: np.ndarray) -> np.ndarray:
     X = 0.5 * (X + X.T)
     if not np.all(np.isfinite(X)):
         raise SolverError("the discrete Lyapunov solution is not finite (A too close to instability?)")
-    resid = np.linalg.norm(A @ X @ A.T - X + Q)
-    scale = max(1.0, float(np.linalg.norm(X)), float(np.linalg.norm(Q)))
+    # ||A X A^T - X + Q||_F <= 1e-8 max(1, ||X||_F, ||Q||_F), both sides divided by c so that the
+    # norms cannot overflow for entries near 1e300
+    c = max(1.0, float(np.max(np.abs(X))), float(np.max(np.abs(Q))))
+    resid = np.linalg.norm((A @ X @ A.T - X + Q) / c)
+    scale = max(1.0 / c, float(np.linalg.norm(X / c)), float(np.linalg.norm(Q / c)))
     if resid > 1e-8 * scale:
-        raise SolverError(f"the discrete Lyapunov solve is inaccurate: residual {resid:.3g}")
+        raise SolverError(f"the discrete Lyapunov solve is inaccurate: residual {resid * c:.3g}")
     return X
 
 
@@ -83,13 +86,22 @@ def controllability_gramian(A: Any, B: Any) -> np.ndarray:
         If the shapes of ``A`` and ``B`` do not fit.
     UnstableSystemError
         If ``A`` is not Schur stable.
+    ParameterError
+        If ``B B^T`` overflows float64.
 
     Examples
     --------
     For ``A = a I`` and ``B = b I``, ``Psi_u = b^2 / (1 - a^2) I``.
     """
     A, B = check_system(A, B)
-    return solve_gramian(A, B @ B.T)
+    with np.errstate(over="ignore", invalid="ignore"):
+        Q = B @ B.T
+    if not np.all(np.isfinite(Q)):
+        raise ParameterError(
+            f"B B^T overflows float64: B has entries up to {format_value(float(np.max(np.abs(B))))} in magnitude "
+            "(the Gramian needs |B| well below 1e154)"
+        )
+    return solve_gramian(A, Q)
 
 
 def noise_gramian(A: Any) -> np.ndarray:

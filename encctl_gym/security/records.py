@@ -30,7 +30,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from .._validation import check_bool, check_int, check_positive, format_value
+from .._validation import check_bool, check_int, check_nonnegative, check_positive, format_value
 from ..errors import ConfigError, ParameterError, ResourceLimitError
 from ..units import SECONDS_PER_YEAR
 
@@ -82,7 +82,7 @@ class Record:
     key_length : int
         Bits of p (or of the modulus).
     year : int
-        Year of the computation.
+        Year of the computation (0 to 9999; 0: not given).
     total_seconds : float
         Total time (core-seconds or wall-clock seconds, see ``time_basis``).
     per_key_seconds : float or None
@@ -267,7 +267,7 @@ def _record(i: int, raw: Any) -> Record:
     basis = raw["time_basis"]
     try:
         k = check_int(f"{where}.key_length", raw["key_length"], minimum=2, maximum=1 << 20)
-        year = check_int(f"{where}.year", raw.get("year", 0), minimum=0)
+        year = check_int(f"{where}.year", raw.get("year", 0), minimum=0, maximum=9999)  # a publication year (0: unknown)
         total, total_text = _duration(f"{where}.total", raw["total"], basis)
         per_key, per_key_text = (None, "") if raw.get("per_key") is None else _duration(f"{where}.per_key", raw["per_key"], basis)
         clock = raw.get("clock_ghz")
@@ -405,8 +405,11 @@ def ratio_points(points: Iterable[Any]) -> tuple[RatioPoint, ...]:
     Raises
     ------
     ConfigError
-        For an empty list, a malformed point or key lengths not strictly increasing.
+        For a value that is not a list of points, an empty list, a malformed point or key
+        lengths not strictly increasing.
     """
+    if isinstance(points, (str, bytes, Mapping)) or not isinstance(points, Iterable):
+        raise ConfigError(f"calibration must be a list of (key_length, ratio_bits) points, got {format_value(points)}")
     out = []
     for i, p in enumerate(points):
         if isinstance(p, RatioPoint):
@@ -429,7 +432,14 @@ def ratio_points(points: Iterable[Any]) -> tuple[RatioPoint, ...]:
 
 def nist_key_length(bits: float, records: RecordSet | None = None) -> int | None:
     """The NIST SP 800-57 key length for a security strength of ``bits``: the smallest tabulated
-    key length whose strength is at least ``bits`` (``None`` above the largest row)."""
+    key length whose strength is at least ``bits`` (``None`` above the largest row).
+
+    Raises
+    ------
+    ParameterError
+        If ``bits`` is not a finite real number >= 0.
+    """
+    bits = check_nonnegative("bits", bits)
     rows = (records or default_records()).nist
     for row in rows:
         if row.strength >= bits:
@@ -439,7 +449,14 @@ def nist_key_length(bits: float, records: RecordSet | None = None) -> int | None
 
 def nist_strength(key_length: int, records: RecordSet | None = None) -> int | None:
     """The NIST SP 800-57 strength of a ``key_length``-bit group: the strength of the largest
-    tabulated key length not above it (``None`` below the smallest row)."""
+    tabulated key length not above it (``None`` below the smallest row).
+
+    Raises
+    ------
+    ParameterError
+        If ``key_length`` is not an integer >= 2.
+    """
+    key_length = check_int("key_length", key_length, 2)
     best = None
     for row in (records or default_records()).nist:
         if row.key_length <= key_length:

@@ -44,7 +44,36 @@ __all__ = [
     "exact_sic_function",
     "exact_sic_asymptotic_function",
     "sic2_bracket",
+    "check_complexity",
+    "complexity_value",
 ]
+
+
+def check_complexity(gamma: Any) -> Callable[[int], Any]:
+    """``gamma`` if it is callable (a sample identifying complexity ``int -> number``).
+
+    Raises
+    ------
+    ParameterError
+        If ``gamma`` is not callable.
+    """
+    if not callable(gamma):
+        raise ParameterError(f"gamma must be a callable sample identifying complexity N -> gamma(N), got {format_value(gamma)}")
+    return gamma
+
+
+def complexity_value(gamma: Callable[[int], Any], N: int) -> Fraction:
+    """``gamma(N)`` exactly (the binary rule), checked: a finite real number >= 0.
+
+    A complexity bounds a squared error (Definition def:sic), so a negative, NaN or non-numeric
+    value is a :class:`ParameterError` naming it, never compared as if it were a number.
+    """
+    value = gamma(N)
+    label = f"gamma({format_value(N)})"  # N may have thousands of digits (n_max = 10**5000)
+    v = binary_fraction(label, value)
+    if v < 0:
+        raise ParameterError(f"{label} must be >= 0 (a sample identifying complexity), got {format_value(value)}")
+    return v
 
 
 def sample_size_for_rate(rate: Any, gamma_c: Any) -> int:
@@ -176,21 +205,29 @@ def minimum_sample_size(gamma: Callable[[int], Any], gamma_c: Any, *, n_min: int
     Raises
     ------
     ParameterError
-        If ``gamma(N) >= gamma_c`` up to ``n_max``.
+        If ``gamma`` is not callable or returns a value that is not a finite real >= 0,
+        ``n_max < n_min``, or ``gamma(N) >= gamma_c`` up to ``n_max``.
     """
+    check_complexity(gamma)
     n_min = check_int("n_min", n_min, 1)
+    n_max = check_int("n_max", n_max, n_min)
     g_c = decimal_fraction("gamma_c", gamma_c)
 
     def below(N: int) -> bool:
-        return binary_fraction(f"gamma({N})", gamma(N)) < g_c
+        return complexity_value(gamma, N) < g_c
+
+    def give_up() -> ParameterError:
+        return ParameterError(f"gamma(N) stays >= gamma_c = {format_value(gamma_c)} up to N = {format_value(n_max)}")
 
     if below(n_min):
         return n_min
-    lo, hi = n_min, n_min + 1  # invariant: not below(lo)
+    if n_max == n_min:
+        raise give_up()
+    lo, hi = n_min, n_min + 1  # invariant: not below(lo), hi <= n_max
     while not below(hi):
-        lo, hi = hi, n_min + 2 * (hi - n_min)
-        if hi > n_max:
-            raise ParameterError(f"gamma(N) stays >= gamma_c = {format_value(gamma_c)} up to N = {format_value(n_max)}")
+        if hi >= n_max:
+            raise give_up()
+        lo, hi = hi, min(n_min + 2 * (hi - n_min), n_max)  # the last step tries n_max itself
     while hi - lo > 1:
         mid = (lo + hi) // 2
         if below(mid):

@@ -270,7 +270,48 @@ def _valid() -> list[Case]:
     ]
 
 
+def _beyond_the_issue() -> list[Case]:
+    """Cases of the same classes found while fixing the issue's (not among its reproducers)."""
+
+    def plant_text(name: str, text: str, **kw: Any) -> Any:
+        def run(tmp: Path) -> Any:
+            path = tmp / name
+            path.write_text(text)
+            return api("encctl_gym.plant_file:load_plant_file")(path, **kw)
+        return run
+
+    def yaml_exponents(spec: Any) -> None:  # YAML 1.1 would read 1e-6 and 442e15 as strings
+        assert (spec.preset.sigma_w2, spec.preset.upsilon, float(spec.A[0, 0])) == (1e-6, 442e15, 0.5), spec.values()
+
+    def search_to_n_max(_: Path) -> int:  # 1/N < 1e-3 first at N = 1001, which is n_max itself
+        return api(f"{SEC}.sample_size:minimum_sample_size")(lambda N: Fraction(1, N), 1e-3, n_max=1001)
+
+    def record_year(tmp: Path) -> Any:
+        data_file = api(f"{SEC}.records:DATA_FILE")
+        path = tmp / "records.json"
+        path.write_text(data_file.read_text().replace('"year": 2015', '"year": ' + "9" * 400, 1))
+        return api(f"{SEC}.records:load_records")(path)
+
+    def check_1001(n: Any) -> None:
+        assert n == 1001, n
+
+    return [
+        case("plant_file", "load_plant_file(JSON with A twice)", "silent", plant_text("dup.json", '{"A": [[0.5]], "B": [[1]], "A": [[0.9]]}')),
+        case("plant_file", "load_plant_file(YAML with A twice)", "silent", plant_text("dup.yaml", "A: [[0.5]]\nB: [[1]]\nA: [[0.9]]\n")),
+        case("plant_file", "valid: load_plant_file(YAML exponents 1e-6, 442e15)", "traceback",
+             plant_text("exp.yaml", "A: [[5e-1]]\nB: [[1]]\nsigma_w2: 1e-6\nupsilon: 442e15\n"), expect="result", check=yaml_exponents),
+        case("plant_file", "load_plant_file(defaults=42)", "traceback", plant_text("p.json", '{"A": [[0.5]], "B": [[1]]}', defaults=42)),
+        case("plant_file", "load_plant_file(defaults={'bogus': 1})", "silent", plant_text("p2.json", '{"A": [[0.5]], "B": [[1]]}', defaults={"bogus": 1})),
+        case(A_, "controllability_gramian(B=1e200: B B^T overflows)", "traceback",
+             lambda _: api(f"{SEC}.gramians:controllability_gramian")(np.array([[0.5]]), np.array([[1e200]]))),
+        case(A_, "valid: minimum_sample_size(n_max=1001, the answer)", "traceback", search_to_n_max, expect="result", check=check_1001),
+        case(A_, "minimum_sample_size(n_max=10^5000, never below)", "traceback",
+             lambda _: api(f"{SEC}.sample_size:minimum_sample_size")(lambda N: 1.0, 0.5, n_max=10**5000), slow=True),  # 16610 doublings
+        case(A_, "load_records(a year of 400 digits)", "silent", record_year),
+    ]
+
+
 def cases() -> list[Case]:
     """Every security-analysis case."""
     return [*_gramians(), *_complexity(), *_deciphering(), *_design(), *_cost_models(), *_exact(), *_attack_design(),
-            *_units_presets_files(), *_valid()]
+            *_units_presets_files(), *_valid(), *_beyond_the_issue()]
