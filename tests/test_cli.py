@@ -51,3 +51,17 @@ def test_a_multi_line_package_error_is_printed_on_one_line(monkeypatch, capsys) 
     assert cli.main(["design"]) == 2
     err = capsys.readouterr().err
     assert err == "encctl-gym design: error: A must be real, got array([[0.5+0.j, 0.1+0.j], [0. +0.j, 0.3+1.j]])\n"
+
+
+def test_a_reader_that_closes_the_pipe_ends_the_command_quietly() -> None:
+    # `encctl-gym design ... | head -1`: the reader goes away after one line
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "encctl_gym.cli", "design", "--preset", "paper-example", "--cost-model", "all"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    )
+    assert proc.stdout is not None
+    proc.stdout.readline()
+    proc.stdout.close()
+    _, err = proc.communicate(timeout=120)
+    assert b"Traceback" not in err and b"BrokenPipeError" not in err
+    assert proc.returncode in (0, 1)
