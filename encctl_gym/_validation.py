@@ -207,8 +207,11 @@ def as_finite_array(name: str, value: Any, ndim: int | None = None) -> np.ndarra
     given).
 
     Complex, boolean and string data are refused (never truncated to the real part or read as
-    0/1), as are integers beyond the float64 range.
+    0/1), as are bytes (NumPy would read ``bytearray(b"1")`` as the number 49) and integers
+    beyond the float64 range.
     """
+    if isinstance(value, (str, bytes, bytearray, memoryview)):
+        raise ParameterError(f"{name} must be a numeric array, got {format_value(value)}")
     try:
         raw = value if isinstance(value, np.ndarray) else np.asarray(value)
     except (TypeError, ValueError, OverflowError) as exc:

@@ -65,3 +65,9 @@ def test_under_an_address_space_limit_check_memory_refuses_what_does_not_fit():
     # the child capped itself at its mapped size + 256 MiB: about that much room is left
     assert room is not None and 0 < room <= 256 * 2**20
     assert "address space left" in message and "1 GiB" in message
+
+
+@pytest.mark.parametrize("value", [bytearray(b"1"), b"12", memoryview(b"1"), "12"])
+def test_bytes_and_text_are_not_read_as_numbers(value):
+    with pytest.raises(ParameterError, match="A must be a numeric array"):
+        as_finite_array("A", value)
