@@ -54,19 +54,8 @@ def compute(
 
 
 def plot(table: Table, path: str | Path) -> Path:
-    """Draw Figure 2 (2 x 3 log-log panels) from a table of :func:`compute` and save it.
-
-    Parameters
-    ----------
-    table
-        Output of :func:`compute`.
-    path
-        PNG file to write.
-
-    Returns
-    -------
-    pathlib.Path
-    """
+    """Draw Figure 2 (2 x 3 log-log panels) from a table of :func:`compute` and save it to
+    ``path`` (PNG); returns the path, as :func:`experiments.fig1_variance_ratio.plot`."""
     s0 = table.summary(PANELS[0])
     runs = s0["errors"].shape[0]
     return panel_figure(

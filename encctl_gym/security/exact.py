@@ -144,13 +144,7 @@ def floor_log2(x: Fraction | int) -> int:
 
 def log2_fraction(x: Fraction | int) -> float:
     """``log2 x`` of a positive fraction or integer in double precision, for any size (no float
-    overflow).
-
-    Raises
-    ------
-    ParameterError
-        If ``x`` is not a Fraction or an integer, or is not > 0.
-    """
+    overflow); refuses what :func:`floor_log2` refuses."""
     x = _exact_positive("log2", x)
     p, q = x.numerator, x.denominator
     sp, sq = max(p.bit_length() - 60, 0), max(q.bit_length() - 60, 0)

@@ -152,20 +152,12 @@ def exact_optimal_sample_size(
 
     Parameters
     ----------
-    tr_psi_u, tr_psi_w : float
-        Gramian traces.
-    m, n : int
-        Dimensions.
     sigma_u2, sigma_w2 : float
         Variances (> 0).
     sigma_x2 : float, default 1.0
         Variance of x_0 (>= 0).
-    gamma_c : float
-        Acceptable estimation error (> 0).
-
-    Returns
-    -------
-    int
+    tr_psi_u, tr_psi_w, m, n, gamma_c
+        As in :func:`optimal_sample_size`; returns the int ``N*``.
     """
     m = check_int("m", m, 1)
     n = check_int("n", n, 1)
