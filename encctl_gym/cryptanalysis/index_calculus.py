@@ -56,9 +56,9 @@ from ..crypto import arith
 from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, GroupError
-from .base import Breaker, Deadline, Precomputation
+from .base import Breaker, Deadline, Precomputation, format_bytes
 from .linalg import flint_backend, solve_mod_prime
-from .smoothness import RHO_MAX_U, FactorBase, dickman_rho, rational_reconstruction
+from .smoothness import RHO_MAX_U, FactorBase, check_bound, dickman_rho, rational_reconstruction
 
 __all__ = [
     "IndexCalculus",
@@ -85,6 +85,13 @@ MATRIX_ENTRY = 5.0e-7
 #: Relations collected beyond the number of unknowns (fraction, plus a constant).
 EXTRA_FRACTION = 0.05
 EXTRA_CONSTANT = 20
+#: Peak bytes per entry of the dense system ``[R | r]`` in :func:`~.linalg.solve_mod_prime` (the
+#: Python entry list, the FLINT matrix, its echelon form and the entries read back), measured for
+#: a 2120 x 2001 system with a 61-bit q: 91 bytes.
+MATRIX_BYTES_PER_ENTRY = 91
+#: Largest expected peak memory of the linear algebra (bytes): 4 GiB. The default bound of a
+#: 128-bit group (6547 unknowns, about 3.8 GiB) fits.
+MAX_MATRIX_BYTES = 4 * 2**30
 #: Share of the primes occurring in the relations whose logarithm must be determined.
 SOLVED_FRACTION = 0.97
 _CHECK_EVERY = 2048
@@ -306,7 +313,9 @@ class IndexCalculus(Breaker):
     Parameters
     ----------
     bound : int, optional
-        The factor-base bound B (default: :func:`choose_bound` for the group's size).
+        The factor-base bound B, at most :data:`~.smoothness.MAX_BOUND` (default:
+        :func:`choose_bound` for the group's size); a bound whose linear algebra would need more
+        than :data:`MAX_MATRIX_BYTES` is refused by :meth:`check_feasible`.
     max_bits : int, optional
         Size limit (default 112 bits: about six minutes and a dense matrix of about 3500 x 3500
         on this machine; at most 128, where the halves a and b still fit in 64 bits).
@@ -323,7 +332,7 @@ class IndexCalculus(Breaker):
         super().__init__(max_bits=max_bits, rng=rng)
         if self.max_bits > 128:
             raise BreakerLimitError(f"index-calculus supports at most 128 bits (max_bits), got {self.max_bits}")
-        self.bound = None if bound is None else check_int("bound", bound, minimum=2)
+        self.bound = None if bound is None else check_bound(bound)
 
     def factor_base_bound(self, group: GroupParams) -> int:
         """B for this group: the ``bound`` given, else :func:`choose_bound` (at least 2, below p)."""
@@ -334,6 +343,26 @@ class IndexCalculus(Breaker):
         """``(first, per_key)`` of :func:`cost_model` at :meth:`factor_base_bound`."""
         model = cost_model(group.bits, self.factor_base_bound(group))
         return model["first"], model["per_key"]
+
+    def matrix_bytes(self, group: GroupParams) -> float:
+        """Expected peak memory of the first linear algebra (bytes): ``k (1 + EXTRA_FRACTION) +
+        EXTRA_CONSTANT`` rows of ``k + 1`` entries, k the (estimated) size of the factor base, at
+        :data:`MATRIX_BYTES_PER_ENTRY` each."""
+        k = _prime_count(self.factor_base_bound(group))
+        return (k * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT) * (k + 1) * MATRIX_BYTES_PER_ENTRY
+
+    def check_feasible(self, group: GroupParams) -> None:
+        """The limits of :class:`~.base.Breaker`, and the memory of the dense linear algebra
+        (:meth:`matrix_bytes` at most :data:`MAX_MATRIX_BYTES`)."""
+        super().check_feasible(group)
+        need = self.matrix_bytes(group)
+        if need > MAX_MATRIX_BYTES:
+            bound = self.factor_base_bound(group)
+            raise BreakerLimitError(
+                f"index-calculus refuses factor-base bound {bound} for this {group.bits}-bit group: about "
+                f"{_prime_count(bound):.0f} unknowns make a dense system of about {format_bytes(need)}, above the "
+                f"limit of {format_bytes(MAX_MATRIX_BYTES)} (MAX_MATRIX_BYTES)"
+            )
 
     def _check_group(self, group: GroupParams) -> None:
         n = group.cofactor
