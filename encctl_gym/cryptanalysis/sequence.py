@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_int
+from .._validation import check_int, format_value
 from ..crypto import arith
 from ..crypto.group import GroupParams
 from ..errors import ParameterError
@@ -88,6 +88,25 @@ def _clock(clock: str) -> str:
     return "seconds" if clock == "wall" else "cpu_seconds"
 
 
+def _check_scheduler(scheduler: Any) -> None:
+    """Refuse a scheduler that :func:`~encctl_gym.parallel.run_tasks` cannot use, before any work:
+    it takes ``None``, ``"local"``, an address ``"protocol://host:port"`` or a
+    ``distributed.Client``."""
+    if scheduler is None or scheduler == "local":
+        return
+    if isinstance(scheduler, str):
+        protocol, sep, location = scheduler.partition("://")
+        if not (sep and protocol and location):
+            raise ParameterError(
+                f"scheduler must be 'local' or a Dask scheduler address like 'tcp://host:8786', got {format_value(scheduler)}"
+            )
+        return
+    if not type(scheduler).__module__.startswith("distributed"):
+        raise ParameterError(
+            f"scheduler must be None, 'local', a Dask scheduler address or a distributed.Client, got {format_value(scheduler)}"
+        )
+
+
 def _break_chunk(task: tuple[Precomputation, list[int], float | None], seed: np.random.SeedSequence) -> list[RecoveredKey]:
     # One task of the parallel path: a copy of the precomputation and a run of consecutive keys.
     pre, hs, time_limit = task
@@ -107,7 +126,7 @@ def break_sequence(
     scheduler: Any = None,
     n_jobs: int = 1,
     chunks: int | None = None,
-    seed: int = 0,
+    seed: int | np.random.SeedSequence = 0,
 ) -> BreakReport:
     """Break the public-key elements ``hs`` of one group with one precomputation.
 
@@ -131,12 +150,12 @@ def break_sequence(
         Run the per-key work through :func:`~encctl_gym.parallel.run_tasks` (with ``n_jobs``):
         ``None`` and ``n_jobs == 1`` break the keys in this process, in order.
     n_jobs : int
-        Workers of the parallel path (``-1``: all cores).
+        Workers of the parallel path (``-1``: all cores, else >= 1).
     chunks : int, optional
-        Number of tasks of the parallel path (default: the number of workers); each carries a
-        copy of the precomputation and a run of consecutive keys.
-    seed : int
-        Seed of the parallel path's per-task randomness.
+        Number of tasks of the parallel path, >= 1 (default: the number of workers); each
+        carries a copy of the precomputation and a run of consecutive keys.
+    seed : int or numpy.random.SeedSequence
+        Seed (>= 0) of the parallel path's per-task randomness.
 
     Returns
     -------
@@ -147,17 +166,28 @@ def break_sequence(
     KeyMismatchError
         If a key is not in G of ``group``.
     ParameterError
-        If tokens are given to a breaker that does not use them, or on bad options.
+        If tokens are given to a breaker that does not use them, or on bad options (checked
+        before the precomputation, whichever path the options serve).
     """
     from tqdm.auto import tqdm
 
     breaker = get_breaker(breaker) if isinstance(breaker, str) else breaker
     if not isinstance(breaker, Breaker):
-        raise ParameterError(f"breaker must be a registry name or a Breaker, got {breaker!r}")
+        raise ParameterError(f"breaker must be a registry name or a Breaker, got {format_value(breaker)}")
     if not isinstance(group, GroupParams):
-        raise ParameterError(f"group must be a GroupParams, got {group!r}")
+        raise ParameterError(f"group must be a GroupParams, got {format_value(group)}")
+    if isinstance(hs, (str, bytes)) or not isinstance(hs, Iterable):
+        raise ParameterError(f"hs must be an iterable of public-key elements, got {format_value(hs)}")
     hs = [check_element(group, h) for h in hs]
+    # Every option is checked before the precomputation, which may be the expensive part.
     n_jobs = check_int("n_jobs", n_jobs)
+    if n_jobs == 0 or n_jobs < -1:
+        raise ParameterError(f"n_jobs must be -1 or >= 1, got {n_jobs}")
+    if chunks is not None:
+        chunks = check_int("chunks", chunks, minimum=1)
+    if not isinstance(seed, np.random.SeedSequence):
+        seed = check_int("seed", seed, minimum=0)
+    _check_scheduler(scheduler)
     if breaker.MAIN_THREAD_ONLY and scheduler is not None:
         raise ParameterError(
             f"breaker {breaker.name!r} runs only in a process's main thread and Dask runs tasks in threads: "
@@ -177,7 +207,7 @@ def break_sequence(
             keys.append(breaker.break_key(h, pre, time_limit=time_limit))
         return BreakReport(breaker.name, group, pre.cost, keys)
     workers = (os.cpu_count() or 1) if n_jobs == -1 else n_jobs
-    n_chunks = max(1, min(len(hs), check_int("chunks", chunks if chunks is not None else workers, minimum=1)))
+    n_chunks = max(1, min(len(hs), chunks if chunks is not None else workers))
     bounds = np.linspace(0, len(hs), n_chunks + 1).round().astype(int)
     tasks = [(pre, hs[a:b], time_limit) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
     from ..parallel import run_tasks
