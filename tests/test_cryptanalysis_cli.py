@@ -232,3 +232,85 @@ def test_models_figure_and_from_csv(quick_rows: list, tmp_path) -> None:
     assert (out / "deciphering_models.png").is_file()
     assert (out / "deciphering_time.csv").read_text() == path.read_text()
     assert deciphering_time.main(["--from-csv", str(tmp_path / "missing.csv"), "--out", str(out)]) == 2
+
+
+# ----------------------------------------------------------------------------- hardening (issue 16)
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--bits", "32", "--keys", "1000000000000"], "--keys = 1000000000000"),
+        (["--bits", "32", "--keys", "9" * 401], "--keys = <integer of 1333 bits"),
+        (["--bits", "712", "--keys", "1", "--breaker", "rho", "--max-bits", "100000"], "MAX_EXPECTED_SECONDS"),
+        (["--bits", "32", "--keys", "2", "--scheduler", "tcp://"], "got 'tcp://'"),
+    ],
+)
+def test_crack_refuses_unbounded_work_in_one_line(capsys: pytest.CaptureFixture, args: list, message: str) -> None:
+    assert main(["crack", *args, "--no-progress", "--json"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0], err
+
+
+def test_crack_keys_limit_and_its_memory_estimate() -> None:
+    from encctl_gym.cryptanalysis.cli import MAX_KEYS, check_keys
+    from encctl_gym.errors import ResourceLimitError
+
+    assert check_keys(MAX_KEYS) == MAX_KEYS and check_keys(1) == 1
+    with pytest.raises(ResourceLimitError, match="MAX_KEYS") as err:
+        check_keys(10**12)
+    assert "2.79e+06 GiB" in str(err.value)  # 10^12 keys of 3000 bytes: 3e15 / 2^30 = 2.794e6 GiB
+    with pytest.raises(ParameterError, match="keys must be an integer, got 2.5"):
+        check_keys(2.5)
+
+
+@pytest.mark.parametrize("u", ["a", None, 2 + 1j, 10**400, float("nan"), -1.0, True])
+def test_dickman_rho_refuses_what_is_not_a_real_u(u: object) -> None:
+    with pytest.raises(ParameterError, match="^u must be") as err:
+        dickman_rho(u)  # type: ignore[arg-type]
+    assert ("integer of 1329 bits" if u == 10**400 else repr(u)) in str(err.value)
+
+
+def test_dickman_rho_takes_an_integer_u() -> None:
+    assert dickman_rho(2) == pytest.approx(1 - math.log(2), rel=1e-14)
+    assert dickman_rho(3) == pytest.approx(0.04860838829, rel=1e-9)  # rho(3), de Bruijn's table
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"p": "a"}, "p must be an integer, got 'a'"),
+        ({"p": None}, "p must be an integer, got None"),
+        ({"p": 1}, "p must be >= 2, got 1"),
+        ({"y": 2.5}, "y must be an integer, got 2.5"),
+        ({"y": None}, "y must be an integer, got None"),
+        ({"y": 101}, "y must lie in [1, p), got y = 101 for p = 101"),
+        ({"bound": 0}, "bound must be >= 1, got 0"),
+        ({"bound": -1}, "bound must be >= 1, got -1"),
+        ({"bound": 2.5}, "bound must be an integer, got 2.5"),
+        ({"bound": "a"}, "bound must be an integer, got 'a'"),
+        ({"bound": 101}, "bound must lie in [1, p), got bound = 101"),
+    ],
+)
+def test_rational_reconstruction_refuses_bad_arguments(kwargs: dict, message: str) -> None:
+    with pytest.raises(ParameterError) as err:
+        rational_reconstruction(**{"y": 5, "p": 101, **kwargs})
+    assert message in str(err.value)
+
+
+def test_rational_reconstruction_at_the_edges_of_its_bound() -> None:
+    # bound = 1: a = 1 and b = 5^-1 = 81 = -20 (mod 101), |b| < 101 (5 * 81 = 405 = 4 * 101 + 1).
+    assert rational_reconstruction(5, 101, 1) == (1, -20)
+    assert -20 % 101 == 81
+    # bound = p - 1: y itself, b = 1.
+    assert rational_reconstruction(5, 101, 100) == (5, 1)
+
+
+def test_factor_base_refuses_a_bound_beyond_its_limit() -> None:
+    from encctl_gym.cryptanalysis.smoothness import MAX_BOUND
+    from encctl_gym.errors import ResourceLimitError
+
+    for bound, shown in ((MAX_BOUND + 1, str(MAX_BOUND + 1)), (10**12, "1000000000000"), (10**400, "<integer of 1329 bits")):
+        with pytest.raises(ResourceLimitError, match="MAX_BOUND") as err:
+            FactorBase(bound)
+        assert shown in str(err.value)
+    with pytest.raises(ResourceLimitError):
+        primes_up_to(10**12)
