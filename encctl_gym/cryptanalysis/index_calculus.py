@@ -51,11 +51,11 @@ from typing import ClassVar
 
 import gmpy2
 
-from .._validation import check_int, check_positive
+from .._validation import check_int, check_positive, format_value
 from ..crypto import arith
 from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
-from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, GroupError
+from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, GroupError, ParameterError
 from .base import Breaker, Deadline, Precomputation, format_bytes
 from .linalg import flint_backend, solve_mod_prime
 from .smoothness import RHO_MAX_U, FactorBase, check_bound, dickman_rho, rational_reconstruction
@@ -68,6 +68,7 @@ __all__ = [
     "choose_bound",
     "cost_model",
     "relation_probability",
+    "MAX_MODEL_BITS",
 ]
 
 #: Calibration of the cost model, measured on this machine (2 cores, Python 3.11, gmpy2 2.3,
@@ -97,11 +98,31 @@ SOLVED_FRACTION = 0.97
 _CHECK_EVERY = 2048
 
 
+#: Largest bit length of p the cost model takes (far beyond any group the package builds; it keeps
+#: every quantity of the model within the float range).
+MAX_MODEL_BITS = 1 << 20
+
+
+def _model_args(bits: object, bound: object) -> tuple[int, float]:
+    bits = check_int("bits", bits, minimum=2, maximum=MAX_MODEL_BITS)
+    bound = check_positive("bound", bound)
+    if bound < 2:
+        raise ParameterError(f"bound must be >= 2, got {format_value(bound)}")
+    return bits, bound
+
+
 def relation_probability(bits: int, bound: float) -> float:
     """Probability that ``y = a / b`` (both about ``bits / 2`` bits) has a and b ``bound``-smooth:
     ``rho(u)^2`` with ``u = (bits / 2) ln 2 / ln B`` (Dickman's rho, :func:`~.smoothness.dickman_rho`);
     0 past the range of the tabulated rho (``u > 40``, a probability below 1e-142), so that the
-    cost model of a group far beyond reach is infinite rather than an error."""
+    cost model of a group far beyond reach is infinite rather than an error.
+
+    Raises
+    ------
+    ParameterError
+        Unless ``2 <= bits <=`` :data:`MAX_MODEL_BITS` is an integer and ``bound >= 2`` a real number.
+    """
+    bits, bound = _model_args(bits, bound)
     u = (bits / 2) * math.log(2) / math.log(bound)
     if u > RHO_MAX_U:
         return 0.0
@@ -122,8 +143,7 @@ def cost_model(bits: int, bound: float) -> dict[str, float]:
         (seconds of phase 2), ``linear_algebra`` (phase 3, dense elimination and the matrix
         build), ``descent`` (phase 4, per key), ``first`` (phases 2-4) and ``per_key``.
     """
-    bits = check_int("bits", bits, minimum=2)
-    bound = check_positive("bound", bound)
+    bits, bound = _model_args(bits, bound)
     k = _prime_count(bound)
     trials = 1.0 / max(relation_probability(bits, bound), 1e-300)
     trial = TRIAL_BASE + TRIAL_PER_BIT * bits + TRIAL_PER_BOUND * bound
@@ -144,8 +164,8 @@ def cost_model(bits: int, bound: float) -> dict[str, float]:
 
 def choose_bound(bits: int) -> int:
     """The factor-base bound B minimising the expected time of the first key (:func:`cost_model`),
-    searched over ``B = 2^(x/8)``, ``x/8`` from 5 to 22."""
-    bits = check_int("bits", bits, minimum=2)
+    searched over ``B = 2^(x/8)``, ``x/8`` from 5 to 22 (``2 <= bits <=`` :data:`MAX_MODEL_BITS`)."""
+    bits = check_int("bits", bits, minimum=2, maximum=MAX_MODEL_BITS)
     best = min(range(40, 177), key=lambda x: cost_model(bits, 2 ** (x / 8))["first"])
     return max(2, int(2 ** (best / 8)))
 
@@ -187,7 +207,7 @@ class Relation(tuple):
 def _split(fb: FactorBase, y: int, p: int, half: int) -> dict[int, int] | None:
     """The exponent vector of lambda(y) = lambda(a) - lambda(|b|), or None if a or b is not smooth."""
     a, b = rational_reconstruction(y, p, half)
-    if not (fb.is_smooth(a) and fb.is_smooth(b)):
+    if not (fb._is_smooth(a) and fb._is_smooth(b)):
         return None
     fa, fb_ = fb.factor(a), fb.factor(b)
     assert fa is not None and fb_ is not None  # both smooth

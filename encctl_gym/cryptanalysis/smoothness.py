@@ -112,7 +112,16 @@ class FactorBase:
         With P the product of the factor base, ``|x|`` is B-smooth iff ``|x|`` divides P^(2^e)
         once ``2^e >= log2 |x|`` (no prime occurs in ``|x|`` more than ``log2 |x|`` times), i.e.
         iff ``(P mod |x|)^(2^e) = 0 (mod |x|)``: one remainder of P and e squarings.
+
+        Raises
+        ------
+        ParameterError
+            If ``x`` is not an integer.
         """
+        return self._is_smooth(check_int("x", x))
+
+    def _is_smooth(self, x: int) -> bool:
+        # is_smooth without the check: the relation search calls it for every trial.
         x = abs(x)
         if x <= 1:
             return x == 1
@@ -120,11 +129,17 @@ class FactorBase:
         return gmpy2.powmod(self.product % x, 1 << e, x) == 0
 
     def factor(self, x: int) -> dict[int, int] | None:
-        """The exponents ``{column: e}`` of a B-smooth ``|x|`` (``None`` if it is not smooth)."""
-        x = abs(int(x))
+        """The exponents ``{column: e}`` of a B-smooth ``|x|`` (``None`` if it is not smooth).
+
+        Raises
+        ------
+        ParameterError
+            If ``x`` is not a nonzero integer.
+        """
+        x = abs(check_int("x", x))
         if x == 0:
             raise ParameterError("0 has no factorisation over a factor base")
-        if not self.is_smooth(x):
+        if not self._is_smooth(x):
             return None
         out: dict[int, int] = {}
         if x < (1 << 64):
