@@ -33,7 +33,7 @@ import dataclasses
 import math
 import threading
 import time
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Any, ClassVar
 
 from .._validation import check_int, check_positive, format_value
@@ -49,6 +49,7 @@ __all__ = [
     "Precomputation",
     "Breaker",
     "check_element",
+    "as_list",
     "verify_exponent",
     "format_seconds",
     "format_bytes",
@@ -193,6 +194,14 @@ def check_element(group: GroupParams, h: Any) -> int:
             f"({group.bits}-bit p = {format_int(group.p)}): a key of another group?"
         )
     return h
+
+
+def as_list(name: str, values: Any, what: str) -> list[Any]:
+    """``values`` as a list, after checking that it is an iterable (not a string or bytes) of
+    ``what`` (named in the message)."""
+    if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
+        raise ParameterError(f"{name} must be an iterable of {what}, got {format_value(values)}")
+    return list(values)
 
 
 def verify_exponent(group: GroupParams, h: int, s: int, who: str) -> int:

@@ -36,15 +36,20 @@ BREAKERS: dict[str, type[Breaker]] = {
 
 def get_breaker(name: str | Breaker, **kwargs: Any) -> Breaker:
     """Build the breaker registered as ``name`` with keyword arguments ``kwargs`` (a
-    :class:`~.base.Breaker` instance is returned as is).
+    :class:`~.base.Breaker` instance is returned as is, and takes no ``kwargs``).
 
     Raises
     ------
     ParameterError
-        For an unknown name (the message lists the registered ones) or an option the breaker
-        does not have (the message lists its options).
+        For an unknown name (the message lists the registered ones), an option the breaker
+        does not have (the message lists its options), or options given with an instance.
     """
     if isinstance(name, Breaker):
+        if kwargs:
+            raise ParameterError(
+                f"options {', '.join(format_value(k) for k in kwargs)} apply to a breaker built by name; "
+                f"set them on the instance {format_value(name)} instead"
+            )
         return name
     try:
         cls = BREAKERS[name]

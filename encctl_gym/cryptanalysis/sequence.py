@@ -22,11 +22,11 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_int, format_value
+from .._validation import check_bool, check_int, format_value
 from ..crypto import arith
 from ..crypto.group import GroupParams
 from ..errors import ParameterError
-from .base import Breaker, Cost, Precomputation, RecoveredKey, check_element
+from .base import Breaker, Cost, Precomputation, RecoveredKey, as_list, check_element
 from .registry import get_breaker
 
 __all__ = ["BreakReport", "break_sequence"]
@@ -176,9 +176,9 @@ def break_sequence(
         raise ParameterError(f"breaker must be a registry name or a Breaker, got {format_value(breaker)}")
     if not isinstance(group, GroupParams):
         raise ParameterError(f"group must be a GroupParams, got {format_value(group)}")
-    if isinstance(hs, (str, bytes)) or not isinstance(hs, Iterable):
-        raise ParameterError(f"hs must be an iterable of public-key elements, got {format_value(hs)}")
-    hs = [check_element(group, h) for h in hs]
+    hs = [check_element(group, h) for h in as_list("hs", hs, "public-key elements")]
+    if tokens is not None:
+        tokens = as_list("tokens", tokens, "update tokens")
     # Every option is checked before the precomputation, which may be the expensive part.
     n_jobs = check_int("n_jobs", n_jobs)
     if n_jobs == 0 or n_jobs < -1:
@@ -193,8 +193,11 @@ def break_sequence(
             f"breaker {breaker.name!r} runs only in a process's main thread and Dask runs tasks in threads: "
             "break its keys without a scheduler"
         )
+    progress = check_bool("progress", progress)
     if pre is None:
         pre = breaker.precompute(group, time_limit=time_limit)
+    elif not isinstance(pre, Precomputation):
+        raise ParameterError(f"pre must be a Precomputation, got {format_value(pre)}")
     elif pre.breaker != breaker.name or pre.group != group:
         raise ParameterError(f"pre is a precomputation of {pre.breaker!r} for another group or breaker")
     if tokens is not None:
