@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from typing import Any
 
@@ -161,7 +162,8 @@ def _ops(ops: dict[str, int]) -> str:
 
 
 def summary(report: BreakReport) -> dict[str, float]:
-    """``T_first`` (precomputation + first key), the mean later key, their ratio, the total."""
+    """``T_first`` (precomputation + first key), the mean later key, their ratio, the total
+    (NaN for the later key and the ratio of a one-key report; ``null`` in the JSON output)."""
     t = report.key_seconds()
     first = report.precomputation.seconds + float(t[0])
     later = float(t[1:].mean()) if t.size > 1 else float("nan")
@@ -204,7 +206,9 @@ def run(args: argparse.Namespace) -> int:
     stats = summary(report)
     if args.json:
         out = report.to_dict()
-        out.update({"bits": group.bits, "group_source": source, "keys_match": True, **stats})
+        # JSON has no NaN: a figure without a value (the later keys of a one-key run) is null.
+        finite = {k: (v if math.isfinite(v) else None) for k, v in stats.items()}
+        out.update({"bits": group.bits, "group_source": source, "keys_match": True, **finite})
         print(json.dumps(out, indent=1))
         return 0
     print(f"crack: {breaker.name} on a {group.bits}-bit {source} group (p = {group.p:#x}), {n} keys of one dynamic-key sequence")
@@ -218,7 +222,7 @@ def run(args: argparse.Namespace) -> int:
     later = "n/a" if n == 1 else format_seconds(stats["mean_later_key"])
     print(
         f"T_first = {format_seconds(stats['T_first'])} (precomputation + key 0), mean later key = {later}, "
-        f"T_1 / T_first = {stats['ratio']:.3g}, total = {format_seconds(stats['total'])}"
+        f"T_1 / T_first = {'n/a' if n == 1 else format(stats['ratio'], '.3g')}, total = {format_seconds(stats['total'])}"
     )
     print(f"all {n} keys checked (g^s = h) and equal to the sequence's secret keys")
     return 0
