@@ -468,3 +468,28 @@ def test_break_sequence_takes_a_seed_sequence_and_one_chunk() -> None:
     hs, secrets, _ = sequence(24, 3)
     report = break_sequence("bsgs", group(24), hs, n_jobs=1, chunks=1, seed=np.random.SeedSequence(4))
     assert report.secrets == list(secrets)
+
+
+def test_options_given_with_a_breaker_instance_are_refused_not_ignored() -> None:
+    rho = PollardRho()
+    with pytest.raises(ParameterError, match="'max_bits' apply to a breaker built by name"):
+        get_breaker(rho, max_bits=20)
+    assert get_breaker(rho) is rho
+    with pytest.raises(ParameterError, match="max_bits applies to an inner breaker built by name"):
+        TokenChain(rho, max_bits=20)
+    assert TokenChain(rho).max_bits == rho.max_bits == 64
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"pre": 3}, "pre must be a Precomputation, got 3"),
+        ({"breaker": "token-chain", "tokens": 5}, "tokens must be an iterable of update tokens, got 5"),
+        ({"progress": "no"}, "progress must be True or False, got 'no'"),
+    ],
+)
+def test_break_sequence_refuses_a_bad_precomputation_tokens_or_progress(kwargs: dict, message: str) -> None:
+    hs, _, _ = sequence(24, 1)
+    with pytest.raises(ParameterError) as err:
+        break_sequence(**{"breaker": "bsgs", "group": group(24), "hs": list(hs), **kwargs})
+    assert message in str(err.value)

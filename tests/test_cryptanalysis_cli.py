@@ -314,3 +314,56 @@ def test_factor_base_refuses_a_bound_beyond_its_limit() -> None:
         assert shown in str(err.value)
     with pytest.raises(ResourceLimitError):
         primes_up_to(10**12)
+
+
+def test_crack_json_of_one_key_has_null_not_nan(capsys: pytest.CaptureFixture) -> None:
+    assert main(["crack", "--bits", "32", "--keys", "1", "--breaker", "bsgs", "--json", "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    out = json.loads(text, parse_constant=lambda c: pytest.fail(f"non-JSON constant {c}"))
+    assert out["mean_later_key"] is None and out["ratio"] is None and len(out["keys"]) == 1
+
+
+@pytest.mark.parametrize(
+    "bits, bound, message",
+    [
+        (10**400, 100, "bits must be <= 1048576"),
+        ("a", 100, "bits must be an integer, got 'a'"),
+        (64, 1, "bound must be >= 2, got 1"),
+        (64, 0.5, "bound must be >= 2, got 0.5"),
+        (64, "a", "bound must be a real number, got 'a'"),
+    ],
+)
+def test_cost_model_refuses_arguments_outside_its_domain(bits: object, bound: object, message: str) -> None:
+    for fn in (cost_model, relation_probability):
+        with pytest.raises(ParameterError) as err:
+            fn(bits, bound)  # type: ignore[arg-type]
+        assert message in str(err.value)
+    with pytest.raises(ParameterError, match="bits must be <= 1048576"):
+        choose_bound(10**400)
+
+
+def test_relation_probability_at_the_smallest_bound() -> None:
+    # B = 2, 64 bits: u = 32 ln 2 / ln 2 = 32, so rho(32)^2 (beyond the closed forms: check u only).
+    assert relation_probability(64, 2) == pytest.approx(dickman_rho(32.0) ** 2, rel=1e-12)
+    assert relation_probability(4000, 2) == 0.0  # u = 2000 > 40: zero, not an error
+
+
+def test_factor_base_tests_refuse_non_integers() -> None:
+    fb = FactorBase(100)
+    for bad in (2.5, "a", None):
+        with pytest.raises(ParameterError, match="x must be an integer"):
+            fb.is_smooth(bad)  # type: ignore[arg-type]
+        with pytest.raises(ParameterError, match="x must be an integer"):
+            fb.factor(bad)  # type: ignore[arg-type]
+    assert fb.factor(2 * 3 * 97) == {0: 1, 1: 1, 24: 1}  # 97 is the 25th prime
+    assert fb.is_smooth(-(2**10) * 97) and not fb.is_smooth(101)
+
+
+def test_solve_mod_prime_refuses_a_bad_modulus_or_column() -> None:
+    with pytest.raises(ParameterError, match="q must be >= 2, got 0"):
+        solve_mod_prime([{0: 1}], [1], 1, 0)
+    with pytest.raises(ParameterError, match="column 5, outside"):
+        solve_mod_prime([{5: 1}], [1], 1, 7)
+    with pytest.raises(ParameterError, match="ncols must be an integer"):
+        solve_mod_prime([{0: 1}], [1], 1.5, 7)
+    assert solve_mod_prime([{0: 3}], [1], 1, 7) == ([5], 1)  # 3 x = 1 (mod 7): x = 5
