@@ -95,18 +95,21 @@ class PariContext(Precomputation):
                 "break these keys without a thread-based scheduler"
             )
         pari = _pari()
+        import cypari._pari as cp
+
         g, order = self._pari_objects()
         target = pari.Mod(h, self.group.p)
-        if deadline.limit is None:
-            result = pari.znlog(target, g, order)
-        else:
-            import cypari._pari as cp
-
-            seconds = max(1, math.ceil(deadline.remaining))
-            try:
+        try:
+            if deadline.limit is None:
+                result = pari.znlog(target, g, order)
+            else:
+                seconds = max(1, math.ceil(deadline.remaining))
                 result = _ZNLOG_ALARM(target, g, order, seconds)
-            except cp.AlarmInterrupt:
-                raise deadline.error() from None
+        except cp.AlarmInterrupt:
+            raise deadline.error() from None
+        except cp.PariError as exc:  # PARI gives up (an algorithm it lacks, its stack): one line, ours
+            said = " ".join(str(exc).split())
+            raise BreakerError(f"pari: znlog failed for h = {format_int(h)}: {format_value(said, 200)}") from None
         if result.type() != "t_INT":
             raise BreakerError(f"pari: znlog found no logarithm of h = {format_int(h)} (result {format_value(str(result))})")
         return int(result), {}, ""
