@@ -493,3 +493,14 @@ def test_break_sequence_refuses_a_bad_precomputation_tokens_or_progress(kwargs: 
     with pytest.raises(ParameterError) as err:
         break_sequence(**{"breaker": "bsgs", "group": group(24), "hs": list(hs), **kwargs})
     assert message in str(err.value)
+
+
+@needs_pari
+def test_a_pari_failure_is_a_one_line_breaker_error(monkeypatch: pytest.MonkeyPatch) -> None:
+    from encctl_gym.cryptanalysis import base
+
+    monkeypatch.setattr(base, "MAX_EXPECTED_SECONDS", math.inf)  # let PARI try a 712-bit group: it gives up at once
+    grp = shipped_group(712)
+    with pytest.raises(BreakerError, match="pari: znlog failed") as err:
+        get_breaker("pari", max_bits=1000).precompute(grp).break_key(pow(grp.g, 12345, grp.p))
+    assert "\n" not in str(err.value) and "712 bits" in str(err.value)
