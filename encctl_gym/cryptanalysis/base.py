@@ -18,8 +18,9 @@ whose costs that definition lumps together:
 Every exponent is checked (``g^s = h``) before it is returned: a failed check raises
 :class:`~encctl_gym.errors.BreakerError`, never a wrong key. A group too large for a breaker
 is refused before any work (:class:`~encctl_gym.errors.BreakerLimitError`, naming the limit
-and the expected time from the breaker's cost model); a call past its ``time_limit`` stops with
-:class:`~encctl_gym.errors.BreakerTimeoutError`.
+and the expected time from the breaker's cost model), and so is a group whose first key that
+model expects to take more than :data:`MAX_EXPECTED_SECONDS` (one year) whatever ``max_bits``
+allows; a call past its ``time_limit`` stops with :class:`~encctl_gym.errors.BreakerTimeoutError`.
 
 This layer imports only :mod:`encctl_gym.crypto.arith`, :mod:`encctl_gym.crypto.group`,
 :mod:`encctl_gym.errors` and :mod:`encctl_gym._validation` (plus numpy, gmpy2, python-flint

@@ -15,6 +15,11 @@ runs once; the table lists each key's wall time, CPU time and operation counts, 
 ``T_first`` (precomputation + first key), the mean wall time of a later key and their ratio. Every recovered key
 is checked (g^s = h) and compared with the sequence's secret key.
 
+Work that cannot finish is refused in one line before it starts: more than :data:`MAX_KEYS`
+keys, a group beyond the breaker's ``--max-bits``, and a first key that the breaker's cost
+model expects to take more than a year whatever ``--max-bits`` says
+(:data:`~encctl_gym.cryptanalysis.base.MAX_EXPECTED_SECONDS`).
+
 With ``--scheduler`` (``local`` starts a Dask ``LocalCluster``; needs ``encctl-gym[dask]``) the
 keys are split into chunks that run as tasks of :func:`encctl_gym.parallel.run_tasks`, each with
 a copy of the precomputation; ``--n-jobs`` above 1 alone uses joblib processes.
