@@ -12,6 +12,12 @@ from a self-contained manylinux wheel for current Pythons (it bundles PARI 2.15)
 publishes a cp311 wheel only for its old release 2.2.0 and falls back to a source build, which
 needs a system PARI, for newer ones. PARI runs only in the main thread of a process (its stack
 is per thread): this breaker refuses to run in another thread instead of crashing.
+
+A PARI error inside ``znlog`` (PARI gives up: "too many iterations", its stack) is a one-line
+:class:`~encctl_gym.errors.BreakerError`. Known limitation of the binding (cypari with PARI
+2.15, reproduced without this package): once an ``alarm`` (the ``time_limit``) has interrupted
+a ``znlog``, the next PARI *error* in the same process crashes it with a segmentation fault;
+calls that succeed are unaffected. Run PARI attacks that may time out in their own process.
 """
 
 from __future__ import annotations
