@@ -38,7 +38,9 @@ key               meaning
 Every entry is checked (:func:`validate_config`): an unknown key, a value of the wrong type or
 outside its range is a one-line :class:`~encctl_gym.errors.ConfigError`, whether it comes from
 a file or from ``--set``. Files are read with YAML's safe loader, at most 1 MiB, without
-aliases (nested aliases can expand a small file into gigabytes).
+aliases (nested aliases can expand a small file into gigabytes) and nested at most
+:data:`MAX_CONFIG_DEPTH` levels. Step counts are at most :data:`MAX_STEPS` and seeds at most
+:data:`MAX_SEED`.
 """
 
 from __future__ import annotations
@@ -50,9 +52,10 @@ from typing import Any, Callable
 
 import yaml
 
+from encctl_gym._validation import format_value
 from encctl_gym.envs.config import default_config as env_default_config
 from encctl_gym.envs.config import resolve_params
-from encctl_gym.errors import ConfigError, ParameterError
+from encctl_gym.errors import ConfigError, EncctlError, ParameterError
 
 from .base import OBSERVATION_MODES
 
@@ -62,6 +65,9 @@ __all__ = [
     "COMMON",
     "REWARD_SCALINGS",
     "MAX_CONFIG_BYTES",
+    "MAX_CONFIG_DEPTH",
+    "MAX_STEPS",
+    "MAX_SEED",
     "read_yaml",
     "default_config",
     "load_config",
@@ -76,6 +82,13 @@ CONFIG_DIR = Path(__file__).resolve().parent / "configs"
 DEFAULTS_DIR = CONFIG_DIR / "defaults"
 #: Largest config file read (bytes).
 MAX_CONFIG_BYTES = 1 << 20
+#: Deepest nesting of mappings and lists in a config file or an override value.
+MAX_CONFIG_DEPTH = 32
+#: Largest step count (``n_timesteps``, ``eval.freq``): stable-baselines3 divides step counts in
+#: float64, exact for integers up to 2**53.
+MAX_STEPS = 2**53
+#: Largest seed: stable-baselines3 seeds NumPy's global generator, which takes seeds below 2**32.
+MAX_SEED = 2**32 - 1
 #: Choices of ``reward_scaling`` (:class:`agents.sb3.SB3VecEnv`).
 REWARD_SCALINGS = ("none", "samples")
 
@@ -105,13 +118,14 @@ COMMON: dict[str, Any] = {
 
 # --------------------------------------------------------------------------- reading
 def read_yaml(path: str | Path) -> dict[str, Any]:
-    """Read one config file: a YAML mapping, safe tags only, no aliases, at most 1 MiB.
+    """Read one config file: a YAML mapping, safe tags only, no aliases, at most 1 MiB, nested at
+    most :data:`MAX_CONFIG_DEPTH` levels.
 
     Raises
     ------
     ConfigError
-        Missing or unreadable file, a YAML error (including ``!!python/...`` tags), an alias,
-        or a top level that is not a mapping.
+        Missing or unreadable file, a YAML error (including ``!!python/...`` tags and integers
+        of over 4300 digits), an alias, deeper nesting, or a top level that is not a mapping.
     """
     p = Path(path)
     if not p.is_file():
@@ -120,19 +134,38 @@ def read_yaml(path: str | Path) -> dict[str, Any]:
         raise ConfigError(f"config file {str(p)!r} is larger than {MAX_CONFIG_BYTES} bytes")
     try:
         text = p.read_text()
-        if any(isinstance(tok, yaml.AliasToken) for tok in yaml.scan(text)):
-            raise ConfigError(f"config file {str(p)!r} uses a YAML alias (*name); write the values out")
+        _check_yaml_tokens(text, f"config file {str(p)!r}")
         data = yaml.safe_load(text)
     except ConfigError:
         raise
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+    except (OSError, UnicodeDecodeError, ValueError, yaml.YAMLError) as exc:  # ValueError: an integer of over 4300 digits
         first = str(exc).strip().splitlines()
-        raise ConfigError(f"cannot read config file {str(p)!r}: {' '.join(first[:2]) if first else type(exc).__name__}") from exc
+        what = format_value(" ".join(first[:2])) if first else type(exc).__name__
+        raise ConfigError(f"cannot read config file {str(p)!r}: {what}") from None
     if data is None:
         return {}
     if not isinstance(data, dict):
         raise ConfigError(f"config file {str(p)!r} must hold a mapping at the top level, got a {type(data).__name__}")
     return data
+
+
+def _check_yaml_tokens(text: str, where: str) -> None:
+    """Refuse YAML aliases and nesting deeper than :data:`MAX_CONFIG_DEPTH`, from the tokens alone
+    (before a Python object is built: PyYAML builds nested values recursively)."""
+    depth = 0
+    for tok in yaml.scan(text):
+        if isinstance(tok, yaml.AliasToken):
+            raise ConfigError(f"{where} uses a YAML alias (*name); write the values out")
+        if isinstance(tok, _OPENING):
+            depth += 1
+            if depth > MAX_CONFIG_DEPTH:
+                raise ConfigError(f"{where} nests mappings or lists more than {MAX_CONFIG_DEPTH} levels deep")
+        elif isinstance(tok, _CLOSING):
+            depth -= 1
+
+
+_OPENING = (yaml.BlockMappingStartToken, yaml.BlockSequenceStartToken, yaml.FlowMappingStartToken, yaml.FlowSequenceStartToken)
+_CLOSING = (yaml.BlockEndToken, yaml.FlowMappingEndToken, yaml.FlowSequenceEndToken)
 
 
 def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
@@ -268,14 +301,16 @@ def load_config(
 Check = Callable[[str, Any], Any]
 
 
-def _int(minimum: int, optional: bool = False) -> Check:
+def _int(minimum: int, optional: bool = False, maximum: int | None = None) -> Check:
     def check(name: str, v: Any) -> Any:
         if v is None and optional:
             return v
         if isinstance(v, bool) or not isinstance(v, numbers.Integral):
-            raise ConfigError(f"{name} must be an integer{' or null' if optional else ''}, got {v!r}")
+            raise ConfigError(f"{name} must be an integer{' or null' if optional else ''}, got {format_value(v)}")
         if v < minimum:
-            raise ConfigError(f"{name} must be >= {minimum}, got {v!r}")
+            raise ConfigError(f"{name} must be >= {minimum}, got {format_value(v)}")
+        if maximum is not None and v > maximum:
+            raise ConfigError(f"{name} must be <= {maximum}, got {format_value(v)}")
         return int(v)
 
     return check
@@ -316,22 +351,22 @@ SCHEMA: dict[str, Any] = {
     "system": _str,
     "config_files": _typed(list, "a list of paths"),
     "quick": _bool,
-    "horizon": _int(2, optional=True),
+    "horizon": _int(2, optional=True, maximum=MAX_STEPS),
     "observation": _choice(OBSERVATION_MODES),
     "features": lambda name, v: _features(name, v),
     "reward_scaling": _choice(REWARD_SCALINGS),
-    "n_envs": _int(1),
-    "n_timesteps": _int(1),
-    "seed": _int(0),
+    "n_envs": _int(1, maximum=MAX_STEPS),
+    "n_timesteps": _int(1, maximum=MAX_STEPS),
+    "seed": _int(0, maximum=MAX_SEED),
     "normalize": {"norm_obs": _bool, "norm_reward": _bool},
     "policy": _str,
     "eval": {
-        "freq": _int(1),
-        "episodes": _int(1),
-        "seed": _int(0),
-        "final_episodes": _int(1),
-        "final_horizon": _int(2, optional=True),
-        "elgamal": {"episodes": _int(0), "max_samples": _int(2), "key_length": _int(16)},
+        "freq": _int(1, maximum=MAX_STEPS),
+        "episodes": _int(1, maximum=MAX_STEPS),
+        "seed": _int(0, maximum=MAX_SEED),
+        "final_episodes": _int(1, maximum=MAX_STEPS),
+        "final_horizon": _int(2, optional=True, maximum=MAX_STEPS),
+        "elgamal": {"episodes": _int(0, maximum=MAX_STEPS), "max_samples": _int(2, maximum=MAX_STEPS), "key_length": _int(16)},
     },
 }
 
@@ -354,7 +389,8 @@ def validate_config(cfg: dict[str, Any]) -> None:
     """Check a whole configuration; raise :class:`ConfigError` naming the first bad entry.
 
     ``env`` is resolved by the environment's own checks (every key of
-    ``encctl_gym.envs.default_config()``, at the training attack length); ``hyperparams`` and
+    ``encctl_gym.envs.default_config()``, at the training attack length, and the final
+    evaluation's ElGamal episodes of ``eval.elgamal``); ``hyperparams`` and
     ``hyperparams.policy_kwargs`` are checked against the algorithm's and the policy's
     constructors (:mod:`agents.hyperparams`).
     """
@@ -373,6 +409,7 @@ def validate_config(cfg: dict[str, Any]) -> None:
         resolve_params(env_config(cfg))
     except ParameterError as exc:
         raise ConfigError(f"env: {exc}") from exc
+    _check_elgamal_evaluation(cfg)
     from .hyperparams import RESERVED, check_kwargs, policy_kwargs
 
     algo_cls = _algorithms()[cfg["algo"]]
@@ -383,15 +420,28 @@ def validate_config(cfg: dict[str, Any]) -> None:
     policy_kwargs(algo_cls, cfg.get("policy", "MlpPolicy"), hp.get("policy_kwargs"))
 
 
+def _check_elgamal_evaluation(cfg: dict[str, Any]) -> None:
+    """The final evaluation's ElGamal episodes (``eval.elgamal``) resolved now, not after training."""
+    from .evaluate import elgamal_config
+
+    el = (cfg.get("eval") or {}).get("elgamal") or {}
+    if not el.get("episodes"):
+        return
+    try:
+        resolve_params(elgamal_config(env_config(cfg), int(el["max_samples"]), key_length=int(el["key_length"]), crypto_seed=0))
+    except EncctlError as exc:
+        raise ConfigError(f"eval.elgamal (max_samples = {format_value(el['max_samples'])}, key_length = "
+                          f"{format_value(el['key_length'])}): {exc}") from None
+
+
 # --------------------------------------------------------------------------- overrides
 def _yaml_value(text: str) -> Any:
     """A YAML value, with ``1e-3``-style floats (strings to YAML 1.1) read as floats."""
     try:
-        if any(isinstance(tok, yaml.AliasToken) for tok in yaml.scan(text)):
-            raise ConfigError(f"override value {text!r} uses a YAML alias")
+        _check_yaml_tokens(text, f"override value {format_value(text)}")
         v = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise ConfigError(f"override value {text!r} is not valid YAML: {str(exc).splitlines()[0]}") from exc
+    except (ValueError, yaml.YAMLError) as exc:  # ValueError: an integer of over 4300 digits
+        raise ConfigError(f"override value {format_value(text)} is not valid YAML: {format_value(str(exc).splitlines()[0])}") from None
     if isinstance(v, str):
         try:
             return float(v)

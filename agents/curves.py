@@ -175,19 +175,25 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
     import matplotlib.pyplot as plt
 
     cs = [c if isinstance(c, LearningCurve) else load_learning_curve(c) for c in curves]
+    # a run given by its directory (or its .npz) is named by the directory: two runs of one
+    # algorithm, system and seed (other settings) stay apart in the legend
+    names = [None if isinstance(c, LearningCurve) else (Path(c).parent if Path(c).suffix == ".npz" else Path(c)).name
+             for c in curves]
     if not cs:
         raise ConfigError("no learning curve to plot")
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     groups = list(dict.fromkeys((c.algo, c.system, c.design_kind) for c in cs))
-    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    fig, ax = plt.subplots(figsize=(11.5, 4.8))
     styles = ("-", "--", "-.", ":")
-    for c in cs:
-        g = groups.index((c.algo, c.system, c.design_kind))
-        seeds = [d.seed for d in cs if (d.algo, d.system, d.design_kind) == (c.algo, c.system, c.design_kind)]
+    for i, (c, name) in enumerate(zip(cs, names)):
+        key = (c.algo, c.system, c.design_kind)
+        g = groups.index(key)
+        within = [j for j, d in enumerate(cs) if (d.algo, d.system, d.design_kind) == key].index(i)
         r, lo, hi = c.ratio()
         col = colors[g % len(colors)]
-        ax.plot(c.timesteps, r, color=col, ls=styles[seeds.index(c.seed) % len(styles)], marker="o", ms=3, lw=1.4,
-                label=f"{c.algo}, {c.system}, seed {c.seed} (N = {c.N}, {c.epsilon.shape[1]} episodes)")
+        ax.plot(c.timesteps, r, color=col, ls=styles[within % len(styles)], marker="o", ms=3, lw=1.4,
+                label=(f"{name}: " if name else "") + f"{c.algo}, {c.system}, {c.design_kind}, seed {c.seed} "
+                f"(N = {c.N}, {c.epsilon.shape[1]} episodes)")
         if np.all(np.isfinite(lo)):
             ax.fill_between(c.timesteps, lo, hi, color=col, alpha=0.15, lw=0)
     for system in dict.fromkeys((c.system, c.design_kind, c.N) for c in cs):
@@ -198,13 +204,23 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
                    label=f"{ref.system}, {ref.design_kind}: Gaussian attack, exact rate / gamma_opt(N)")
     ax.axhline(1.0, color="k", lw=1.0, label="1: the optimal design (gamma_opt, same power)")
     ax.set_xlabel("training steps")
+    # the interesting range is near 1: a policy that starts at zero input (ARS) has an error many
+    # orders above the optimum at first, and those points are cut at the top (said in the plot)
+    refs = [c.gamma_gauss / c.gamma_opt for c in cs] + [c.gamma / c.gamma_opt for c in cs]
+    top = max(2.0, 1.3 * max(refs))
+    peak = max(float(np.nanmax(c.ratio()[0])) for c in cs)
+    if peak > top:
+        low = min(0.9, min(float(np.nanmin(c.ratio()[0])) for c in cs) * 0.97)
+        ax.set_ylim(low, top)
+        ax.text(0.5, 0.98, f"cut at {top:.2g}: early evaluations up to {peak:.3g}", transform=ax.transAxes,
+                fontsize=7, va="top", ha="center")
     ax.set_ylabel("E[eps(N)] / gamma_opt(N)  (evaluation episodes)")
     ax.set_title(title or "Learning curves: evaluation error over the optimum", fontsize=10)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return path
 

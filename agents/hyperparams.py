@@ -26,9 +26,10 @@ import types
 import typing
 from typing import Any
 
+from encctl_gym._validation import format_value
 from encctl_gym.errors import ConfigError
 
-__all__ = ["ACTIVATIONS", "RESERVED", "SCHEDULED", "type_hints", "check_value", "check_kwargs", "policy_kwargs",
+__all__ = ["ACTIVATIONS", "RESERVED", "SCHEDULED", "INT64_MAX", "type_hints", "check_value", "check_kwargs", "network_bytes", "policy_kwargs",
            "parse_schedule", "make_schedules"]
 
 #: ``activation_fn`` names accepted in configs -> ``torch.nn`` class names.
@@ -44,6 +45,8 @@ _POSITIVE_INT = frozenset({"n_steps", "batch_size", "n_epochs", "buffer_size", "
                            "target_update_interval", "policy_delay", "lstm_hidden_size", "n_lstm_layers",
                            "n_delta", "n_top", "n_eval_episodes"})
 _UNIT_INTERVAL = frozenset({"gamma", "gae_lambda", "tau"})
+#: Largest integer hyperparameter (sizes and counts are int64 in PyTorch and NumPy).
+INT64_MAX = 2**63 - 1
 #: Hyperparameters that accept a schedule, given in a config as ``lin_<value>``.
 SCHEDULED = frozenset({"learning_rate", "clip_range", "delta_std"})
 
@@ -148,19 +151,38 @@ def _matches(value: Any, ann: Any) -> bool:
     return False  # classes, callables, objects: not expressible in a config
 
 
+def _outside_int64(value: Any) -> int | None:
+    """The first integer in ``value`` (nested lists, tuples and mappings) beyond :data:`INT64_MAX`."""
+    stack = [value]
+    while stack:
+        v = stack.pop()
+        if isinstance(v, numbers.Integral) and not isinstance(v, bool) and abs(int(v)) > INT64_MAX:
+            return int(v)
+        if isinstance(v, (list, tuple)):
+            stack.extend(v)
+        elif isinstance(v, dict):
+            stack.extend(v.values())
+    return None
+
+
 def check_value(name: str, value: Any, annotation: Any) -> Any:
     """Check one value against its annotation and the domain rules; return it (tuples from lists).
 
     Raises
     ------
     ConfigError
-        Naming ``name``, the value and the expected type.
+        Naming ``name``, the value and the expected type; also for an integer beyond
+        :data:`INT64_MAX` (a 401-digit ``batch_size`` is never a batch size).
     """
     leaf = name.rsplit(".", 1)[-1]
     if leaf in SCHEDULED and parse_schedule(name, value) is not None:
         return value
     if not _matches(value, annotation):
-        raise ConfigError(f"{name}={value!r} does not fit its type {_describe(annotation)}")
+        raise ConfigError(f"{name}={format_value(value)} does not fit its type {_describe(annotation)}")
+    big = _outside_int64(value)
+    if big is not None:
+        raise ConfigError(f"{name} holds the integer {format_value(big)}, outside the 64-bit range (|v| <= {INT64_MAX}) that "
+                          "PyTorch and NumPy count in")
     if leaf in _POSITIVE_INT and value is not None and value < 1:
         raise ConfigError(f"{name} must be >= 1, got {value!r}")
     if leaf in _UNIT_INTERVAL and not 0.0 < float(value) <= 1.0:
@@ -212,6 +234,25 @@ def check_kwargs(where: str, kwargs: dict[str, Any], fn: Any, reserved: frozense
             raise ConfigError(f"unknown {where} key {key!r} for {owner}; known: {known}")
         out[key] = check_value(f"{where}.{key}", value, hints.get(key, Any))
     return out
+
+
+def network_bytes(net_arch: Any, n_in: int, n_out: int) -> int:
+    """Estimated bytes of the policy networks of ``net_arch`` while training (an upper estimate).
+
+    Every network of ``net_arch`` (a list: one actor and one critic of those layer sizes; a
+    mapping such as ``{pi: [...], vf: [...]}``: one per entry) maps ``n_in`` inputs through its
+    layers to ``n_out`` outputs. Each weight is counted 32 times in float32: the parameters,
+    their gradients and Adam's two moments (16 bytes), twice for the critics' copies and targets
+    of the off-policy algorithms.
+    """
+    if net_arch is None:
+        return 0
+    nets = [net_arch, net_arch] if isinstance(net_arch, (list, tuple)) else list(dict(net_arch).values())
+    weights = 0
+    for layers in nets:
+        sizes = [int(n_in), *(int(v) for v in layers), int(n_out)]
+        weights += sum((a + 1) * b for a, b in zip(sizes[:-1], sizes[1:]))
+    return 32 * weights
 
 
 def policy_kwargs(algo_cls: type, policy: str, kwargs: dict[str, Any] | None) -> dict[str, Any]:

@@ -26,16 +26,20 @@ from __future__ import annotations
 
 import json
 import shutil
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Sequence
 
+from encctl_gym._validation import format_value
 from encctl_gym.errors import ConfigError
 
-__all__ = ["RUN_FILE", "RunInfo", "read_run", "find_runs", "new_run_dir"]
+__all__ = ["RUN_FILE", "MAX_RUN_FILE_BYTES", "RunInfo", "read_run", "check_model_file", "find_runs", "new_run_dir", "check_output_dir"]
 
 #: The metadata file that makes a directory a training run.
 RUN_FILE = "run.json"
+#: Largest ``run.json`` read (bytes); one written by ``train`` takes a few kilobytes.
+MAX_RUN_FILE_BYTES = 16 * 2**20
 
 #: Model files by the name ``which`` selects them with.
 MODEL_FILES = {"final": "model.zip", "best": "best_model.zip"}
@@ -94,7 +98,27 @@ class RunInfo:
         p = self.path / MODEL_FILES[which]
         if not p.is_file():
             raise ConfigError(f"no {MODEL_FILES[which]} in {self.path}")
+        check_model_file(p)
         return p
+
+
+def check_model_file(path: str | Path) -> None:
+    """Check, without unpickling anything, that ``path`` is a model archive as stable-baselines3
+    saves it (a readable zip file holding the ``data`` member).
+
+    Raises
+    ------
+    ConfigError
+        For a file that is not a zip archive, a damaged one, or one without ``data``.
+    """
+    p = Path(path)
+    try:
+        with zipfile.ZipFile(p) as archive:
+            names = archive.namelist()
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
+        raise ConfigError(f"cannot load {p}: not a readable model archive (a zip file): {format_value(str(exc))}") from None
+    if "data" not in names:
+        raise ConfigError(f"cannot load {p}: not a stable-baselines3 model archive (no 'data' member among {format_value(names)})")
 
 
 def read_run(run_dir: str | Path) -> RunInfo:
@@ -112,17 +136,23 @@ def read_run(run_dir: str | Path) -> RunInfo:
     Raises
     ------
     ConfigError
-        If the directory or its ``run.json`` is missing, is not valid JSON, or lacks a field
-        (``algo``, ``observation``, ``env``) or has one of the wrong type.
+        If the directory or its ``run.json`` is missing, larger than :data:`MAX_RUN_FILE_BYTES`,
+        is not valid JSON (including integers of over 4300 digits and nesting deeper than
+        Python's recursion limit), or lacks a field (``algo``, ``observation``, ``env``) or has
+        one of the wrong type.
     """
     path = Path(run_dir)
     meta_path = path / RUN_FILE
     if not meta_path.is_file():
         raise ConfigError(f"{str(path)!r} is not a training run (no {RUN_FILE})")
+    size = meta_path.stat().st_size
+    if size > MAX_RUN_FILE_BYTES:
+        raise ConfigError(f"{meta_path} has {size} bytes; a {RUN_FILE} has at most {MAX_RUN_FILE_BYTES}")
     try:
         meta = json.loads(meta_path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ConfigError(f"cannot read {meta_path}: {exc}") from exc
+    except (OSError, ValueError, RecursionError) as exc:  # ValueError: bad JSON, bad UTF-8, an integer of over 4300 digits
+        what = "nests too deeply" if isinstance(exc, RecursionError) else format_value(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+        raise ConfigError(f"cannot read {meta_path}: {what}") from None
     if not isinstance(meta, dict):
         raise ConfigError(f"{meta_path} must hold a JSON object, got {type(meta).__name__}")
     for key, typ in (("algo", str), ("observation", str), ("env", dict)):
@@ -190,12 +220,14 @@ def new_run_dir(parent: str | Path, name: str, *, overwrite: bool = False) -> Pa
     Raises
     ------
     ConfigError
-        If ``name`` is not a plain directory name, or ``overwrite`` is asked for a directory
-        that holds files but no run (it is not deleted).
+        If ``name`` is not a plain directory name, ``parent`` exists but is not a directory or
+        cannot be created, or ``overwrite`` is asked for a directory that holds files but no run
+        (it is not deleted).
     """
     if not name or Path(name).name != name or name in (".", ".."):
         raise ConfigError(f"run name must be a plain directory name, got {name!r}")
     parent = Path(parent)
+    check_output_dir(parent, "the runs directory (--out)")
     target = parent / name
     if target.exists() and overwrite:
         if not target.is_dir():
@@ -209,5 +241,26 @@ def new_run_dir(parent: str | Path, name: str, *, overwrite: bool = False) -> Pa
         while (parent / f"{name}-{i}").exists():
             i += 1
         target = parent / f"{name}-{i}"
-    target.mkdir(parents=True, exist_ok=True)
+    try:
+        target.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"cannot create the run directory {str(target)!r}: {exc.strerror or exc}") from None
     return target
+
+
+def check_output_dir(path: str | Path, what: str = "the output directory") -> Path:
+    """Create the directory ``path`` (with its parents) if needed, before any work is done.
+
+    Raises
+    ------
+    ConfigError
+        If ``path`` or one of its parents is a file, or the directory cannot be created.
+    """
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise ConfigError(f"{what} {str(p)!r} exists and is not a directory")
+    try:
+        p.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"cannot create {what} {str(p)!r}: {exc.strerror or exc}") from None
+    return p

@@ -36,12 +36,14 @@ from typing import Any, Callable
 
 import numpy as np
 
+from encctl_gym._validation import format_value
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ConfigError
+from encctl_gym.resources import check_memory
 
 from .config import CONFIG_DIR, apply_override, env_config, load_config, run_name, validate_config
 from .curves import CURVE_FILE, curve_for, plot_learning_curves
-from .hyperparams import make_schedules, policy_kwargs
+from .hyperparams import make_schedules, network_bytes, policy_kwargs
 from .runs import RUN_FILE, new_run_dir, read_run
 from .sb3 import ALGORITHMS, SB3VecEnv, algorithm_class, load_attacker
 
@@ -104,7 +106,11 @@ def train(
     Raises
     ------
     ConfigError
-        A configuration entry rejected by the checks or by the algorithm's constructor.
+        A configuration entry rejected by the checks or by the algorithm's constructor, or
+        networks PyTorch cannot allocate.
+    ResourceLimitError
+        Policy networks estimated above :data:`encctl_gym.resources.MEMORY_LIMIT`
+        (:func:`agents.hyperparams.network_bytes`), refused before they are built.
     """
     import torch
     from stable_baselines3.common.callbacks import CallbackList
@@ -130,10 +136,19 @@ def train(
     if hasattr(eval_env, "training"):
         eval_env.training = False
         eval_env.norm_reward = False
+    n_in = int(np.prod(env.observation_space.shape))
+    n_out = int(np.prod(env.action_space.shape))
+    net_arch = (cfg["hyperparams"].get("policy_kwargs") or {}).get("net_arch")
+    check_memory(f"training the policy networks of net_arch = {format_value(net_arch)} ({n_in} inputs, {n_out} outputs)",
+                 network_bytes(net_arch, n_in, n_out), advice="use smaller layers (hyperparams.policy_kwargs.net_arch)")
     try:
         model = algo_cls(cfg["policy"], env, seed=seed, verbose=verbose, device="cpu", **hp)
     except (AssertionError, ValueError, TypeError) as exc:  # stable-baselines3's own checks of the values
-        raise ConfigError(f"{cfg['algo']} rejected the hyperparameters {cfg['hyperparams']}: {exc}") from exc
+        raise ConfigError(f"{cfg['algo']} rejected the hyperparameters {format_value(cfg['hyperparams'])}: {exc}") from exc
+    except (RuntimeError, MemoryError) as exc:  # PyTorch could not allocate the networks
+        first = str(exc).strip().splitlines()
+        raise ConfigError(f"{cfg['algo']} could not build its model with the hyperparameters {format_value(cfg['hyperparams'])}: "
+                          f"{type(exc).__name__}: {format_value(first[0] if first else '')}") from None
     run_dir = new_run_dir(out, name or run_name(cfg, seed), overwrite=overwrite)
     model.tensorboard_log = str(run_dir / "tb") if tensorboard else None
     meta: dict[str, Any] = {
@@ -273,7 +288,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--no-tensorboard", action="store_true", help="no TensorBoard logs")
     parser.add_argument("--no-final-eval", action="store_true", help="skip the final evaluation (ideal and ElGamal)")
-    parser.add_argument("--verbose", type=int, default=0, help="stable-baselines3 verbosity (0, 1, 2)")
+    parser.add_argument("--verbose", type=int, default=0, choices=(0, 1, 2), help="stable-baselines3 verbosity (0, 1, 2)")
 
 
 def run(args: argparse.Namespace) -> int:

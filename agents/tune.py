@@ -38,9 +38,11 @@ from typing import Any, Callable
 import numpy as np
 import yaml
 
+from encctl_gym._validation import format_value
 from encctl_gym.errors import ConfigError, EncctlError
 
-from .config import CONFIG_DIR, apply_override, load_config
+from .config import CONFIG_DIR, MAX_STEPS, apply_override, load_config
+from .runs import check_output_dir
 from .sb3 import ALGORITHMS  # the [rl] extra: without it the CLI says which extra to install
 
 __all__ = ["SEARCH_SPACES", "TUNED_KEYS", "objective_ratio", "tuned_config", "tune", "add_arguments", "run"]
@@ -209,8 +211,7 @@ def tune(
     algo = cfg["algo"]
     if algo not in SEARCH_SPACES:
         raise ConfigError(f"no search space for algorithm {algo!r}; tunable: {', '.join(SEARCH_SPACES)}")
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = check_output_dir(out, "the tuning directory (--out)")
     name = study_name or f"{algo}_{cfg['system']}"
     url = storage or f"sqlite:///{(out / 'study.db').resolve()}"
     optuna.logging.set_verbosity(optuna.logging.WARNING)
@@ -284,11 +285,13 @@ def run(args: argparse.Namespace) -> int:
     """Tune; print the best trial and where its configuration went."""
     for flag, value, minimum in (("trials", args.trials, 1), ("episodes", args.episodes, 2)):
         if value < minimum:
-            raise ConfigError(f"--{flag} must be >= {minimum}, got {value}")
+            raise ConfigError(f"--{flag} must be >= {minimum}, got {format_value(value)}")
+        if value > MAX_STEPS:
+            raise ConfigError(f"--{flag} must be <= {MAX_STEPS}, got {format_value(value)}")
     if args.save_config and not args.preset:
         raise ConfigError("--save-config writes agents/configs/{algo}_{preset}.yaml and needs --preset")
     cfg = load_config(args.algo, args.preset, path=args.config, system=args.system, quick=args.quick)
-    cfg["seed"] = int(args.seed)
+    apply_override(cfg, f"seed={args.seed}")  # checked like any seed (0 <= seed <= MAX_SEED)
     if args.n_timesteps is not None:
         apply_override(cfg, f"n_timesteps={args.n_timesteps}")
     for item in args.overrides:

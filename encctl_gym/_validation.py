@@ -60,7 +60,8 @@ def format_value(value: Any, limit: int = 120) -> str:
     Integers of more than about 36 digits are shown by their size (``<integer of 1329 bits,
     about 401 digits>``: Python refuses ``str`` of integers over 4300 digits, and a message
     must never fail); strings and reprs are cut at ``limit`` characters; arrays and sequences
-    show their shape or length and a few entries.
+    show their shape or length and a few entries; the text is one line (a matrix's rows are
+    joined), so that the command line's one-line error stays one line.
 
     Parameters
     ----------
@@ -90,9 +91,10 @@ def format_value(value: Any, limit: int = 120) -> str:
             return repr(bytes(value[:limit])) + (f"... ({len(value)} bytes)" if len(value) > limit else "")
         if isinstance(value, np.ndarray):
             if value.dtype.kind in "biufc" and value.size <= 6:
-                return f"array({np.array2string(value, threshold=6, edgeitems=2, separator=', ')}, dtype={value.dtype})"
+                body = _one_line(np.array2string(value, threshold=6, edgeitems=2, separator=", "))
+                return f"array({body}, dtype={value.dtype})"
             if value.dtype.kind in "biufc":
-                body = np.array2string(value.ravel()[:_MAX_ITEMS_SHOWN], separator=", ")
+                body = _one_line(np.array2string(value.ravel()[:_MAX_ITEMS_SHOWN], separator=", "))
                 return f"<array of shape {value.shape}, dtype {value.dtype}, first entries {body[:limit]}>"
             return f"<array of shape {value.shape}, dtype {value.dtype}>"
         if isinstance(value, (list, tuple)):
@@ -105,10 +107,18 @@ def format_value(value: Any, limit: int = 120) -> str:
             items = ", ".join(f"{format_value(k, limit // 4)}: {format_value(value[k], limit // 2)}" for k in keys)
             more = f", ... ({len(value)} keys)" if len(value) > _MAX_ITEMS_SHOWN else ""
             return "{" + items + more + "}"
-        text = repr(value)
+        text = _one_line(repr(value))
     except Exception:  # noqa: BLE001 - a repr that fails must not hide the real error
         return f"<{type(value).__name__} object>"
     return text if len(text) <= limit else text[:limit] + f"... ({len(text)} characters)"
+
+
+def _one_line(text: str) -> str:
+    """``text`` with its line breaks and the indentation after them folded into single spaces
+    (NumPy prints a matrix on several lines; an error message is one line)."""
+    if "\n" not in text and "\r" not in text:
+        return text
+    return " ".join(part.strip() for part in text.replace("\r", "\n").split("\n") if part.strip())
 
 
 def _as_float(name: str, value: Any) -> float:

@@ -48,6 +48,12 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
+def one_line(message: str) -> str:
+    """``message`` on one line: its lines joined by spaces (an array's repr in a message spans
+    several lines; the command line prints every error as one)."""
+    return " ".join(part.strip() for part in message.splitlines() if part.strip())
+
+
 def build_parser(selected: str | None = None) -> argparse.ArgumentParser:
     """The argument parser; only the ``selected`` subcommand's module is imported (so that, e.g.,
     ``design`` does not load torch)."""
@@ -93,7 +99,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args._run(args) or 0)
     except EncctlError as exc:
-        print(f"encctl-gym {args.command}: error: {exc}", file=sys.stderr)
+        print(f"encctl-gym {args.command}: error: {one_line(str(exc))}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("encctl-gym: interrupted", file=sys.stderr)

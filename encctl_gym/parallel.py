@@ -25,15 +25,16 @@ from __future__ import annotations
 
 import contextlib
 import logging
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from typing import Any, TypeVar
 
 import numpy as np
 
-from ._validation import check_int
+from ._validation import check_int, format_value
 from .errors import ConfigError, ParameterError
+from .resources import check_memory
 
-__all__ = ["SeedLike", "as_seed_sequence", "child_seeds", "run_tasks"]
+__all__ = ["SeedLike", "as_seed_sequence", "child_seeds", "check_n_jobs", "check_scheduler", "run_tasks"]
 
 SeedLike = int | np.integer | np.random.SeedSequence
 """An integer seed or a :class:`numpy.random.SeedSequence`."""
@@ -54,6 +55,42 @@ def as_seed_sequence(seed: SeedLike) -> np.random.SeedSequence:
     if isinstance(seed, np.random.SeedSequence):
         return seed
     return np.random.SeedSequence(check_int("seed", seed, minimum=0))
+
+
+#: Bytes one child :class:`numpy.random.SeedSequence` takes (measured: about 370; rounded up).
+SEED_BYTES = 512
+
+
+def check_n_jobs(n_jobs: Any) -> int:
+    """``n_jobs`` of :func:`run_tasks`: ``-1`` (all cores) or a count ``>= 1``.
+
+    Raises
+    ------
+    ParameterError
+        For anything else (0, -5, 2.5, a string, a bool).
+    """
+    n_jobs = check_int("n_jobs", n_jobs)
+    if n_jobs == 0 or n_jobs < -1:
+        raise ParameterError(f"n_jobs must be -1 (all cores) or >= 1, got {format_value(n_jobs)}")
+    return n_jobs
+
+
+def check_scheduler(scheduler: Any) -> Any:
+    """A ``scheduler`` given by name (the command line's ``--scheduler``), checked before any work:
+    ``None``, ``"local"`` or a Dask scheduler address (``"tcp://host:8786"``: a string with
+    ``://``); any other object is passed through (:func:`run_tasks` accepts a
+    ``distributed.Client`` and refuses the rest when it uses it).
+
+    Raises
+    ------
+    ParameterError
+        For a string that is neither ``"local"`` nor an address.
+    """
+    if isinstance(scheduler, str) and scheduler != "local" and "://" not in scheduler:
+        raise ParameterError(
+            f"scheduler must be 'local' or a Dask scheduler address like 'tcp://host:8786', got {format_value(scheduler)}"
+        )
+    return scheduler
 
 
 #: How long to wait for a remote Dask scheduler before giving up.
@@ -82,6 +119,7 @@ def child_seeds(seed: SeedLike, n: int) -> list[np.random.SeedSequence]:
     """
     ss = as_seed_sequence(seed)
     n = check_int("n", n, minimum=0)
+    check_memory(f"n = {format_value(n)} child seeds", SEED_BYTES * n, advice="spawn fewer children")
     return [np.random.SeedSequence(ss.entropy, spawn_key=(*ss.spawn_key, i), pool_size=ss.pool_size) for i in range(n)]
 
 
@@ -126,7 +164,7 @@ def _dask_client(scheduler: Any, n_jobs: int, cluster_kwargs: dict[str, Any] | N
         return
     raise ParameterError(
         f"scheduler must be None, 'local', a Dask scheduler address like 'tcp://host:8786' "
-        f"or a distributed.Client, got {scheduler!r}"
+        f"or a distributed.Client, got {format_value(scheduler)}"
     )
 
 
@@ -186,12 +224,15 @@ def run_tasks(
     import joblib
     from tqdm.auto import tqdm
 
+    if not callable(func):
+        raise ParameterError(f"func must be a function of a task and a seed, got {format_value(func)}")
+    if isinstance(tasks, (str, bytes)) or not isinstance(tasks, Iterable):
+        raise ParameterError(f"tasks must be a sequence of task descriptions, got {format_value(tasks)}")
     tasks = list(tasks)
-    n_jobs = check_int("n_jobs", n_jobs)
-    if n_jobs == 0 or n_jobs < -1:
-        raise ParameterError(f"n_jobs must be -1 or >= 1, got {n_jobs}")
+    n_jobs = check_n_jobs(n_jobs)
+    scheduler = check_scheduler(scheduler)
     if backend not in ("loky", "threading", "multiprocessing"):
-        raise ParameterError(f"backend must be 'loky', 'threading' or 'multiprocessing', got {backend!r}")
+        raise ParameterError(f"backend must be 'loky', 'threading' or 'multiprocessing', got {format_value(backend)}")
     seeds = child_seeds(seed, len(tasks))
     bar = tqdm(total=len(tasks), desc=desc, disable=not progress, leave=False)
     results: list[R] = []

@@ -5,21 +5,60 @@ much with :class:`~encctl_gym.errors.ResourceLimitError`, naming the estimate: t
 arrays here (:func:`check_memory`), the residue table in its own module
 (:func:`encctl_gym.crypto.residue_table.residue_table_bytes`). A bad value is a clear error,
 never a process killed for memory.
+
+The default bound is :data:`MEMORY_LIMIT`, lowered to the address space the process may still
+map when it runs under a limit (``ulimit -v``, ``RLIMIT_AS``: :func:`memory_headroom`), so an
+allocation that would end in ``MemoryError`` is refused with its estimate instead.
 """
 
 from __future__ import annotations
 
+import resource
+from pathlib import Path
+
 from ._validation import check_int
 from .errors import ResourceLimitError
 
-__all__ = ["MEMORY_LIMIT", "check_memory"]
+__all__ = ["MEMORY_LIMIT", "check_memory", "memory_headroom", "default_memory_limit"]
 
 #: Default largest allocation (bytes) of one structure; pass ``limit`` to allow more.
 MEMORY_LIMIT = 8 * 2**30
 
 
+def memory_headroom() -> int | None:
+    """Bytes of address space this process may still map under its ``RLIMIT_AS`` soft limit
+    (``None`` when there is no such limit, or it cannot be read)."""
+    try:
+        soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    except (OSError, ValueError):  # pragma: no cover - platforms without RLIMIT_AS
+        return None
+    if soft == resource.RLIM_INFINITY:
+        return None
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmSize:"):
+                return max(0, soft - int(line.split()[1]) * 1024)
+    except OSError:  # pragma: no cover - no /proc
+        return None
+    return None  # pragma: no cover
+
+
+def default_memory_limit() -> int:
+    """:data:`MEMORY_LIMIT`, or less when :func:`memory_headroom` is smaller."""
+    room = memory_headroom()
+    return MEMORY_LIMIT if room is None else min(MEMORY_LIMIT, room)
+
+
+def _gib(n: int) -> str:
+    try:
+        return f"{n / 2**30:.3g}"
+    except OverflowError:  # an estimate beyond the float range (a count of 10**400)
+        return f"10^{int(n.bit_length() * 0.30103) - 9}"
+
+
 def check_memory(what: str, need: int, limit: int | None = None, advice: str = "") -> None:
-    """Raise :class:`ResourceLimitError` if ``need`` bytes exceed ``limit`` (default :data:`MEMORY_LIMIT`).
+    """Raise :class:`ResourceLimitError` if ``need`` bytes exceed ``limit`` (default
+    :func:`default_memory_limit`: :data:`MEMORY_LIMIT`, or the address space left under a limit).
 
     Parameters
     ----------
@@ -32,7 +71,11 @@ def check_memory(what: str, need: int, limit: int | None = None, advice: str = "
     advice : str
         How to make it smaller (appended to the message).
     """
-    cap = MEMORY_LIMIT if limit is None else check_int("memory_limit", limit, minimum=1)
+    if limit is None:
+        cap = default_memory_limit()
+        which = "memory_limit" if cap == MEMORY_LIMIT else "the address space left under this process's limit"
+    else:
+        cap, which = check_int("memory_limit", limit, minimum=1), "memory_limit"
     if need > cap:
-        msg = f"{what} needs about {need / 2**30:.3g} GiB, above the limit of {cap / 2**30:.3g} GiB (memory_limit)"
+        msg = f"{what} needs about {_gib(need)} GiB, above the limit of {_gib(cap)} GiB ({which})"
         raise ResourceLimitError(msg + (f"; {advice}" if advice else ""))

@@ -190,14 +190,57 @@ def read_csv(path: str | os.PathLike[str]) -> Table:
     return Table(cols)
 
 
+def _checked(check: Callable[[str], Any], what: str) -> Callable[[str], Any]:
+    """An argparse ``type`` that runs ``check`` on the option's text and reports its package
+    error as argparse's one-line usage error (not argparse's generic "invalid value")."""
+
+    def convert(text: str) -> Any:
+        try:
+            return check(text)
+        except ParameterError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    convert.__name__ = what
+    return convert
+
+
+def _seed(text: str) -> int:
+    from encctl_gym._validation import check_int
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise ParameterError(f"--seed must be a non-negative integer, got {text[:40]!r}") from None
+    return check_int("--seed", value, minimum=0)
+
+
+def _n_jobs(text: str) -> int:
+    from encctl_gym.parallel import check_n_jobs
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise ParameterError(f"--n-jobs must be -1 (all cores) or a count >= 1, got {text[:40]!r}") from None
+    return check_n_jobs(value)
+
+
+def _scheduler(text: str) -> str:
+    from encctl_gym.parallel import check_scheduler
+
+    return str(check_scheduler(text))
+
+
 def add_common_arguments(parser: argparse.ArgumentParser) -> None:
-    """The options every reproduction script shares."""
+    """The options every reproduction script shares (``--seed``, ``--n-jobs`` and ``--scheduler``
+    are checked as they are parsed: a bad value is a one-line usage error, before any work)."""
     parser.add_argument("--out", default="results", help="output directory (default: results/)")
     parser.add_argument("--quick", action="store_true", help="small grid and few runs: a smoke test of a few seconds")
-    parser.add_argument("--seed", type=int, default=0, help="master seed (default: 0)")
-    parser.add_argument("--n-jobs", type=int, default=-1, help="worker processes (-1: all cores; 1: serial)")
+    parser.add_argument("--seed", type=_checked(_seed, "seed"), default=0, help="master seed, an integer >= 0 (default: 0)")
     parser.add_argument(
-        "--scheduler", default=None,
+        "--n-jobs", type=_checked(_n_jobs, "n_jobs"), default=-1, help="worker processes (-1: all cores; 1: serial)"
+    )
+    parser.add_argument(
+        "--scheduler", type=_checked(_scheduler, "scheduler"), default=None,
         help="Dask scheduler: 'local' (start a LocalCluster) or an address like tcp://host:8786 "
         "(default: joblib processes on this machine; needs encctl-gym[dask])",
     )
@@ -358,13 +401,14 @@ def script_main(
     argv: Sequence[str] | None = None,
 ) -> int:
     """``main`` of an experiment script: parse, run, and print a package error as one line (exit 2)."""
+    from encctl_gym.cli import OneLineParser, one_line
     from encctl_gym.errors import EncctlError
 
-    parser = argparse.ArgumentParser(description=(doc or "").strip().splitlines()[0])
+    parser = OneLineParser(description=(doc or "").strip().splitlines()[0])
     add_arguments(parser)
     args = parser.parse_args(argv)
     try:
         return run(args)
     except EncctlError as exc:
-        print(f"{name}: error: {exc}", file=sys.stderr)
+        print(f"{name}: error: {one_line(str(exc))}", file=sys.stderr)
         return 2

@@ -277,3 +277,171 @@ def test_corrupt_or_missing_model_is_a_config_error(tmp_path, capsys):
     meta["algo"] = "dqn"
     d = _run_dir(tmp_path, meta)
     _one_line_error(capsys, ["evaluate", str(d)], "unknown algorithm 'dqn'")
+
+
+# ------------------------------------------------------------------ hardening (issue 16)
+def _depth(v: object) -> int:
+    return 1 + max((_depth(x) for x in v), default=0) if isinstance(v, list) else 0
+
+
+def test_nesting_is_bounded_before_yaml_builds_anything(tmp_path):
+    from agents.config import MAX_CONFIG_DEPTH
+
+    ok = tmp_path / "ok.yaml"  # the top-level mapping is one level, the flow lists the others
+    ok.write_text("x: " + "[" * (MAX_CONFIG_DEPTH - 1) + "]" * (MAX_CONFIG_DEPTH - 1) + "\n")
+    assert _depth(read_yaml(ok)["x"]) == MAX_CONFIG_DEPTH - 1
+    deep = tmp_path / "deep.yaml"
+    deep.write_text("x: " + "[" * MAX_CONFIG_DEPTH + "]" * MAX_CONFIG_DEPTH + "\n")
+    with pytest.raises(ConfigError, match=f"more than {MAX_CONFIG_DEPTH} levels"):
+        read_yaml(deep)
+    bomb = tmp_path / "bomb.yaml"  # deeper than Python's recursion limit
+    bomb.write_text("x: " + "[" * 100_000 + "]" * 100_000 + "\n")
+    with pytest.raises(ConfigError, match="levels deep") as exc:
+        read_yaml(bomb)
+    assert "\n" not in str(exc.value)
+    cfg = load_config("ppo", "small", quick=True)
+    with pytest.raises(ConfigError, match="override value"):
+        apply_override(cfg, "hyperparams.policy_kwargs.net_arch=" + "[" * 5000 + "]" * 5000)
+
+
+def test_integers_of_more_than_4300_digits_are_one_config_error(tmp_path):
+    f = tmp_path / "digits.yaml"
+    f.write_text("n_envs: " + "9" * 5000 + "\n")
+    with pytest.raises(ConfigError, match="cannot read config file") as exc:
+        read_yaml(f)
+    assert len(str(exc.value)) < 500
+    with pytest.raises(ConfigError, match="override value"):
+        apply_override(load_config("ppo", "small", quick=True), "seed=" + "9" * 5000)
+
+
+@pytest.mark.parametrize(
+    "key, largest",
+    [("n_timesteps", 2**53), ("eval.freq", 2**53), ("horizon", 2**53), ("n_envs", 2**53), ("eval.final_episodes", 2**53),
+     ("seed", 2**32 - 1), ("eval.seed", 2**32 - 1)],
+)
+def test_counts_and_seeds_have_an_upper_bound(key, largest):
+    from agents.config import SCHEMA
+
+    rule = SCHEMA
+    for part in key.split("."):
+        rule = rule[part]
+    assert rule(key, largest) == largest  # the largest value passes the entry's check
+    with pytest.raises(ConfigError, match=f"{key} must be <= {largest}, got {largest + 1}"):
+        rule(key, largest + 1)
+    with pytest.raises(ConfigError, match="integer of 1333 bits"):  # named by its size, never printed in full
+        apply_override(load_config("ppo", "small", quick=True), f"{key}={'9' * 401}")
+
+
+def test_a_seed_numpy_cannot_take_is_refused_in_one_line(capsys, tmp_path):
+    np.random.seed(2**32 - 1)  # the largest seed is one NumPy's global generator (seeded by stable-baselines3) takes
+    with pytest.raises(ValueError):
+        np.random.seed(2**32)
+    out = str(tmp_path / "o")
+    _one_line_error(capsys, ["train", "--algo", "ppo", "--preset", "small", "--quick", "--out", out, "--seed", str(2**32)],
+                    "seed must be <= 4294967295, got 4294967296")
+    _one_line_error(capsys, ["train", "--algo", "ppo", "--preset", "small", "--quick", "--out", out, "--n-timesteps", "9" * 401],
+                    "n_timesteps must be <= 9007199254740992")
+    with pytest.raises(SystemExit) as exc:  # argparse's own error, one line through the CLI's parser
+        cli.main(["train", "--algo", "ppo", "--preset", "small", "--quick", "--out", out, "--verbose", "7"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert exc.value.code == 2 and len(err) == 1 and "--verbose: invalid choice: 7" in err[0], err
+    assert not Path(out).exists()
+
+
+def test_the_final_elgamal_evaluation_is_checked_before_training():
+    cfg = load_config("ppo", "small", quick=True)
+    with pytest.raises(ConfigError, match=r"eval\.elgamal \(max_samples = \d+, key_length = 100000\)"):
+        apply_override(cfg, "eval.elgamal.key_length=100000")
+    apply_override(cfg, "eval.elgamal.episodes=0")  # no ElGamal episodes: nothing to check
+    apply_override(cfg, "eval.elgamal.key_length=100000")
+    assert cfg["eval"]["elgamal"]["key_length"] == 100000
+
+
+def test_integer_hyperparameters_stay_within_int64():
+    from agents.hyperparams import INT64_MAX
+
+    assert INT64_MAX == np.iinfo(np.int64).max
+    assert check_value("hyperparams.batch_size", INT64_MAX, int) == INT64_MAX
+    with pytest.raises(ConfigError, match="batch_size holds the integer <integer of 1333 bits"):
+        check_value("hyperparams.batch_size", int("9" * 401), int)
+    with pytest.raises(ConfigError, match="net_arch holds the integer 9223372036854775808"):
+        check_value("hyperparams.policy_kwargs.net_arch", [64, INT64_MAX + 1], list[int])
+
+
+def test_network_bytes_by_hand():
+    from agents.hyperparams import network_bytes
+
+    # [64, 64] from 11 inputs to 2 outputs: (11 + 1) 64 + (64 + 1) 64 + (64 + 1) 2 = 5058 weights, actor and critic
+    assert network_bytes([64, 64], 11, 2) == 32 * 2 * 5058
+    # pi: (3 + 1) 8 + (8 + 1) 1 = 41; vf: (3 + 1) 4 + (4 + 1) 1 = 21
+    assert network_bytes({"pi": [8], "vf": [4]}, 3, 1) == 32 * (41 + 21)
+    assert network_bytes(None, 11, 2) == 0
+
+
+def test_huge_policy_networks_are_refused_before_pytorch_allocates(capsys, tmp_path):
+    out = str(tmp_path / "o")
+    line = _one_line_error(capsys, ["train", "--algo", "ppo", "--preset", "small", "--quick", "--n-timesteps", "64", "--no-progress",
+                                    "--no-tensorboard", "--no-final-eval", "--out", out, "--set",
+                                    "hyperparams.policy_kwargs.net_arch=[100000000]"], "net_arch = [100000000]")
+    assert "GiB" in line and "memory_limit" in line
+
+
+def test_run_json_parse_failures_are_config_errors(tmp_path, monkeypatch):
+    import agents.runs as runs
+
+    d = _run_dir(tmp_path, '{"algo": "ppo", "observation": "full", "env": {}, "seed": ' + "9" * 5000 + "}")
+    with pytest.raises(ConfigError, match="cannot read .*run.json.*4300") as exc:
+        read_run(d)
+    assert len(str(exc.value)) < 500
+    _run_dir(tmp_path, '{"algo": "ppo", "env": ' + "[" * 100_000 + "]" * 100_000 + "}")
+    with pytest.raises(ConfigError, match="nests too deeply"):
+        read_run(d)
+    _run_dir(tmp_path, {"algo": "ppo", "observation": "full", "env": {}, "pad": "x" * 200})
+    monkeypatch.setattr(runs, "MAX_RUN_FILE_BYTES", 100)
+    with pytest.raises(ConfigError, match=r"run.json has \d+ bytes; a run.json has at most 100"):
+        read_run(d)
+
+
+def test_model_archives_are_checked_without_unpickling(tmp_path):
+    from agents.runs import check_model_file
+
+    p = tmp_path / "model.zip"
+    p.write_bytes(b"PK\x03\x04" + b"\x00" * 40 + b"garbage")
+    with pytest.raises(ConfigError, match="not a readable model archive"):
+        check_model_file(p)
+    with zipfile.ZipFile(p, "w") as z:
+        z.writestr("notes.txt", "hello")
+    with pytest.raises(ConfigError, match="no 'data' member among \\['notes.txt'\\]"):
+        check_model_file(p)
+    with zipfile.ZipFile(p, "w") as z:
+        z.writestr("data", "{}")
+    assert check_model_file(p) is None
+
+
+def test_an_output_path_that_is_a_file_is_refused(tmp_path):
+    from agents.runs import check_output_dir
+
+    f = tmp_path / "afile"
+    f.write_text("x")
+    with pytest.raises(ConfigError, match="the runs directory .* exists and is not a directory"):
+        new_run_dir(f, "run")
+    with pytest.raises(ConfigError, match="cannot create the output directory"):
+        check_output_dir(f / "sub")
+    assert check_output_dir(tmp_path / "a" / "b") == tmp_path / "a" / "b" and (tmp_path / "a" / "b").is_dir()
+    assert f.read_text() == "x"
+
+
+def test_evaluate_refuses_empty_lists_and_a_file_as_out_before_the_work(tmp_path, capsys):
+    meta = {"algo": "ppo", "observation": "full", "env": {"preset": "small", "gamma_opt": False, "max_samples": 20}, "config": {}}
+    d = _run_dir(tmp_path, meta)
+    with zipfile.ZipFile(d / "model.zip", "w") as z:  # passes the archive check; never loaded here
+        z.writestr("data", "{}")
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    base = ["evaluate", str(d), "--no-progress", "--episodes", "1"]
+    _one_line_error(capsys, [*base, "--systems", ""], "no systems in ''")
+    _one_line_error(capsys, [*base, "--delays", ""], "decipher delay ''")
+    _one_line_error(capsys, [*base, "--samples", "9" * 401], "--samples must be <= 9223372036854775807")
+    _one_line_error(capsys, [*base, "--out", str(afile)], "exists and is not a directory")
+    _one_line_error(capsys, [*base, "--points", "100000000"], "points = 100000000 attack lengths exceed the horizon N = 20")
+    assert afile.read_text() == "x"

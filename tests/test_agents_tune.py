@@ -5,6 +5,7 @@ storage, and one-line errors (including a missing optuna)."""
 from __future__ import annotations
 
 import builtins
+import importlib.util
 
 import numpy as np
 import pytest
@@ -67,10 +68,20 @@ def test_tune_errors_are_one_line(tmp_path, capsys, monkeypatch):
         (["tune", "--algo", "ars", "--save-config", "--out", str(tmp_path)], "needs --preset"),
         (["tune", "--algo", "ars", "--preset", "small", "--quick", "--set", "hyperparams.n_delta=0", "--out", str(tmp_path)],
          "hyperparams.n_delta must be >= 1"),
+        (["tune", "--algo", "ars", "--preset", "small", "--quick", "--seed", "-1", "--out", str(tmp_path)], "seed must be >= 0, got -1"),
+        (["tune", "--algo", "ars", "--preset", "small", "--quick", "--seed", str(2**32), "--out", str(tmp_path)],
+         "seed must be <= 4294967295, got 4294967296"),
     ):
         assert cli.main(argv) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and needle in err[0], err
+    if importlib.util.find_spec("optuna") is not None:  # the output directory is checked once Optuna is there
+        afile = tmp_path / "afile"
+        afile.write_text("x")
+        assert cli.main(["tune", "--algo", "ars", "--preset", "small", "--quick", "--out", str(afile), "--no-progress"]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "the tuning directory (--out)" in err[0] and "is not a directory" in err[0], err
+        assert afile.read_text() == "x"
     real_import = builtins.__import__
 
     def no_optuna(name, *args, **kwargs):

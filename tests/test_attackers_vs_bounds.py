@@ -244,3 +244,44 @@ def test_the_old_module_path_still_imports():
         avb = importlib.import_module("experiments.attackers_vs_bounds")
     assert avb.compute is cmp.compute and avb.fit_rate is cmp.fit_rate and avb.Setting is cmp.Setting
     assert cli.SUBCOMMANDS["compare"][0] == "experiments.compare.cli"
+
+
+# ------------------------------------------------------------------ hardening (issue 16)
+def test_compare_refuses_empty_lists_huge_counts_and_a_file_as_out(tmp_path, capsys):
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    for argv, needle in ((["--delays", ""], "decipher delay ''"), (["--systems", ""], "no systems in ''"),
+                         (["--attackers", ""], "no attackers in ''"),
+                         (["--max-samples", "9" * 401], "--max-samples must be <= 9223372036854775807, got <integer of 1333 bits"),
+                         (["--points", "100000000"], "--points must be <= 60, got 100000000"),
+                         (["--episodes", "1000000000000"], "episodes = 1000000000000"),
+                         (["--out", str(afile)], "exists and is not a directory")):
+        args = ["compare", "--quick", "--no-progress", "--elgamal-episodes", "0", "--out", str(tmp_path / "c"), *argv]
+        assert cli.main(args) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and needle in err[0], (argv, err)
+    assert afile.read_text() == "x"
+
+
+def test_length_grid_has_at_most_the_horizon_points():
+    s = cmp.make_setting("small", 0, cap=20)
+    assert s.params.horizon == 20
+    grid = cmp.length_grid(s.params, 20)  # every length from 2 (n + m) + 1 = 9 to 20 at most once
+    assert grid[0] == 9 and grid[-1] == 20 and np.all(np.diff(grid) > 0) and len(grid) <= 12
+    with pytest.raises(ConfigError, match="points = 21 attack lengths exceed the horizon N = 20"):
+        cmp.length_grid(s.params, 21)
+
+
+def test_record_bytes_by_hand():
+    from experiments.compare.protocol import record_bytes
+
+    s0 = cmp.make_setting("small", 0, cap=20)  # delivered states: one running record of 20 steps too
+    s_end = cmp.make_setting("small", "end", cap=20)
+    atts = [GaussianAttacker(s0.params), OptimalDesignAttacker(s0.params)]
+    P = len(cmp.length_grid(s0.params, 4))
+    assert record_bytes([(s0, atts)], 10, 4) == 8 * 10 * (P + 2) * 2 + 16 * 10 * 20
+    assert record_bytes([(s_end, atts[:1])], 10, 4) == 8 * 10 * (P + 2)
+    from encctl_gym.errors import ResourceLimitError
+
+    with pytest.raises(ResourceLimitError, match="episodes = 1000000000000"):
+        cmp.compute(["small"], delays=(0,), episodes=10**12, cap=20, points=4, attackers=("gaussian",), elgamal_episodes=0)

@@ -35,3 +35,19 @@ def test_design_does_not_import_torch() -> None:
 def test_console_script_version() -> None:
     res = subprocess.run([sys.executable, "-m", "encctl_gym.cli", "--version"], capture_output=True, text=True)
     assert res.returncode == 0 and "encctl-gym" in res.stdout
+
+
+def test_a_multi_line_package_error_is_printed_on_one_line(monkeypatch, capsys) -> None:
+    """An error whose message spans lines (an array's repr) is still one line on stderr, exit 2."""
+    from encctl_gym import cli
+    from encctl_gym.errors import ParameterError
+
+    def boom(args):  # type: ignore[no-untyped-def]
+        raise ParameterError("A must be real, got array([[0.5+0.j, 0.1+0.j],\n [0. +0.j, 0.3+1.j]])")
+
+    import encctl_gym.security.design_cli as design_cli
+
+    monkeypatch.setattr(design_cli, "run", boom)  # the parser takes the subcommand's run when it is built
+    assert cli.main(["design"]) == 2
+    err = capsys.readouterr().err
+    assert err == "encctl-gym design: error: A must be real, got array([[0.5+0.j, 0.1+0.j], [0. +0.j, 0.3+1.j]])\n"

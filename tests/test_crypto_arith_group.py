@@ -4,21 +4,29 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import gmpy2
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from encctl_gym.crypto import arith
 from encctl_gym.crypto.arith import (
+    MAX_PRIMALITY_REPS,
     PowmodCounter,
     RandomSource,
     SecureRandom,
     SeededRandom,
     as_random_source,
+    check_integer,
+    check_rng,
     invert,
     is_prime,
     jacobi,
+    legendre,
+    mulmod,
     powmod,
     secure_random,
     seeded_random,
@@ -26,16 +34,21 @@ from encctl_gym.crypto.arith import (
 from encctl_gym.crypto.elgamal import keygen
 from encctl_gym.crypto.group import (
     DEFAULT_MAX_GENERATION_SECONDS,
+    MAX_GROUP_FILE_BYTES,
+    MAX_SIEVE_LIMIT,
+    MAX_SIEVE_WINDOW,
     MIN_GENERATE_BITS,
     SHIPPED_BITS,
     GroupParams,
+    as_group,
     estimate_generation_seconds,
     generate_safe_prime_group,
     get_group,
     shipped_group,
     sieve_window,
 )
-from encctl_gym.errors import EncctlError, GroupError, ParameterError, ResourceLimitError
+from encctl_gym._validation import format_value
+from encctl_gym.errors import ConfigError, EncctlError, GroupError, ParameterError, ResourceLimitError
 
 # Toy group used for known answers (hand-checked):
 #   p = 23 = 2 * 11 + 1, q = 11, g = 4 = 2^2.
@@ -108,6 +121,105 @@ def test_as_random_source_and_bad_bounds():
         src.between(5, 5)
     with pytest.raises(NotImplementedError):
         RandomSource().below(3)
+
+
+# Non-integers that gmpy2 would refuse with a bare TypeError (or, for 2.5, that would lose digits).
+NON_INTEGERS = [2.5, 3.0, "7", None, [7], True, 2 + 0j, np.float64(3.0)]
+
+
+@pytest.mark.parametrize("bad", NON_INTEGERS, ids=repr)
+@pytest.mark.parametrize("call, position", [
+    (powmod, 0), (powmod, 1), (powmod, 2), (mulmod, 0), (mulmod, 1), (mulmod, 2), (invert, 0), (invert, 1),
+    (jacobi, 0), (jacobi, 1), (legendre, 0), (legendre, 1),
+], ids=lambda v: getattr(v, "__name__", str(v)))
+def test_arith_refuses_non_integers_naming_the_value(call, position, bad):
+    args = {powmod: [3, 5, 7], mulmod: [3, 5, 7], invert: [3, 7], jacobi: [3, 7], legendre: [3, 7]}[call]
+    args[position] = bad
+    with pytest.raises(ParameterError, match=r"must be an integer.*got " + re.escape(format_value(bad))):
+        call(*args)
+
+
+@pytest.mark.parametrize("mod", [1, 0, -7], ids=repr)
+def test_moduli_must_exceed_one(mod):
+    # gmpy2 alone returns residues in (mod, 0] for a negative modulus (powmod(3, 5, -7) = -2) and 0 modulo 1
+    for call, args in ((powmod, (3, 5, mod)), (mulmod, (3, 5, mod)), (invert, (3, mod))):
+        with pytest.raises(ParameterError, match=rf"mod must be an integer > 1, got {mod}"):
+            call(*args)
+
+
+@pytest.mark.parametrize("n", [4, 0, -7, -1], ids=repr)
+def test_jacobi_needs_an_odd_positive_modulus(n):
+    with pytest.raises(ParameterError, match=rf"odd n > 0, got n = {n}"):
+        jacobi(3, n)
+
+
+@pytest.mark.parametrize("p", [1, 4, 0, -7, 9, 15, 561], ids=repr)
+def test_legendre_needs_an_odd_prime(p):
+    # 9, 15 and 561 are odd composites: (a/p) there is a Jacobi symbol and does not tell squares
+    with pytest.raises(ParameterError, match=rf"odd prime p, got p = {p}"):
+        legendre(2, p)
+
+
+def test_arith_accepts_every_exact_integer_type_with_known_answers():
+    # 3^5 = 243 = 34 * 7 + 5; 6 * 5 = 30 = 4 * 7 + 2; 3 * 5 = 15 = 2 * 7 + 1
+    for t in (int, gmpy2.mpz, np.int64, np.uint8):
+        assert powmod(t(3), t(5), t(7)) == 5
+        assert mulmod(t(6), t(5), t(7)) == 2
+        assert invert(t(3), t(7)) == 5
+    # (2/15) = (2/3)(2/5) = (-1)(-1) = 1 although 2 is not a square modulo 15; 3^2 = 9 = 2 (mod 7)
+    assert jacobi(np.int64(2), np.int64(15)) == 1 and legendre(np.int64(2), 7) == 1 and legendre(3, 7) == -1
+    assert check_integer("x", np.int16(-4)) == -4 and type(check_integer("x", np.int16(-4))) is int
+    big = gmpy2.mpz(2) ** 600
+    assert check_integer("x", big) is big
+
+
+@pytest.mark.parametrize("reps", [0, -1, MAX_PRIMALITY_REPS + 1, 2.5, "a", None, True], ids=repr)
+def test_is_prime_checks_n_and_reps(reps):
+    with pytest.raises(ParameterError, match="reps"):
+        is_prime(7, reps)
+    assert is_prime(7, 1) and is_prime(7, MAX_PRIMALITY_REPS) and not is_prime(9, 1)
+    for bad in (2.5, "7", None, [7]):
+        with pytest.raises(ParameterError, match=r"n must be an integer"):
+            is_prime(bad)
+
+
+def test_between_checks_its_bounds():
+    src = seeded_random(3)
+    for bad in ("9", None, 2.5, True):
+        with pytest.raises(ParameterError, match=r"high must be an integer.*got " + re.escape(format_value(bad))):
+            src.between(1, bad)
+    with pytest.raises(ParameterError, match="low must be an integer"):
+        src.between(1.0, 5)
+    assert all(10 <= seeded_random(4).between(np.int64(10), gmpy2.mpz(12)) < 12 for _ in range(5))
+    # the same draws whatever integer type the bounds have
+    assert seeded_random(5).between(np.int32(7), 10**30) == seeded_random(5).between(7, 10**30)
+
+
+@settings(max_examples=60, deadline=None)
+@given(base=st.integers(-(10**30), 10**30), exp=st.integers(0, 10**6), mod=st.integers(2, 10**30))
+def test_powmod_and_mulmod_equal_python_and_never_leave_zero_to_mod(base, exp, mod):
+    assert powmod(base, exp, mod) == pow(base, exp, mod)
+    assert mulmod(base, exp, mod) == base * exp % mod
+    assert 0 <= powmod(base, exp, mod) < mod
+    with pytest.raises(ParameterError):
+        powmod(base, exp, -mod)
+
+
+def test_check_rng_refuses_bad_values_without_drawing():
+    gen = np.random.default_rng(0)
+    state = gen.bit_generator.state
+    assert check_rng(gen) is gen and gen.bit_generator.state == state
+    src = seeded_random(1)
+    assert check_rng(src) is src and check_rng(None) is None and check_rng(np.int64(5)) == 5
+    for bad, match in (("seed", "'seed'"), (2.5, "2.5"), ([1], r"\[1\]"), (True, "True"), (-1, ">= 0, got -1")):
+        with pytest.raises(ParameterError, match=match):
+            check_rng(bad)
+        # a shipped size is not generated, but a bad rng is refused all the same
+        with pytest.raises(ParameterError, match=match):
+            get_group(64, rng=bad)
+        with pytest.raises(ParameterError, match=match):
+            as_group(shipped_group(64), rng=bad)
+    assert get_group(64, rng=gen) is not None and gen.bit_generator.state == state
 
 
 # ---------------------------------------------------------------------------- group
@@ -195,6 +307,82 @@ def test_json_roundtrip(tmp_path):
         GroupParams.load(tmp_path / "bad.json")
 
 
+def test_group_files_that_cannot_be_read_are_config_errors(tmp_path):
+    grp = shipped_group(64)
+    missing = tmp_path / "missing.json"
+    with pytest.raises(ConfigError, match=r"cannot read the group file .*missing\.json"):
+        GroupParams.load(missing)
+    with pytest.raises(ConfigError, match="cannot read the group file"):
+        GroupParams.load(tmp_path)  # a directory
+    junk = tmp_path / "junk.json"
+    junk.write_bytes(bytes(range(256)))
+    with pytest.raises(ConfigError, match=r"junk\.json' is not UTF-8 text"):
+        GroupParams.load(junk)
+    utf16 = tmp_path / "utf16.json"
+    utf16.write_bytes(grp.to_json().encode("utf-16"))
+    with pytest.raises(ConfigError, match="not UTF-8"):
+        GroupParams.load(utf16)
+    big = tmp_path / "big.json"
+    with big.open("wb") as f:  # sparse: larger than the bound on paper only
+        f.seek(MAX_GROUP_FILE_BYTES)
+        f.write(b" ")
+    with pytest.raises(ConfigError, match=rf"larger than MAX_GROUP_FILE_BYTES = {MAX_GROUP_FILE_BYTES}"):
+        GroupParams.load(big)
+    # a file of exactly the bound is read (and then refused for its content only)
+    with big.open("r+b") as f:
+        f.truncate(MAX_GROUP_FILE_BYTES)
+    with pytest.raises(GroupError, match="invalid group JSON"):
+        GroupParams.load(big)
+    for target in (tmp_path, tmp_path / "no" / "such" / "g.json"):
+        with pytest.raises(ConfigError, match="cannot write the group file"):
+            grp.save(target)
+
+
+@pytest.mark.parametrize("text, match", [
+    (None, "must be a str or bytes, got None"),
+    (42, "must be a str or bytes, got 42"),
+    (["{}"], "must be a str or bytes"),
+    ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
+    ('{"p": ' + "9" * 5000 + ', "q": 11, "g": 4}', "invalid group JSON"),
+    (b"\xff\xfe", "invalid group JSON"),
+], ids=["None", "int", "list", "deep", "digits", "bad-bytes"])
+def test_from_json_refuses_non_text_and_deep_nesting(text, match):
+    with pytest.raises(GroupError, match=match):
+        GroupParams.from_json(text)
+
+
+def test_group_methods_check_their_argument_types(tmp_path):
+    grp = shipped_group(64)
+    assert grp.contains(np.int64(4)) and grp.contains(gmpy2.mpz(4)) and not grp.contains(0)  # 4 = g is in G
+    for bad in ("4", 2.5, None, [4]):
+        with pytest.raises(ParameterError, match=r"m must be an integer.*got " + re.escape(format_value(bad))):
+            grp.contains(bad)
+    for bad in ("no", 1, None):
+        with pytest.raises(ParameterError, match=r"recheck must be True or False, got " + re.escape(format_value(bad))):
+            grp.verify(recheck=bad)
+    assert grp.verify(recheck=np.bool_(True)) is grp
+    path = tmp_path / "g.json"
+    grp.save(str(path))
+    assert GroupParams.load(str(path)) == grp
+    for bad in (42, None, ["g.json"]):
+        with pytest.raises(ParameterError, match=r"path must be a str or a path, got " + re.escape(format_value(bad))):
+            GroupParams.load(bad)
+        with pytest.raises(ParameterError, match="path must be a str or a path"):
+            grp.save(bad)
+    with pytest.raises(ParameterError, match="verify must be True or False, got 'no'"):
+        GroupParams.load(path, verify="no")
+    for bad in (np.array([23, 11, 4]), [23, 11, 4], "abc", None):
+        with pytest.raises(GroupError, match="group data must be a mapping with fields p, q, g"):
+            GroupParams.from_dict(bad)
+    with pytest.raises(ParameterError, match="progress must be True or False, got 'no'"):
+        generate_safe_prime_group(32, rng=1, progress="no")
+
+
+def test_from_json_reads_utf8_bytes():
+    grp = shipped_group(128)
+    assert GroupParams.from_json(grp.to_json().encode("utf-8")) == grp
+
+
 def _assert_safe_prime_group(grp: GroupParams, bits: int) -> None:
     assert grp.bits == bits and grp.p == 2 * grp.q + 1
     assert gmpy2.is_prime(grp.p) and gmpy2.is_prime(grp.q)
@@ -274,6 +462,36 @@ def test_sieve_strikes_exactly_the_candidates_with_small_factors():
         q = q0 + 2 * k
         has_small = any(q % ell == 0 or (2 * q + 1) % ell == 0 for ell in primes)
         assert (k in kept) == (not has_small), k
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"n_cand": -1}, "n_cand must be >= 0"),
+    ({"n_cand": MAX_SIEVE_WINDOW + 1}, f"n_cand must be <= {MAX_SIEVE_WINDOW}"),
+    ({"n_cand": 10**12}, f"n_cand must be <= {MAX_SIEVE_WINDOW}"),
+    ({"n_cand": 2.5}, "n_cand must be an integer, got 2.5"),
+    ({"limit": 2}, "limit must be >= 3"),
+    ({"limit": MAX_SIEVE_LIMIT + 1}, f"limit must be <= {MAX_SIEVE_LIMIT}"),
+    ({"limit": "a"}, "limit must be an integer, got 'a'"),
+    ({"q0": -5}, "q0 must be odd and >= limit = 1000.*got -5"),
+    ({"q0": 10**6}, "q0 must be odd.*got 1000000"),
+    ({"q0": 999}, "q0 must be odd and >= limit = 1000.*got 999"),
+    ({"q0": 2.5}, "q0 must be an integer.*got 2.5"),
+], ids=lambda v: str(v))
+def test_sieve_window_is_bounded_and_checks_its_arguments(kwargs, match):
+    args = {"q0": 10**6 + 1, "n_cand": 100, "limit": 1000, **kwargs}
+    with pytest.raises(ParameterError, match=match):
+        sieve_window(**args)
+
+
+def test_sieve_window_edges():
+    assert sieve_window(1001, 0, 1000).size == 0
+    # q0 = limit = 101: candidates 101, 103, ..., 119; kept iff q and 2q + 1 have no odd prime
+    # factor below 101: 101 (203 = 7 * 29: out), 103 (207 = 9 * 23: out), 105 = 3 * 35 (out),
+    # 107 (215 = 5 * 43: out), 109 (219 = 3 * 73: out), 111 = 3 * 37 (out), 113 (227 prime: kept),
+    # 115 = 5 * 23 (out), 117 = 9 * 13 (out), 119 = 7 * 17 (out)
+    assert sieve_window(101, 10, 101).tolist() == [6]
+    with pytest.raises(ParameterError, match=f"window must be <= {MAX_SIEVE_WINDOW}"):
+        generate_safe_prime_group(64, rng=1, window=MAX_SIEVE_WINDOW + 1)
 
 
 def test_sieve_survival_matches_the_product_of_the_estimate():

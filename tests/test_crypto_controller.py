@@ -344,6 +344,22 @@ def test_injection_bad_input():
         ctrl.step(_x(1), inject=bad)
 
 
+@pytest.mark.parametrize("inject, match", [
+    (42, "inject must be a matrix of ModifiedCiphertext, got int"),
+    ("abcd", "inject must have shape \\(4, 4\\), got \\(4, 1\\)"),
+    ([], "inject must be a non-empty rectangular matrix"),
+    ([[None] * 4] * 4, "inject must contain ModifiedCiphertext entries, got NoneType"),
+], ids=["int", "str", "empty", "None-entries"])
+def test_injection_must_be_a_matrix_of_the_plants_ciphertexts(inject, match):
+    ctrl = EncryptedLinearController(PHI, G64, 2.0**10, 10.0, rng=9)
+    with pytest.raises(CiphertextError, match=match):
+        ctrl.step(_x(1), inject=inject)
+    # the refused injection changed nothing: a valid one still decodes exactly after it
+    a = np.array([0.5, -0.25, 1.0, 0.0])
+    forged = forge_injection(ctrl.pk0, ctrl.pk, a, ctrl.encoder, 4, seeded_random(2))
+    assert np.array_equal(ctrl.step(_x(2), inject=forged), injection_value(a, ctrl.encoder, 4))
+
+
 # ---------------------------------------------------------------------------- quantized twin
 def test_every_scheme_pairs_its_plant_and_server_and_forgery():
     """The registry's parties run the loop for every scheme; static keys never change and the

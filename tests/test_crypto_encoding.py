@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from fractions import Fraction
 
 import gmpy2
@@ -11,14 +12,17 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from encctl_gym._validation import format_value
 from encctl_gym.crypto.arith import PowmodCounter, seeded_random
 from encctl_gym.crypto.elgamal import decrypt, encrypt, keygen
 from encctl_gym.crypto.encoding import (
     DEFAULT_MAX_SHIFT,
     Encoder,
     decode_int,
+    decode_scaled,
     default_max_shift,
     encode_int,
+    lift,
     nearest_member,
 )
 from encctl_gym.crypto.group import GroupParams, shipped_group
@@ -285,3 +289,89 @@ def test_encoder_needs_a_verified_group_and_huge_values_give_one_line_errors():
         Encoder(G64, 2.0**10, x_bound=10**400)
     with pytest.raises(PlaintextError, match=r"\(66439 bits\)"):
         decode_int(G64, 10**20000)  # more than Python's 4300-digit limit of int-to-str
+
+
+@pytest.mark.parametrize("group", ["abc", 64, None, 23.0], ids=repr)
+def test_integer_codec_needs_a_group(group):
+    with pytest.raises(ParameterError, match=r"group must be a GroupParams, got " + re.escape(format_value(group))):
+        encode_int(group, 5)
+    with pytest.raises(ParameterError, match=r"group must be a GroupParams"):
+        decode_int(group, 4)
+
+
+@pytest.mark.parametrize("ratio, match", [
+    ((0, 1), r"delta_ratio = \(0, 1\) must have num > 0 and den > 0"),
+    ((1024, 0), r"delta_ratio = \(1024, 0\)"),
+    ((-1, 1), r"delta_ratio = \(-1, 1\)"),
+    ((1.5, 1), r"delta_ratio\[0\] must be an integer.*got 1.5"),
+    ((1, True), r"delta_ratio\[1\] must be an integer.*got True"),
+    ("ab", r"delta_ratio must be a pair \(num, den\).*got 'ab'"),
+    ((1, 2, 3), r"delta_ratio must be a pair.*got \(1, 2, 3\)"),
+    (None, r"delta_ratio must be a pair.*got None"),
+], ids=lambda v: repr(v))
+def test_decode_scaled_checks_delta_ratio(ratio, match):
+    with pytest.raises(ParameterError, match=match):
+        decode_scaled(5, ratio)
+
+
+@pytest.mark.parametrize("w", [2.5, 5.0, "5", None, True], ids=repr)
+def test_decode_scaled_needs_an_integer_w(w):
+    # a float w would be divided as it is (2.5 / 1024 = 0.00244140625): a silent non-plaintext
+    with pytest.raises(ParameterError, match=r"w must be an integer, got " + re.escape(format_value(w))):
+        decode_scaled(w, (1024, 1))
+
+
+def test_decode_scaled_known_answers_for_every_integer_type():
+    # w / Delta^k with Delta = num / den: 5 / 1024; -6 / (3/2)^2 = -6 * 4 / 9 = -8/3
+    assert decode_scaled(5, (1024, 1)) == 5 / 1024
+    assert decode_scaled(np.int64(-6), (3, 2), 2) == float(Fraction(-8, 3))
+    assert decode_scaled(gmpy2.mpz(-6), [np.int64(3), 2], 2) == float(Fraction(-8, 3))
+    assert decode_scaled(10**400, (10**399, 1)) == 10.0  # exact integers beyond the float range
+
+
+@pytest.mark.parametrize("x_bound", [-1.0, -1e-300, float("nan"), "a", 2 + 1j], ids=repr)
+def test_max_abs_signed_needs_a_bound(x_bound):
+    enc = Encoder(G64, 2.0**10)
+    with pytest.raises(ParameterError, match=r"x_bound must be"):
+        enc.max_abs_signed(x_bound)
+
+
+def test_max_abs_signed_known_answers():
+    enc = Encoder(G64, 2.0**10)  # max_shift = 64
+    assert enc.max_abs_signed(0.0) == 64
+    assert enc.max_abs_signed(1.5) == 1536 + 64
+    assert enc.max_abs_signed(0.25 / 1024) == 0 + 64  # round(0.25) = 0
+    with pytest.raises(EncodingOverflowError, match="overflows a float"):
+        Encoder(G64, 1e300).max_abs_signed(1e300)
+
+
+@pytest.mark.parametrize("call", [
+    lambda g: nearest_member(g, 5, 64), lambda g: default_max_shift(g), lambda g: lift(g, 5),
+], ids=["nearest_member", "default_max_shift", "lift"])
+@pytest.mark.parametrize("group", ["abc", 64, None], ids=repr)
+def test_group_functions_need_a_group(call, group):
+    with pytest.raises(ParameterError, match=r"group must be a GroupParams, got " + re.escape(format_value(group))):
+        call(group)
+
+
+def test_nearest_member_and_lift_check_their_integers():
+    for bad in (2.5, "5", None, True):
+        with pytest.raises(ParameterError, match=r"v must be an integer"):
+            nearest_member(TOY, bad, 2)
+        with pytest.raises(ParameterError, match=r"m must be an integer"):
+            lift(TOY, bad)
+    for bad in (-1, 2.5, "a"):
+        with pytest.raises(ParameterError, match=r"max_shift must be"):
+            nearest_member(TOY, 5, bad)
+    # in TOY, 5 is not in G = {1, 2, 3, 4, 6, ...}: 6 is tried before 4; 7 -> 8 (+1), 10 -> 9 (-1)
+    assert nearest_member(TOY, np.int64(5), np.int64(1)) == (6, 1)
+    assert nearest_member(TOY, 7, 1) == (8, 1) and nearest_member(TOY, 10, 1) == (9, 1)
+    assert lift(TOY, np.int64(12)) == -11 and lift(TOY, 11) == 11 and lift(TOY, gmpy2.mpz(22)) == -1
+
+
+def test_max_shift_must_leave_representable_values():
+    # TOY: (p - 1)/2 = 11; a shift of 11 or more leaves no |round(Delta x)| + max_shift <= 11
+    assert Encoder(TOY, 1.0, max_shift=10).max_shift == 10
+    for bad in (11, 12, 10**400):
+        with pytest.raises(ParameterError, match=r"max_shift must be <= 10, got "):
+            Encoder(TOY, 1.0, max_shift=bad)

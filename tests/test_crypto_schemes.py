@@ -336,3 +336,42 @@ def test_keygen_accepts_bits_and_secure_rng():
         keygen(64.5)
     with pytest.raises(ParameterError):
         keygen("64")
+
+
+# A value beyond Python's int-to-str limit (4300 digits): repr() of it raises ValueError, so a
+# message that showed it with !r would itself fail; format_value shows its size instead.
+HUGER = 10**5000
+HUGER_SHOWN = "<integer of 16610 bits, about 5001 digits>"
+
+
+def test_messages_survive_values_beyond_the_int_to_str_limit():
+    from encctl_gym.crypto.arith import as_random_stream
+    from encctl_gym.crypto.schemes import get_scheme
+    from encctl_gym.crypto.servers import TokenControllerServer
+
+    pk, sk = keygen(G64, 1)
+    calls = [
+        (lambda: encrypt(HUGER, 4, rng=seeded_random(1)), ParameterError, "pk must be a PublicKey, got int: "),
+        (lambda: decrypt(sk, HUGER), CiphertextError, "expected an ElGamal Ciphertext"),
+        (lambda: get_scheme(HUGER), ParameterError, "unknown scheme "),
+        (lambda: seeded_random(1).spawn(HUGER), ParameterError, "purpose of a random stream must be a string, got "),
+        (lambda: as_random_stream([HUGER], "encrypt"), ParameterError, "rng must be None"),
+        (lambda: TokenControllerServer(pk, [[encrypt(pk, 4, seeded_random(2))]]).receive_token(HUGER), ParameterError,
+         "token must be an UpdateToken, got "),
+        (lambda: Ciphertext(G64, 4, 4, t=-HUGER), CiphertextError, "Ciphertext.t must be a time step >= 0, got -"),
+    ]
+    for call, err, start in calls:
+        with pytest.raises(err) as info:
+            call()
+        text = str(info.value)
+        assert start in text and HUGER_SHOWN in text and "\n" not in text, text
+
+
+def test_server_refuses_state_ciphertexts_that_are_not_a_sequence():
+    from encctl_gym.crypto.servers import ControllerServer
+
+    pk, _ = keygen(G64, 1)
+    server = ControllerServer(pk, [[encrypt(pk, 4, seeded_random(2))]])
+    for bad in (42, None, 2.5):
+        with pytest.raises(CiphertextError, match=r"state ciphertexts must be a sequence of 1 Ciphertext, got " + str(bad)):
+            server.evaluate(bad)

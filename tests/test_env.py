@@ -526,7 +526,7 @@ def _step_past_a_chunk() -> None:
         ({"decipher_delay": np.array([1, 2])}, ParameterError, "decipher_delay"),
         ({"scheme": ["modified"]}, ParameterError, "scheme"),
         ({"warmup_steps": 10**9}, ParameterError, "warmup_steps"),
-        ({"input_history": 10**9}, ParameterError, "GiB"),
+        ({"input_history": 10**9}, ParameterError, "input_history must be <= 64 .*got 1000000000"),
         ({"scheme": "static", "max_samples": 10**12}, ParameterError, "GiB"),
     ],
 )
@@ -636,3 +636,82 @@ def test_a_configured_estimator_gives_epsilon_and_reward_of_its_own_fit(estimato
 def test_a_bad_estimator_is_refused_at_construction(estimator, text):
     with pytest.raises(ParameterError, match=text):
         EncryptedLTIAttackEnv(config={**SMALL, "estimator": estimator})
+
+
+# ---------------------------------------------------------------- hardening (issue 16)
+@pytest.mark.parametrize("action", [np.array([True, False]), [True, False], np.array([[0.1 + 1j, 0.0]]), np.array(["a", "b"])])
+def test_boolean_complex_and_string_actions_are_refused_naming_them(action):
+    """A boolean action is not read as 0/1, a complex one is not cut to its real part."""
+    env = EncryptedLTIAttackEnv(config=SMALL)
+    env.reset(seed=0)
+    with pytest.raises(ParameterError, match="action must be a real numeric array") as err:
+        env.step(action)
+    assert ("True" in str(err.value)) if np.asarray(action).dtype.kind == "b" else True
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "text"),
+    [
+        ("warmup_steps", 10**5000, "warmup_steps must be <= 100000 .*about 5001 digits"),
+        ("input_history", 10**400, "input_history must be <= 64 .*about 401 digits"),
+        ("input_history", 65, "input_history must be <= 64 .*got 65"),
+        ("delta", 10**400, "delta must be <= 2\\^53 .*about 401 digits"),
+        ("delta", 2**53 + 1, "delta must be <= 2\\^53 .*9007199254740993"),
+    ],
+    ids=["warmup_steps-5001-digits", "input_history-401-digits", "input_history-65", "delta-401-digits", "delta-2^53+1"],
+)
+def test_huge_integer_settings_are_refused_naming_the_value(key, value, text):
+    with pytest.raises(ParameterError, match=text):
+        resolve_params({**SMALL, key: value})
+
+
+def test_an_infinite_actuator_bound_is_refused():
+    """action_scale = 1e308 with sigma_u2 = 4 makes u_max = 2e308 = inf in float64."""
+    with pytest.raises(ParameterError, match=r"u_max.*action_scale = 1e\+308 and sigma_u2 = 4"):
+        resolve_params({**SMALL, "preset": None, "A": [[0.5]], "B": [[1.0]], "sigma_w2": 1.0, "sigma_u2": 4.0,
+                        "upsilon": 1e9, "tau_c": "1y", "gamma_c": 1e-3, "action_scale": 1e308})
+
+
+def test_a_quantisation_table_beyond_its_bound_is_refused_before_it_is_built():
+    """x_bound = 2e4 at Delta = 4096 needs |round(Delta x)| up to 81 920 001 > 2^24 entries."""
+    from encctl_gym.loop.ideal import MAX_TABLE_LIMIT
+
+    assert 4096 * 20000 + 1 > MAX_TABLE_LIMIT
+    with pytest.raises(ResourceLimitError, match=r"x_bound = 20000.0, Delta = 4096.*81920001.*2\^24"):
+        EncryptedLTIAttackEnv(config={**SMALL, "x_bound": 2e4})
+    with pytest.raises(ResourceLimitError, match=r"x_bound = 20000.0"):
+        EncryptedLTIAttackVectorEnv(num_envs=2, config={**SMALL, "x_bound": 2e4}, helper_thread=False)
+
+
+def test_a_batch_beyond_the_float_range_is_refused_with_its_size():
+    with pytest.raises(ResourceLimitError, match=r"num_envs = <integer of 1329 bits, about 401 digits>"):
+        EncryptedLTIAttackVectorEnv(num_envs=10**400, config=SMALL, helper_thread=False)
+
+
+@pytest.mark.parametrize("delta", [1e-300, 1e-320, 5e-324])
+def test_a_subnormal_a_optimality_regularization_gives_finite_rewards_that_telescope(delta):
+    """The return of ``a_optimality`` telescopes to log(d / delta) - log tr((G_N + delta I)^-1):
+    finite although d / delta overflows float64 for a subnormal delta."""
+    env = EncryptedLTIAttackEnv(config={**SMALL, "reward": "a_optimality", "logdet_regularization": delta})
+    env.reset(seed=0)
+    rewards = []
+    for _ in range(200):
+        _, r, term, trunc, _ = env.step(np.full(2, 0.5, dtype=np.float32))
+        rewards.append(r)
+        if term or trunc:
+            break
+    assert all(math.isfinite(r) for r in rewards)
+    lam = np.clip(np.linalg.eigvalsh(env.episode.G[0]), 0.0, None)
+    # log(d / delta) and log sum 1 / (lam + delta), each computed with Python's exact-range logs
+    expected = (math.log(4) - math.log(delta)) - math.log(math.fsum(math.exp(-math.log(v + delta)) for v in lam))
+    assert math.isclose(sum(rewards), expected, rel_tol=1e-9)
+
+
+def test_bad_vector_flags_are_refused_before_a_helper_thread_starts():
+    import threading
+
+    before = threading.active_count()
+    for kw in ({"parallel": "no"}, {"helper_thread": 1}):
+        with pytest.raises(ParameterError, match="must be a bool"):
+            EncryptedLTIAttackVectorEnv(num_envs=2, config=SMALL, **kw)
+    assert threading.active_count() == before

@@ -153,11 +153,28 @@ def test_reproduce_quick_through_the_cli(tmp_path: Path, capsys: pytest.CaptureF
     assert t.columns["N"].max() == QUICK.N_max
 
 
-def test_cli_bad_option_is_a_one_line_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    rc = cli.main(["reproduce", "--quick", "--only", "fig2", "--n-jobs", "0", "--out", str(tmp_path)])
-    assert rc == 2
+@pytest.mark.parametrize(
+    ("option", "value", "text"),
+    [
+        ("--n-jobs", "0", "n_jobs must be -1 (all cores) or >= 1, got 0"),
+        ("--n-jobs", "-5", "n_jobs must be -1 (all cores) or >= 1, got -5"),
+        ("--n-jobs", "abc", "--n-jobs must be -1 (all cores) or a count >= 1, got 'abc'"),
+        ("--seed", "-1", "--seed must be >= 0, got -1"),
+        ("--seed", "2.5", "--seed must be a non-negative integer, got '2.5'"),
+        ("--scheduler", "bogus", "scheduler must be 'local' or a Dask scheduler address like 'tcp://host:8786', got 'bogus'"),
+    ],
+)
+def test_cli_bad_option_is_a_one_line_error_before_any_work(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], option: str, value: str, text: str
+) -> None:
+    """--seed, --n-jobs and --scheduler are checked as they are parsed (the design step, which
+    uses none of them, would otherwise run and exit 0)."""
+    with pytest.raises(SystemExit) as exc:
+        cli.main(["reproduce", "--quick", "--only", "design", option, value, "--out", str(tmp_path)])
+    assert exc.value.code == 2
     err = capsys.readouterr().err.strip()
-    assert err.startswith("encctl-gym reproduce: error:") and "n_jobs" in err and "\n" not in err
+    assert err.startswith("encctl-gym reproduce: error:") and text in err and "\n" not in err
+    assert not any(tmp_path.iterdir())  # nothing was written
 
 
 def test_reproduce_module_and_script_entry_points(tmp_path: Path) -> None:

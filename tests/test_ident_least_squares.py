@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from encctl_gym.errors import EncctlError, ParameterError, ShapeError
+from encctl_gym.errors import EncctlError, ParameterError, ResourceLimitError, ShapeError
 from encctl_gym.ident.error import estimation_error
 from encctl_gym.ident.least_squares import (
     GRAM_COND_LIMIT,
@@ -284,3 +284,48 @@ def test_property_prefix_grid_equals_least_squares(n: int, m: int, seed: int, cu
         A_hat, B_hat = least_squares(sim.states[:, :N], sim.inputs[:, :N])
         ref = np.concatenate([A_hat, B_hat], axis=-1)
         np.testing.assert_allclose(theta[:, k], ref, rtol=0, atol=1e-8 * max(1.0, np.abs(ref).max()))
+
+
+# ---------------------------------------------------------------- hardening (issue 16)
+@pytest.mark.parametrize("which", ["x_t", "u_t", "x_next"])
+@pytest.mark.parametrize("bad", [np.array([1j, 0.0]), np.array([True, False]), np.array(["a", "b"])])
+def test_rls_update_refuses_complex_boolean_and_string_data(which, bad) -> None:
+    """A complex sample is not cut to its real part, a boolean one not read as 0/1; the data so
+    far are left unchanged."""
+    rls = RecursiveLeastSquares(2, 2)
+    good = {"x_t": np.zeros(2), "u_t": np.zeros(2), "x_next": np.zeros(2)}
+    with pytest.raises(ParameterError, match=f"real numeric {which}, got <?array"):
+        rls.update(**{**good, which: bad})
+    assert rls.count == 0
+
+
+def test_rls_update_names_the_non_finite_argument() -> None:
+    rls = RecursiveLeastSquares(2, 1)
+    with pytest.raises(ParameterError, match=r"finite entries in u_t, got array\(\[nan\]"):
+        rls.update(np.zeros(2), np.array([np.nan]), np.zeros(2))
+
+
+@pytest.mark.parametrize("n", [10**6, 10**400])
+def test_rls_of_an_impossible_size_is_refused_with_its_memory(n) -> None:
+    """n = 10^6 needs (2n + m)^2 * 8 bytes = about 29 800 GiB for its moment matrix."""
+    with pytest.raises(ResourceLimitError, match="recursive least squares for n = .* GiB"):
+        RecursiveLeastSquares(n, 1)
+
+
+def test_solve_normal_equations_checks_its_arrays_and_solves_a_known_system() -> None:
+    from encctl_gym.ident.least_squares import solve_normal_equations
+
+    G = np.array([[4.0, 2.0], [2.0, 3.0]])
+    C = np.array([[2.0], [1.0]])
+    theta, ok = solve_normal_equations(G, C)  # G x = C: x = (1/8) [3*2 - 2*1, -2*2 + 4*1] = [0.5, 0]
+    assert ok and np.allclose(theta, [[0.5, 0.0]], atol=1e-15)
+    with pytest.raises(ShapeError, match=r"C must have shape \(2, 'k'\)"):
+        solve_normal_equations(G, np.ones((3, 1)))
+    with pytest.raises(ShapeError, match=r"C must have shape \(1, 1, 2, 'k'\)"):
+        solve_normal_equations(G[None, None], C)
+    with pytest.raises(ShapeError, match="square matrices"):
+        solve_normal_equations(np.ones((2, 3)), C)
+    with pytest.raises(ParameterError, match="G must be real"):
+        solve_normal_equations(G * 1j, C)
+    with pytest.raises(ParameterError, match="C must be a numeric array"):
+        solve_normal_equations(G, None)

@@ -154,3 +154,39 @@ def test_log_grid() -> None:
     assert log_grid(9, 100, 1).tolist() == [100]
     with pytest.raises(ParameterError):
         log_grid(10, 5, 3)
+
+
+# ---------------------------------------------------------------- hardening (issue 16)
+def test_log_grid_refuses_sizes_beyond_int64_and_grids_beyond_memory() -> None:
+    with pytest.raises(ParameterError, match=r"N_max must be <= 9007199254740992, got <integer of 1329 bits"):
+        log_grid(10, 10**400, 5)
+    with pytest.raises(ParameterError, match=r"N_max must be <= 9007199254740992, got 9223372036854775807"):
+        log_grid(2, 2**63 - 1, 3)  # was an int64 overflow of the rounded float grid
+    with pytest.raises(EncctlError, match=r"points = 1000000000000 .* GiB"):
+        log_grid(10, 1000, 10**12)
+    assert log_grid(2, 2**53, 3).tolist() == [2, 2**27, 2**53]  # the geometric mean of 2 and 2^53 is 2^27
+
+
+def test_child_seeds_refuses_a_count_beyond_memory() -> None:
+    with pytest.raises(EncctlError, match=r"n = 1000000000000 child seeds needs about"):
+        child_seeds(0, 10**12)
+
+
+@pytest.mark.parametrize(("kwargs", "text"), [({"func": "abc"}, "func must be a function"), ({"tasks": None}, "tasks must be a sequence"),
+                                              ({"tasks": 3}, "tasks must be a sequence of task descriptions, got 3"),
+                                              ({"scheduler": "bogus"}, "got 'bogus'")])
+def test_run_tasks_refuses_what_it_cannot_run(kwargs, text) -> None:  # type: ignore[no-untyped-def]
+    args = {"func": lambda t, s: t, "tasks": [1, 2], "seed": 0, "n_jobs": 1, **kwargs}
+    with pytest.raises(ParameterError, match=text):
+        run_tasks(**args)
+
+
+def test_gaussian_attack_of_an_impossible_size_is_refused_with_its_memory() -> None:
+    from encctl_gym.sim.plant import simulate_gaussian_attack
+
+    plant = LinearPlant(np.array([[0.5, 0.1], [0.0, 0.3]]), np.array([[1.0], [0.5]]), sigma_w2=0.1)
+    # 2 * 8 * runs * (N (2n + m) + n) bytes = 16 * 10^9 * (5 N + 2): N = 10^9 is about 7.5e10 GiB
+    with pytest.raises(EncctlError, match=r"runs = 3 trajectories of N = 1000000000 .* GiB"):
+        simulate_gaussian_attack(plant, N=10**9, runs=3, sigma_u2=1.0, seed=0)
+    with pytest.raises(EncctlError, match=r"runs = 1000000000 trajectories"):
+        gaussian_attack_errors(plant, sample_sizes=[10, 20], runs=10**9, sigma_u2=1.0, seed=0)

@@ -48,11 +48,13 @@ from typing import Any
 import gmpy2
 import numpy as np
 
-from .._validation import check_int
+from .._validation import check_int, format_value
 from ..errors import ParameterError
 
 __all__ = [
     "mpz",
+    "check_integer",
+    "MAX_PRIMALITY_REPS",
     "powmod",
     "mulmod",
     "invert",
@@ -69,6 +71,7 @@ __all__ = [
     "seeded_random",
     "as_random_source",
     "as_random_stream",
+    "check_rng",
     "RngLike",
 ]
 
@@ -76,6 +79,35 @@ mpz = gmpy2.mpz
 
 # Number of calls of :func:`powmod` in this process (read via :func:`powmod_count`).
 _POWMOD_CALLS = 0
+
+
+_MPZ = type(gmpy2.mpz(0))
+_INT_TYPES = (int, _MPZ)
+
+#: Largest number of Miller-Rabin repetitions :func:`is_prime` accepts (GMP's own default is 25).
+MAX_PRIMALITY_REPS = 1000
+
+
+def check_integer(name: str, value: Any) -> int:
+    """``value`` if it is an exact integer (``int``, ``gmpy2.mpz`` or a NumPy integer), else a
+    :class:`ParameterError` naming it.
+
+    Booleans, floats (even integral ones: ``2.0**64`` is not exact), strings and everything
+    else are refused: big-integer arithmetic on a float would silently lose digits, and gmpy2
+    would raise a bare ``TypeError``. NumPy integers are returned as Python ints.
+    """
+    if type(value) is int or type(value) is _MPZ:  # fast path (hot in every exponentiation)
+        return value
+    if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)):
+        raise ParameterError(f"{name} must be an integer (int or gmpy2.mpz), got {format_value(value)}")
+    return int(value)
+
+
+def _check_modulus(name: str, mod: Any) -> int:
+    mod = check_integer(name, mod)
+    if mod <= 1:
+        raise ParameterError(f"{name} must be an integer > 1, got {format_int(mod)}")
+    return mod
 
 
 def powmod(base: int, exp: int, mod: int) -> int:
@@ -87,14 +119,23 @@ def powmod(base: int, exp: int, mod: int) -> int:
     Parameters
     ----------
     base, exp, mod : int
-        Integers (Python ``int`` or ``gmpy2.mpz``); ``mod`` > 1.
+        Integers (Python ``int``, ``gmpy2.mpz`` or a NumPy integer); ``mod`` > 1.
 
     Returns
     -------
     gmpy2.mpz
         The residue in ``[0, mod)``.
+
+    Raises
+    ------
+    ParameterError
+        If an argument is not an integer, ``mod <= 1`` (a negative modulus would give a
+        residue in ``(mod, 0]``), or ``exp < 0`` and ``base`` has no inverse modulo ``mod``.
     """
     global _POWMOD_CALLS
+    if not (type(base) in _INT_TYPES and type(exp) in _INT_TYPES and type(mod) in _INT_TYPES and mod > 1):
+        base, exp = check_integer("base", base), check_integer("exp", exp)
+        mod = _check_modulus("mod", mod)
     _POWMOD_CALLS += 1
     try:
         return gmpy2.powmod(base, exp, mod)
@@ -132,18 +173,31 @@ class PowmodCounter:
 
 
 def mulmod(a: int, b: int, mod: int) -> int:
-    """Return ``a * b mod mod`` with gmpy2 integers (the Eval of Example ex:elgamal)."""
-    return gmpy2.f_mod(gmpy2.mul(a, b), mod)
-
-
-def invert(a: int, mod: int) -> int:
-    """Return the inverse of ``a`` modulo ``mod``.
+    """Return ``a * b mod mod`` with gmpy2 integers (the Eval of Example ex:elgamal).
 
     Raises
     ------
     ParameterError
-        If ``a`` has no inverse modulo ``mod`` (``gcd(a, mod) != 1``).
+        If an argument is not an integer or ``mod <= 1`` (as :func:`powmod`).
     """
+    if not (type(a) in _INT_TYPES and type(b) in _INT_TYPES and type(mod) in _INT_TYPES and mod > 1):
+        a, b = check_integer("a", a), check_integer("b", b)
+        mod = _check_modulus("mod", mod)
+    return gmpy2.f_mod(gmpy2.mul(a, b), mod)
+
+
+def invert(a: int, mod: int) -> int:
+    """Return the inverse of ``a`` modulo ``mod`` (in ``[1, mod)``).
+
+    Raises
+    ------
+    ParameterError
+        If ``a`` or ``mod`` is not an integer, ``mod <= 1`` (modulo 1 every number is 0, and a
+        negative modulus is not a residue class), or ``a`` has no inverse modulo ``mod``
+        (``gcd(a, mod) != 1``).
+    """
+    a = check_integer("a", a)
+    mod = _check_modulus("mod", mod)
     try:
         return gmpy2.invert(a, mod)
     except ZeroDivisionError as exc:
@@ -161,8 +215,16 @@ def is_prime(n: int, reps: int = 25) -> bool:
     n : int
         The number to test; values < 2 are not prime.
     reps : int, default 25
-        Repetitions passed to ``gmpy2.is_prime``.
+        Repetitions passed to ``gmpy2.is_prime``, in ``[1, MAX_PRIMALITY_REPS]``.
+
+    Raises
+    ------
+    ParameterError
+        If ``n`` is not an integer or ``reps`` is not an integer in range.
     """
+    n = check_integer("n", n)
+    if type(reps) is not int or not 1 <= reps <= MAX_PRIMALITY_REPS:
+        reps = check_int("reps", reps, minimum=1, maximum=MAX_PRIMALITY_REPS)
     if n < 2:
         return False
     return bool(gmpy2.is_prime(n, reps))
@@ -174,12 +236,36 @@ def jacobi(a: int, n: int) -> int:
     For a safe prime p = 2q + 1, ``jacobi(m, p) == 1`` iff m is a quadratic residue, i.e.
     iff m lies in the order-q subgroup of Example ex:elgamal. One call costs about as much
     as a few multiplications, far less than a modular exponentiation.
+
+    Raises
+    ------
+    ParameterError
+        If ``a`` or ``n`` is not an integer, or ``n`` is not odd and positive (the symbol is
+        undefined there).
     """
-    return int(gmpy2.jacobi(a, n))
+    if not (type(a) in _INT_TYPES and type(n) in _INT_TYPES and n > 0):
+        a, n = check_integer("a", a), check_integer("n", n)
+        if n <= 0:  # gmpy2 would return a symbol for a negative odd n
+            raise ParameterError(f"the Jacobi symbol (a/n) needs an odd n > 0, got n = {format_int(n)}")
+    try:
+        return int(gmpy2.jacobi(a, n))
+    except ValueError:  # gmpy2 refuses an even n
+        raise ParameterError(f"the Jacobi symbol (a/n) needs an odd n > 0, got n = {format_int(n)}") from None
 
 
 def legendre(a: int, p: int) -> int:
-    """Legendre symbol (a/p) for an odd prime p (see :func:`jacobi`)."""
+    """Legendre symbol (a/p) for an odd prime p (see :func:`jacobi`).
+
+    Raises
+    ------
+    ParameterError
+        If ``a`` or ``p`` is not an integer, or ``p`` is not an odd prime (for a composite p
+        the value would be the Jacobi symbol, which does not tell quadratic residues; callers
+        that already know p is prime use :func:`jacobi`, which skips the primality test).
+    """
+    a, p = check_integer("a", a), check_integer("p", p)
+    if p < 3 or p % 2 == 0 or not is_prime(p):
+        raise ParameterError(f"the Legendre symbol (a/p) needs an odd prime p, got p = {format_int(p)}")
     return int(gmpy2.legendre(a, p))
 
 
@@ -215,7 +301,15 @@ class RandomSource:
         raise NotImplementedError
 
     def between(self, low: int, high: int) -> int:
-        """Return an integer uniform in ``[low, high)``; requires ``low < high``."""
+        """Return an integer uniform in ``[low, high)``; requires integers ``low < high``.
+
+        Raises
+        ------
+        ParameterError
+            If a bound is not an integer, or the range is empty.
+        """
+        if not (type(low) in _INT_TYPES and type(high) in _INT_TYPES):
+            low, high = check_integer("low", low), check_integer("high", high)
         if not high > low:
             raise ParameterError(f"empty range [{format_int(low)}, {format_int(high)})")
         return low + self.below(high - low)
@@ -234,7 +328,7 @@ class RandomSource:
         if type(n) is int and n >= 1:  # fast path
             return n
         if isinstance(n, bool) or not isinstance(n, (numbers.Integral, type(mpz(0)))):
-            raise ParameterError(f"the bound n must be an integer, got {n!r}")
+            raise ParameterError(f"the bound n must be an integer, got {format_value(n)}")
         if n < 1:
             raise ParameterError(f"the bound n must be >= 1, got {format_int(n)}")
         return n
@@ -263,7 +357,7 @@ def _length_prefixed(data: bytes) -> bytes:
 
 def _check_purpose(purpose: Any) -> str:
     if not isinstance(purpose, str):
-        raise ParameterError(f"the purpose of a random stream must be a string, got {purpose!r}")
+        raise ParameterError(f"the purpose of a random stream must be a string, got {format_value(purpose)}")
     return purpose
 
 
@@ -373,15 +467,32 @@ def as_random_source(rng: RngLike, purpose: str = "") -> RandomSource:
     ParameterError
         For any other type, or a negative seed.
     """
+    rng = check_rng(rng)
     if rng is None:
         return SecureRandom()
     if isinstance(rng, RandomSource):
         return rng
     if isinstance(rng, np.random.Generator):
         return SeededRandom(_generator_seed(rng), purpose)
-    if isinstance(rng, bool) or not isinstance(rng, (numbers.Integral, np.integer)):
-        raise ParameterError(f"rng must be None, an int seed, a numpy Generator or a RandomSource, got {rng!r}")
     return SeededRandom(int(rng), purpose)
+
+
+def check_rng(rng: Any, name: str = "rng") -> RngLike:
+    """Check the type of an ``rng`` argument without drawing from it; return it unchanged.
+
+    For calls that take ``rng`` but may not need it (a shipped group is not generated): a bad
+    value is refused all the same, and a generator or stream is left untouched.
+
+    Raises
+    ------
+    ParameterError
+        Unless ``rng`` is None, an int seed >= 0, a numpy Generator or a :class:`RandomSource`.
+    """
+    if rng is None or isinstance(rng, (RandomSource, np.random.Generator)):
+        return rng
+    if isinstance(rng, bool) or not isinstance(rng, (numbers.Integral, np.integer)):
+        raise ParameterError(f"{name} must be None, an int seed, a numpy Generator or a RandomSource, got {format_value(rng)}")
+    return check_int(f"the seed {name}", rng, minimum=0)
 
 
 def as_random_stream(rng: RngLike, caller: str) -> RandomSource:

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validation import format_value
 from ..errors import CiphertextError, KeyMismatchError, ParameterError
 from . import arith
 from .group import GroupParams
@@ -52,7 +53,7 @@ def integer_field(obj: Any, name: str, err: type) -> None:
         object.__setattr__(obj, name, int(value))
         return
     if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)):
-        raise err(f"{type(obj).__name__}.{name} must be an integer, got {value!r}")
+        raise err(f"{type(obj).__name__}.{name} must be an integer, got {format_value(value)}")
     object.__setattr__(obj, name, int(value))
 
 
@@ -64,7 +65,7 @@ def step_field(obj: Any, name: str, err: type, optional: bool) -> None:
     if type(value) is int and value >= 0:  # fast path
         return
     if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)) or value < 0:
-        raise err(f"{type(obj).__name__}.{name} must be a time step >= 0, got {value!r}")
+        raise err(f"{type(obj).__name__}.{name} must be a time step >= 0, got {format_value(value)}")
     object.__setattr__(obj, name, int(value))
 
 
@@ -72,14 +73,14 @@ def group_field(obj: Any, err: type) -> GroupParams:
     """Check that ``obj.group`` is a :class:`GroupParams`; return it."""
     group = obj.group
     if type(group) is not GroupParams and not isinstance(group, GroupParams):
-        raise err(f"{type(obj).__name__}.group must be a GroupParams, got {group!r}")
+        raise err(f"{type(obj).__name__}.group must be a GroupParams, got {format_value(group)}")
     return group
 
 
 def check_instance(value: Any, cls: type, name: str) -> None:
     """Raise :class:`ParameterError` unless ``value`` is a ``cls`` (the message names both)."""
     if not isinstance(value, cls):
-        raise ParameterError(f"{name} must be a {cls.__name__}, got {type(value).__name__}: {value!r}")
+        raise ParameterError(f"{name} must be a {cls.__name__}, got {type(value).__name__}: {format_value(value)}")
 
 
 def check_same_group(a: Any, b: Any, what: str = "keys") -> GroupParams:
@@ -152,7 +153,7 @@ def check_ciphertext_of(group: GroupParams, ct: Any, cls: type, components: tupl
         If ``ct`` belongs to another group.
     """
     if not isinstance(ct, cls):
-        raise CiphertextError(f"expected {description}, got {ct!r}")
+        raise CiphertextError(f"expected {description}, got {format_value(ct)}")
     check_group_of(ct, group)
     for name in components:
         check_component(group, getattr(ct, name), name)

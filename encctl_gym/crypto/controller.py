@@ -23,6 +23,7 @@ import numpy as np
 
 from . import arith
 from .arith import RngLike
+from .checks import check_ciphertext_matrix
 from .elgamal import Ciphertext, PublicKey
 from .encoding import Encoder
 from .group import GroupParams, as_group
@@ -170,12 +171,16 @@ class EncryptedLinearController:
         EncodingOverflowError
             If ``|x_j| > x_bound``.
         CiphertextError, KeyMismatchError
-            If an injected output is malformed or of the wrong step.
+            If an injected output is not an alpha x beta matrix of the ciphertexts the plant
+            decrypts, is malformed, or is of another group or step.
         """
+        if inject is not None:  # refused before anything is encrypted or evaluated
+            shape = (self.alpha, self.beta)
+            inject = check_ciphertext_matrix("inject", inject, self.plant.output_type, shape)
         ct_x = self.plant.encrypt_state(x)
         out = self.server.evaluate(ct_x)
         if inject is not None:
-            out = [list(r) for r in inject]
+            out = inject
         u = self.plant.decrypt_output(out)
         token = self.plant.update_keys()
         if self.scheme_parts.token_to_server:

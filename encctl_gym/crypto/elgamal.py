@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validation import format_value
 from ..errors import CiphertextError, KeyMismatchError, ParameterError, PlaintextError
 from . import arith
 from .arith import RngLike
@@ -162,7 +163,7 @@ def check_plaintext(group: GroupParams, m: Any) -> int:
     """
     if type(m) is not int:
         if isinstance(m, bool) or not (isinstance(m, (numbers.Integral, np.integer)) or type(m) is _MPZ):
-            raise PlaintextError(f"plaintext must be an integer element of G, got {m!r}")
+            raise PlaintextError(f"plaintext must be an integer element of G, got {format_value(m)}")
         m = int(m)
     if m == 0:
         raise PlaintextError("plaintext m = 0 is not an element of G (0 has no order)")

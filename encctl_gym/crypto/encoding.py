@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_int, check_positive
+from .._validation import check_int, check_positive, format_value
 from ..errors import EncodingOverflowError, ParameterError, PlaintextError
 from . import arith
 from .arith import format_int as fmt
@@ -85,7 +85,7 @@ def default_max_shift(group: GroupParams) -> int:
     ParameterError
         If the cofactor exceeds :data:`MAX_ENCODABLE_COFACTOR`.
     """
-    n = group.cofactor
+    n = _check_group(group).cofactor
     if n > MAX_ENCODABLE_COFACTOR:
         raise ParameterError(
             f"the group's cofactor n = {n} is too large for nearest-element encoding "
@@ -123,10 +123,17 @@ def nearest_member(group: GroupParams, v: int, max_shift: int) -> tuple[int, int
 
     Raises
     ------
+    ParameterError
+        If ``group`` is not a :class:`GroupParams`, ``v`` is not an integer or ``max_shift`` is
+        not an integer >= 0.
     PlaintextError
         If no member of G lies within ``max_shift`` of ``v``.
     """
-    p = group.p
+    if type(v) is not int:
+        v = _as_int("v", v)
+    if type(max_shift) is not int or max_shift < 0:
+        max_shift = check_int("max_shift", max_shift, 0)
+    p = _check_group(group).p
     if _is_member_residue(group, v % p):
         return v, 0
     for k in range(1, max_shift + 1):
@@ -144,7 +151,7 @@ def encode_int(group: GroupParams, v: int, max_shift: int | None = None) -> int:
     :class:`EncodingOverflowError` if ``|w| > (p - 1)/2`` (it would not decode back).
     """
     v = _as_int("v", v)
-    group.verify()
+    _check_group(group).verify()
     ms = default_max_shift(group) if max_shift is None else check_int("max_shift", max_shift, 0)
     w, _ = nearest_member(group, v, ms)
     if abs(w) > group.half:
@@ -153,8 +160,15 @@ def encode_int(group: GroupParams, v: int, max_shift: int | None = None) -> int:
 
 
 def lift(group: GroupParams, m: int) -> int:
-    """Signed representative of the residue ``m`` in (-p/2, p/2] (first step of Dcd)."""
-    return m - group.p if m > group.half else m
+    """Signed representative of the residue ``m`` in (-p/2, p/2] (first step of Dcd).
+
+    ``m`` is taken as a residue in [0, p) (:func:`decode_int` checks that range); a
+    non-integer ``m`` or ``group`` raises :class:`ParameterError`.
+    """
+    if type(m) is not int:
+        m = _as_int("m", m)
+    half = _check_group(group).half
+    return m - group.p if m > half else m
 
 
 def decode_int(group: GroupParams, m: int) -> int:
@@ -166,7 +180,7 @@ def decode_int(group: GroupParams, m: int) -> int:
         If ``m`` is not an integer in [0, p).
     """
     m = _as_int("m", m, PlaintextError)
-    if not 0 <= m < group.p:
+    if not 0 <= m < _check_group(group).p:
         raise PlaintextError(f"plaintext m = {fmt(m)} is outside [0, p) for p = {fmt(group.p)}")
     return lift(group, m)
 
@@ -175,22 +189,52 @@ def _check_power(power: Any) -> int:
     if type(power) is int and power in DECODE_POWERS:  # fast path
         return power
     if isinstance(power, bool) or not isinstance(power, (numbers.Integral, np.integer)) or int(power) not in DECODE_POWERS:
-        raise ParameterError(f"power must be one of {DECODE_POWERS} (Delta for a value, Delta^2 for a product), got {power!r}")
+        raise ParameterError(
+            f"power must be one of {DECODE_POWERS} (Delta for a value, Delta^2 for a product), got {format_value(power)}"
+        )
     return int(power)
+
+
+def _check_delta_ratio(delta_ratio: Any) -> tuple[int, int]:
+    if type(delta_ratio) is tuple and len(delta_ratio) == 2:  # fast path (every decode)
+        num, den = delta_ratio
+        if type(num) is int and type(den) is int and num > 0 and den > 0:
+            return num, den
+    if not isinstance(delta_ratio, (tuple, list)) or len(delta_ratio) != 2:
+        raise ParameterError(
+            f"delta_ratio must be a pair (num, den) of integers > 0 with Delta = num / den, got {format_value(delta_ratio)}"
+        )
+    num, den = (arith.check_integer(f"delta_ratio[{i}]", v) for i, v in enumerate(delta_ratio))
+    if num <= 0 or den <= 0:
+        raise ParameterError(f"delta_ratio = ({fmt(num)}, {fmt(den)}) must have num > 0 and den > 0 (Delta = num / den > 0)")
+    return int(num), int(den)
 
 
 def decode_scaled(w: int, delta_ratio: tuple[int, int], power: int = 1) -> float:
     """Return ``w / Delta**power`` correctly rounded, with ``Delta = num/den`` given exactly.
 
+    Parameters
+    ----------
+    w : int
+        The signed integer to decode (``int``, ``gmpy2.mpz`` or a NumPy integer).
+    delta_ratio : tuple of int
+        ``(num, den)`` with ``num, den > 0``: Delta as an exact fraction
+        (``float.as_integer_ratio``).
+    power : int, default 1
+        One of :data:`DECODE_POWERS`.
+
     Raises
     ------
     ParameterError
-        If ``power`` is not in :data:`DECODE_POWERS`.
+        If ``w`` is not an integer, ``delta_ratio`` is not a pair of integers > 0, or
+        ``power`` is not in :data:`DECODE_POWERS`.
     EncodingOverflowError
         If the quotient does not fit in a double.
     """
     power = _check_power(power)
-    num, den = delta_ratio
+    num, den = _check_delta_ratio(delta_ratio)
+    if type(w) is not int:
+        w = _as_int("w", w)
     try:
         return (w * den**power) / num**power
     except OverflowError as exc:
@@ -199,21 +243,27 @@ def decode_scaled(w: int, delta_ratio: tuple[int, int], power: int = 1) -> float
 
 def _as_int(name: str, value: Any, err: type = ParameterError) -> int:
     if isinstance(value, bool):
-        raise err(f"{name} must be an integer, got {value!r}")
+        raise err(f"{name} must be an integer, got {format_value(value)}")
     if isinstance(value, (numbers.Integral, np.integer)) or type(value).__name__ == "mpz":
         return int(value)
-    raise err(f"{name} must be an integer, got {value!r}")
+    raise err(f"{name} must be an integer, got {format_value(value)}")
+
+
+def _check_group(group: Any) -> GroupParams:
+    if not isinstance(group, GroupParams):
+        raise ParameterError(f"group must be a GroupParams, got {format_value(group)}")
+    return group
 
 
 def _as_finite(name: str, x: Any) -> float:
     if isinstance(x, bool) or not isinstance(x, (numbers.Real, np.floating, np.integer)):
-        raise ParameterError(f"{name} must be a real number, got {x!r}")
+        raise ParameterError(f"{name} must be a real number, got {format_value(x)}")
     try:
         xf = float(x)
     except OverflowError:
         raise EncodingOverflowError(f"{name} = {fmt(x)} is too large for a float") from None
     if not math.isfinite(xf):
-        raise ParameterError(f"{name} must be finite, got {x!r}")
+        raise ParameterError(f"{name} must be finite, got {format_value(x)}")
     return xf
 
 
@@ -222,14 +272,14 @@ def _as_finite_array(name: str, x: Any) -> np.ndarray:
     try:
         arr = x if isinstance(x, np.ndarray) else np.asarray(x)
     except (TypeError, ValueError) as exc:  # e.g. a ragged nested list
-        raise ParameterError(f"{name} must be a numeric (real) array, got {x!r}: {exc}") from None
+        raise ParameterError(f"{name} must be a numeric (real) array, got {format_value(x)}: {exc}") from None
     kind = arr.dtype.kind
     if kind == "O":  # e.g. a list mixing Python ints and floats, or gmpy2 numbers
         flat = arr.ravel().tolist()
         for v in flat:
             real = isinstance(v, (numbers.Real, np.floating, np.integer)) or type(v).__name__ == "mpz"
             if isinstance(v, bool) or not real:
-                raise ParameterError(f"{name} must contain real numbers, got {v!r}")
+                raise ParameterError(f"{name} must contain real numbers, got {format_value(v)}")
         try:
             arr = np.asarray([float(v) for v in flat], dtype=np.float64).reshape(arr.shape)
         except OverflowError as exc:
@@ -239,7 +289,7 @@ def _as_finite_array(name: str, x: Any) -> np.ndarray:
         shown = bad[0] if bad.size else arr.ravel()[0]
         raise ParameterError(f"{name} must be real, got a complex array (e.g. {shown!r}); its imaginary part would be lost")
     elif kind not in "iuf":
-        raise ParameterError(f"{name} must be a numeric (real) array, got dtype {arr.dtype}: {x!r}")
+        raise ParameterError(f"{name} must be a numeric (real) array, got dtype {arr.dtype}: {format_value(x)}")
     else:
         arr = arr.astype(np.float64, copy=False)
     if not np.all(np.isfinite(arr)):
@@ -263,14 +313,16 @@ class Encoder:
         i.e. ``|round(Delta x)| + max_shift <= (p - 1)/2``.
     max_shift : int, optional
         Largest allowed distance between ``round(Delta x)`` and its encoding (default
-        :func:`default_max_shift`: 64 for safe-prime groups).
+        :func:`default_max_shift`: 64 for safe-prime groups), below ``(p - 1)/2``.
 
     Raises
     ------
     GroupError
         If ``group`` does not verify (:meth:`~.group.GroupParams.verify`).
     ParameterError
-        If ``delta`` is not a finite number > 0, or ``x_bound`` is not finite and >= 0.
+        If ``group`` is not a :class:`GroupParams`, ``delta`` is not a finite number > 0,
+        ``x_bound`` is not finite and >= 0, or ``max_shift`` is not an integer in
+        ``[0, (p - 1)/2)``.
     EncodingOverflowError
         If ``x_bound`` itself is not representable.
 
@@ -283,17 +335,17 @@ class Encoder:
     """
 
     def __init__(self, group: GroupParams, delta: float, x_bound: float | None = None, max_shift: int | None = None) -> None:
-        if not isinstance(group, GroupParams):
-            raise ParameterError(f"group must be a GroupParams, got {group!r}")
-        self.group = group.verify()  # membership tests are only meaningful in a verified group
+        self.group = _check_group(group).verify()  # membership tests are only meaningful in a verified group
         self.delta = check_positive("delta", delta)
         self.delta_ratio: tuple[int, int] = self.delta.as_integer_ratio()
-        self.max_shift = default_max_shift(group) if max_shift is None else check_int("max_shift", max_shift, 0)
+        # a shift beyond (p - 1)/2 leaves no representable value (every encode would overflow)
+        ms = default_max_shift(group) if max_shift is None else check_int("max_shift", max_shift, 0, group.half - 1)
+        self.max_shift = ms
         self.x_bound: float | None = None
         if x_bound is not None:
             xb = _as_finite("x_bound", x_bound)
             if xb < 0:
-                raise ParameterError(f"x_bound must be >= 0, got {x_bound!r}")
+                raise ParameterError(f"x_bound must be >= 0, got {format_value(x_bound)}")
             self._check_v(xb, self._round(xb), "x_bound")
             self.x_bound = xb
 
@@ -369,8 +421,19 @@ class Encoder:
         return (0.5 + s) / self.delta
 
     def max_abs_signed(self, x_bound: float) -> int:
-        """Upper bound on ``|w|`` over all ``|x| <= x_bound``: ``round(Delta x_bound) + max_shift``."""
-        return abs(self._round(_as_finite("x_bound", x_bound))) + self.max_shift
+        """Upper bound on ``|w|`` over all ``|x| <= x_bound``: ``round(Delta x_bound) + max_shift``.
+
+        Raises
+        ------
+        ParameterError
+            If ``x_bound`` is not a finite real number >= 0 (a bound on ``|x|``).
+        EncodingOverflowError
+            If ``Delta x_bound`` overflows a float.
+        """
+        xb = _as_finite("x_bound", x_bound)
+        if xb < 0:
+            raise ParameterError(f"x_bound must be >= 0 (a bound on |x|), got {format_value(x_bound)}")
+        return self._round(xb) + self.max_shift
 
     # ------------------------------------------------------------------ arrays
     def quantize_array(self, x: Any) -> np.ndarray:

@@ -28,6 +28,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
 import sys
 import time
 from collections.abc import Mapping
@@ -37,8 +38,8 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_int, check_positive
-from ..errors import GroupError, ParameterError, ResourceLimitError
+from .._validation import check_bool, check_int, check_positive, format_value
+from ..errors import ConfigError, GroupError, ParameterError, ResourceLimitError
 from . import arith
 from .arith import RngLike
 from .arith import format_int as fmt
@@ -47,6 +48,9 @@ __all__ = [
     "GroupParams",
     "MIN_GENERATE_BITS",
     "MAX_GROUP_BITS",
+    "MAX_GROUP_FILE_BYTES",
+    "MAX_SIEVE_WINDOW",
+    "MAX_SIEVE_LIMIT",
     "SHIPPED_BITS",
     "DEFAULT_MAX_GENERATION_SECONDS",
     "estimate_generation_seconds",
@@ -68,10 +72,23 @@ MIN_GENERATE_BITS = 16
 #: highest, 256-bit, security level of finite-field discrete logarithms).
 MAX_GROUP_BITS = 16384
 
+#: Largest group file :meth:`GroupParams.load` reads, in bytes.
+MAX_GROUP_FILE_BYTES = 1 << 20
+
+#: Largest number of candidates sieved at once (:func:`sieve_window`, the ``window`` of
+#: :func:`generate_safe_prime_group`): one byte each.
+MAX_SIEVE_WINDOW = 1 << 24
+
+#: Largest bound of the sieving primes of :func:`sieve_window` (the search itself uses at most
+#: 2**20): the sieve of Eratosthenes below it takes one byte per integer.
+MAX_SIEVE_LIMIT = 1 << 24
+
 #: Bit lengths of the groups shipped in ``crypto/data/groups.json``.
 SHIPPED_BITS: tuple[int, ...] = (64, 128, 256, 512, 712, 1024, 2048)
 
 _DATA_FILE = Path(__file__).with_name("data") / "groups.json"
+
+_MPZ = type(arith.mpz(0))
 
 # (p, q, g) triples that passed GroupParams.verify() in this process.
 _VERIFIED: set[tuple[int, int, int]] = set()
@@ -90,6 +107,12 @@ def _as_int(name: str, value: Any) -> int:
         return check_int(name, value)
     except ParameterError as exc:
         raise GroupError(str(exc)) from exc
+
+
+def _as_path(path: Any) -> Path:
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"path must be a str or a path, got {format_value(path)}")
+    return Path(path)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -178,7 +201,15 @@ class GroupParams:
 
         For safe-prime groups this is one Jacobi symbol (no modular exponentiation); for
         another cofactor it is ``pow(m, q, p) == 1`` (one exponentiation).
+
+        Raises
+        ------
+        ParameterError
+            If ``m`` is not an integer (a float or a string is not "not a member": it is no
+            residue at all).
         """
+        if type(m) is not int and type(m) is not _MPZ:
+            m = arith.check_integer("m", m)
         if not 0 < m < self.p:
             return False
         if self.is_safe_prime:
@@ -204,7 +235,11 @@ class GroupParams:
         ------
         GroupError
             Naming the failed condition and the offending value.
+        ParameterError
+            If ``recheck`` is not a bool.
         """
+        if recheck is not False:
+            recheck = check_bool("recheck", recheck)
         key = (self.p, self.q, self.g)
         if key in _VERIFIED and not recheck:
             return self
@@ -236,6 +271,8 @@ class GroupParams:
         GroupError
             If a field is missing or the declared ``bits``/``cofactor`` do not match.
         """
+        if not isinstance(data, Mapping):
+            raise GroupError(f"group data must be a mapping with fields p, q, g, got {format_value(data)}")
         try:
             group = cls(data["p"], data["q"], data["g"])
         except (KeyError, TypeError) as exc:
@@ -255,24 +292,79 @@ class GroupParams:
         return json.dumps(self.to_dict(), indent=1)
 
     @classmethod
-    def from_json(cls, text: str) -> GroupParams:
-        """Parse :meth:`to_json` output; raises :class:`GroupError` on malformed JSON."""
+    def from_json(cls, text: str | bytes) -> GroupParams:
+        """Parse :meth:`to_json` output.
+
+        Raises
+        ------
+        GroupError
+            If ``text`` is not text (``str`` or UTF-8 ``bytes``), is malformed or too deeply
+            nested JSON, or does not describe a group (:meth:`from_dict`).
+        """
+        if not isinstance(text, (str, bytes, bytearray)):
+            raise GroupError(f"group JSON must be a str or bytes, got {format_value(text)}")
         try:
             data = json.loads(text)
-        except ValueError as exc:  # malformed, or a decimal number beyond the int-to-str limit
+        except RecursionError:
+            raise GroupError("invalid group JSON: nested too deeply (a group is one flat object)") from None
+        except ValueError as exc:  # malformed, not UTF-8, or a decimal number beyond the int-to-str limit
             raise GroupError(f"invalid group JSON: {exc}") from None
         if not isinstance(data, dict):
             raise GroupError(f"group JSON must be an object, got a {type(data).__name__}")
         return cls.from_dict(data)
 
     def save(self, path: str | Path) -> None:
-        """Write :meth:`to_json` to ``path``."""
-        Path(path).write_text(self.to_json() + "\n", encoding="utf-8")
+        """Write :meth:`to_json` to ``path``.
+
+        Raises
+        ------
+        ParameterError
+            If ``path`` is not a str or a path.
+        ConfigError
+            If the file cannot be written (a directory, a missing parent, no permission, ...).
+        """
+        target = _as_path(path)
+        try:
+            target.write_text(self.to_json() + "\n", encoding="utf-8")
+        except OSError as exc:
+            raise ConfigError(f"cannot write the group file {format_value(str(target))}: {exc.strerror or exc}") from None
 
     @classmethod
     def load(cls, path: str | Path, verify: bool = True) -> GroupParams:
-        """Read a group written by :meth:`save` (verified unless ``verify=False``)."""
-        group = cls.from_json(Path(path).read_text(encoding="utf-8"))
+        """Read a group written by :meth:`save` (verified unless ``verify=False``).
+
+        At most :data:`MAX_GROUP_FILE_BYTES` are read (a group of :data:`MAX_GROUP_BITS` bits
+        takes about 13 kB).
+
+        Raises
+        ------
+        ParameterError
+            If ``path`` is not a str or a path, or ``verify`` is not a bool.
+        ConfigError
+            If the file cannot be read, is larger than :data:`MAX_GROUP_FILE_BYTES` or is not
+            UTF-8 text.
+        GroupError
+            If its content is not a valid group (:meth:`from_json`, :meth:`verify`).
+        """
+        source = _as_path(path)
+        if verify is not True:
+            verify = check_bool("verify", verify)
+        shown = format_value(str(source))
+        try:
+            with source.open("rb") as f:
+                raw = f.read(MAX_GROUP_FILE_BYTES + 1)
+        except OSError as exc:
+            raise ConfigError(f"cannot read the group file {shown}: {exc.strerror or exc}") from None
+        if len(raw) > MAX_GROUP_FILE_BYTES:
+            raise ConfigError(
+                f"the group file {shown} is larger than MAX_GROUP_FILE_BYTES = {MAX_GROUP_FILE_BYTES} bytes "
+                "(a group file is a few kilobytes)"
+            )
+        try:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise ConfigError(f"the group file {shown} is not UTF-8 text: {exc.reason} at byte {exc.start}") from None
+        group = cls.from_json(text)
         return group.verify() if verify else group
 
     def __repr__(self) -> str:
@@ -297,8 +389,34 @@ def sieve_window(q0: int, n_cand: int, limit: int) -> np.ndarray:
     A candidate is struck out when q or 2q + 1 is divisible by an odd prime l < ``limit``:
     ``q0 + 2k = 0 (mod l)`` iff ``k = -q0 / 2``, and ``2(q0 + 2k) + 1 = 0 (mod l)`` iff
     ``k = (-1/2 - q0) / 2`` (mod l). ``q0`` must be odd and, so that a prime q is not struck
-    out by itself, larger than every sieving prime.
+    out by itself, at least ``limit`` (larger than every sieving prime).
+
+    Parameters
+    ----------
+    q0 : int
+        The first candidate, odd and >= ``limit``.
+    n_cand : int
+        Number of candidates, in ``[0, MAX_SIEVE_WINDOW]``.
+    limit : int
+        Bound of the sieving primes, in ``[3, MAX_SIEVE_LIMIT]``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The surviving indices k, ascending.
+
+    Raises
+    ------
+    ParameterError
+        If an argument is not an integer or is outside its range (the message names it).
     """
+    q0 = arith.check_integer("q0", q0)
+    n_cand = check_int("n_cand", n_cand, minimum=0, maximum=MAX_SIEVE_WINDOW)
+    limit = check_int("limit", limit, minimum=3, maximum=MAX_SIEVE_LIMIT)
+    if q0 % 2 == 0 or q0 < limit:
+        raise ParameterError(
+            f"q0 must be odd and >= limit = {limit} (a prime q below the sieve bound would strike itself out), got {fmt(q0)}"
+        )
     primes = _small_primes(limit)
     inv2 = _inverses_of_two(limit)
     sieve = np.ones(n_cand, dtype=bool)
@@ -316,7 +434,7 @@ def _inverses_of_two(limit: int) -> tuple[int, ...]:
 
 def _check_bits(bits: Any) -> int:
     if isinstance(bits, bool) or not isinstance(bits, (int, np.integer)):
-        raise ParameterError(f"bits must be an integer, got {bits!r}")
+        raise ParameterError(f"bits must be an integer, got {format_value(bits)}")
     bits = int(bits)
     if bits < MIN_GENERATE_BITS:
         raise ParameterError(
@@ -356,7 +474,8 @@ _TWIN_PRIME_CONSTANT = 0.6601618158468696
 def _search_plan(bits: int, window: int | None = None) -> tuple[int, int]:
     """(window, sieve limit) of the safe-prime search for ``bits`` (shared with the estimate)."""
     large = bits >= 1536
-    window = check_int("window", (1 << 16 if large else 1 << 14) if window is None else window, minimum=16)
+    default = 1 << 16 if large else 1 << 14
+    window = check_int("window", default if window is None else window, minimum=16, maximum=MAX_SIEVE_WINDOW)
     cap = 1 << (20 if large else 16)
     # Sieve only with primes below q_low = 2^(bits - 2), so that a prime q is never struck out
     # by itself (q_low is not built for huge bits: it exceeds the cap from 23 bits on).
@@ -463,7 +582,8 @@ def generate_safe_prime_group(
         Print the number of tested candidates on stderr while searching.
     window : int, optional
         Number of candidates sieved at once (default 2**14, or 2**16 from 1536 bits on, where
-        the sieve also uses more primes because each primality test is expensive).
+        the sieve also uses more primes because each primality test is expensive); at most
+        :data:`MAX_SIEVE_WINDOW`.
     max_seconds : float, default :data:`DEFAULT_MAX_GENERATION_SECONDS`
         Limit on :func:`estimate_generation_seconds`, checked before the search starts.
 
@@ -475,13 +595,16 @@ def generate_safe_prime_group(
     Raises
     ------
     ParameterError
-        If ``bits`` is not an integer or is below :data:`MIN_GENERATE_BITS`, or
-        ``max_seconds`` is not finite and > 0.
+        If ``bits`` is not an integer or is below :data:`MIN_GENERATE_BITS`, ``max_seconds``
+        is not finite and > 0, ``progress`` is not a bool, or ``window`` is not an integer in
+        ``[16, MAX_SIEVE_WINDOW]``.
     ResourceLimitError
         If the estimated time exceeds ``max_seconds`` (the message gives both).
     """
     bits = _check_bits(bits)
     max_seconds = check_positive("max_seconds", max_seconds)
+    if progress is not False:
+        progress = check_bool("progress", progress)
     window, limit = _search_plan(bits, window)
     estimate = estimate_generation_seconds(bits, window)
     if estimate > max_seconds:
@@ -578,6 +701,7 @@ def get_group(
         If a group must be generated and its estimated time exceeds ``max_seconds``.
     """
     bits = _check_bits(bits)
+    arith.check_rng(rng)  # refused even where it is not needed (a shipped size)
     if bits in SHIPPED_BITS:
         return shipped_group(bits)
     return generate_safe_prime_group(bits, rng=rng, progress=progress, max_seconds=max_seconds)
@@ -587,6 +711,7 @@ def as_group(group_or_bits: GroupParams | int, rng: RngLike = None) -> GroupPara
     """Accept a :class:`GroupParams` (verified here) or a bit length (:func:`get_group`, with
     the default time limit; call :func:`get_group` with ``max_seconds`` for larger sizes)."""
     if isinstance(group_or_bits, GroupParams):
+        arith.check_rng(rng)
         return group_or_bits.verify()
     return get_group(group_or_bits, rng=rng)
 

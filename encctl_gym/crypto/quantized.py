@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import as_finite_array, check_nonnegative
+from .._validation import as_finite_array, check_nonnegative, format_value
 from ..errors import EncodingOverflowError, ParameterError
 from .encoding import Encoder
 
@@ -58,7 +58,7 @@ class QuantizedLinearController:
 
     def __init__(self, Phi: Any, encoder: Encoder, x_bound: float) -> None:
         if not isinstance(encoder, Encoder):
-            raise ParameterError(f"encoder must be an Encoder, got {encoder!r}")
+            raise ParameterError(f"encoder must be an Encoder, got {format_value(encoder)}")
         phi = as_finite_array("Phi", Phi)
         if phi.ndim == 1:
             phi = phi.reshape(1, -1)

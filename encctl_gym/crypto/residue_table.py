@@ -6,12 +6,13 @@ is the set of quadratic residues, so membership of an integer ``v`` is its Legen
 ``chi(v) = (v / p) = 1``; and because ``p = 3 (mod 4)``, ``chi(-v) = -chi(v)``.
 
 ``chi`` is completely multiplicative, so a table of ``chi(v)`` for ``0 <= v <= V`` needs the
-Legendre symbol (one call of :func:`~.arith.legendre`) only at the primes below ``V``: start
-from ``chi = 1`` and, for every prime ``l`` with ``chi(l) = -1``, flip the sign at the
-multiples of each power of ``l``. From ``chi`` a table of offsets to the nearest member (with
-the encoder's tie-break: ``+d`` before ``-d``) turns the quantisation of a whole batch into
-one gather. This is what lets the environment's ``crypto="ideal"`` backend and its vector
-environment apply *exactly* the encoder's quantisation at numpy speed;
+Legendre symbol only at the primes below ``V`` (one call of :func:`~.arith.jacobi` each, which
+equals it for the verified prime p): start from ``chi = 1`` and, for every prime ``l`` with
+``chi(l) = -1``, flip the sign at the multiples of each power of ``l``. From ``chi`` a table of
+offsets to the nearest member (with the encoder's tie-break: ``+d`` before ``-d``) turns the
+quantisation of a whole batch into one gather. This is what lets the environment's
+``crypto="ideal"`` backend and its vector environment apply *exactly* the encoder's quantisation
+at numpy speed;
 :func:`~.encoding.nearest_member` is the reference it is tested against.
 
 Memory is estimated before anything is allocated (:func:`residue_table_bytes`: about
@@ -29,6 +30,7 @@ import numpy as np
 
 from .._validation import check_int
 from ..errors import EncodingOverflowError, GroupError, ParameterError, ResourceLimitError
+from ..resources import memory_headroom
 from . import arith
 from .group import GroupParams
 
@@ -78,7 +80,7 @@ def _legendre_table(p: int, n: int) -> np.ndarray:
     mp = arith.mpz(p)
     for start in range(0, primes.size, _BLOCK):
         for ell in primes[start : start + _BLOCK].tolist():
-            if arith.legendre(ell, mp) == -1:
+            if arith.jacobi(ell, mp) == -1:  # the Legendre symbol: p is a verified prime
                 power = ell
                 while power < n:  # chi(ell^k m) = (-1)^k chi(m): flip once per power dividing v
                     chi[power::power] *= -1
@@ -126,18 +128,26 @@ class ResidueTable:
     ParameterError
         If ``limit`` is out of range, or a gap between residues exceeds the search pad.
     ResourceLimitError
-        If building the table would need more than ``max_bytes`` (the message gives both).
+        If building the table would need more than ``max_bytes``, or more than the address space
+        the process may still map under a limit (:func:`encctl_gym.resources.memory_headroom`);
+        the message gives both.
     """
 
     def __init__(self, p: GroupParams | int, limit: int, max_bytes: int = DEFAULT_MAX_TABLE_BYTES) -> None:
         limit = check_int("limit", limit)
         max_bytes = check_int("max_bytes", max_bytes, minimum=1)
         need = residue_table_bytes(max(limit, 0))
-        if need > max_bytes:
+        room = memory_headroom()
+        if need > max_bytes or (room is not None and need > room):
+            bound, name = (
+                (max_bytes, "max_bytes")
+                if need > max_bytes or room is None
+                else (room, "the address space left under this process's limit")
+            )
             raise ResourceLimitError(
                 f"a residue table for |v| <= limit = {arith.format_int(limit)} needs about "
-                f"{arith.format_int(need >> 20)} MiB to build, more than max_bytes = "
-                f"{max_bytes >> 20} MiB; use a smaller Delta or a smaller declared range "
+                f"{arith.format_int(need >> 20)} MiB to build, more than {name} = "
+                f"{bound >> 20} MiB; use a smaller Delta or a smaller declared range "
                 "(x_bound), or raise max_bytes"
             )
         p = _safe_prime(p)

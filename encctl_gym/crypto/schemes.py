@@ -24,6 +24,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from .._validation import format_value
 from ..errors import ParameterError
 from .arith import RandomSource
 from .plant_side import ModifiedPlant, PlantParty, StaticPlant, TokenPlant
@@ -72,5 +73,5 @@ SCHEMES: dict[str, Scheme] = {
 def get_scheme(name: Any) -> Scheme:
     """The scheme ``name`` of :data:`SCHEMES`; an unknown name raises :class:`ParameterError`."""
     if not isinstance(name, str) or name not in SCHEMES:
-        raise ParameterError(f"unknown scheme {name!r}; choose one of {', '.join(SCHEMES)}")
+        raise ParameterError(f"unknown scheme {format_value(name)}; choose one of {', '.join(SCHEMES)}")
     return SCHEMES[name]

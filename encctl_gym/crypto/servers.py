@@ -25,6 +25,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
+from .._validation import format_value
 from ..errors import CiphertextError, KeyMismatchError, ParameterError
 from . import arith
 from .arith import RngLike
@@ -47,7 +48,12 @@ def _parameter_ciphertexts(pk: PublicKey, ct_phi: Sequence[Sequence[Ciphertext]]
 
 def _state_ciphertexts(pk: PublicKey, ct_xi: Any, beta: int, step: int | None) -> list[Ciphertext]:
     """The ``beta`` state ciphertexts, each checked (group, components in G, and ``step`` if given)."""
-    cts = [ct_xi] if isinstance(ct_xi, Ciphertext) else list(ct_xi)
+    try:
+        cts = [ct_xi] if isinstance(ct_xi, Ciphertext) else list(ct_xi)
+    except TypeError:
+        raise CiphertextError(
+            f"the state ciphertexts must be a sequence of {beta} Ciphertext, got {format_value(ct_xi)}"
+        ) from None
     if len(cts) != beta:
         raise CiphertextError(f"expected {beta} state ciphertexts, got {len(cts)}")
     for c in cts:
@@ -210,7 +216,7 @@ class TokenControllerServer(StaticControllerServer):
             If the token is not for the server's current step.
         """
         if not isinstance(token, UpdateToken):
-            raise ParameterError(f"token must be an UpdateToken, got {token!r}")
+            raise ParameterError(f"token must be an UpdateToken, got {format_value(token)}")
         if token.t is not None and token.t != self.t:
             raise KeyMismatchError(f"token is for step t = {token.t}, server is at step t = {self.t}")
         self._ct_phi = [[ciphertext_update(self._pk, c, token, self._rng) for c in row] for row in self._ct_phi]

@@ -112,10 +112,13 @@ def default_config() -> dict[str, Any]:
     ``logdet_regularization``     delta of ``G + delta I`` in the Gram-matrix rewards
                                   (``logdet``, ``a_optimality``)
     ``crypto``                    ``"ideal"`` (exact arithmetic, no big integers) or ``"elgamal"``
-    ``delta``                     encoder scaling factor Delta (Definition def:ec)
-    ``x_bound``                   declared state range of the encoder (overflow raises)
+    ``delta``                     encoder scaling factor Delta (Definition def:ec), an integer
+                                  in 2 .. 2^53
+    ``x_bound``                   declared state range of the encoder (overflow raises); the
+                                  ideal backend tabulates |round(Delta v)| up to 2^24
+                                  (``MAX_TABLE_LIMIT``): Delta * max(x_bound, u_max) must stay below
     ``action_scale``              actuator bound in units of sigma_u: a = action * scale * sigma_u
-    ``input_history``             number of own past inputs in the observation
+    ``input_history``             number of own past inputs in the observation (at most 64)
     ``gamma_opt``                 compute gamma_opt(N) of the optimal attack design for info
     ``crypto_seed``               seed of the crypto randomness (``None``: secure source)
     ============================  ==============================================================
@@ -238,6 +241,15 @@ class AttackParams:
 #: plant forgets x_0 geometrically fast under it, so more is never needed.
 MAX_WARMUP_STEPS = 100_000
 
+#: Most own past inputs in the observation (``input_history``): the observation holds
+#: ``input_history * m`` entries, shifted every step, and the compiled kernels are specialised
+#: (unrolled) for each length, so that a longer history costs compile time at the first step.
+MAX_INPUT_HISTORY = 64
+
+#: Largest encoder scaling factor Delta: the loop's arithmetic holds ``Delta`` and the quantised
+#: values ``round(Delta x)`` in float64 and int64, exact only up to 2^53.
+MAX_DELTA = 2**53
+
 #: Values taken from the preset, the package's defaults or the configuration, by key
 #: (:attr:`AttackParams.sources`).
 SOURCE_KEYS = ("A", "B", "sigma_w2", "sigma_x2", "sigma_u2", "upsilon", "tau_c", "gamma_c")
@@ -285,19 +297,19 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         A budget too small to identify anything (fewer than n + m + 1 samples).
     """
     if config is not None and not isinstance(config, Mapping):
-        raise ConfigError(f"config must be a mapping of configuration keys to values, got {config!r}")
+        raise ConfigError(f"config must be a mapping of configuration keys to values, got {format_value(config)}")
     cfg = default_config()
     merged = dict(config or {})
     merged.update(kwargs)
     unknown = sorted(set(merged) - set(cfg), key=str)
     if unknown:
-        raise ParameterError(f"unknown configuration key(s) {unknown}; known keys: {sorted(cfg)}")
+        raise ParameterError(f"unknown configuration key(s) {format_value(unknown)}; known keys: {sorted(cfg)}")
     cfg.update(merged)
     if ("A" in merged or "B" in merged) and "preset" not in merged:
         cfg["preset"] = None  # a plant of the user's is not silently completed from the default preset
     name = cfg["preset"]
     if name is not None and not isinstance(name, str):
-        raise ParameterError(f"preset must be a preset name or None, got {name!r}")
+        raise ParameterError(f"preset must be a preset name or None, got {format_value(name)}")
     preset = get_preset(name) if name is not None else None
     if preset is None and (cfg["A"] is None or cfg["B"] is None):
         raise ParameterError("without a preset, both A and B must be given")
@@ -416,16 +428,29 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     delay = cfg["decipher_delay"]
     if isinstance(delay, str):
         if delay != "end":
-            raise ParameterError(f"decipher_delay must be a non-negative integer or 'end', got {delay!r}")
+            raise ParameterError(f"decipher_delay must be a non-negative integer or 'end', got {format_value(delay)}")
         delay_v: int | None = None
     else:
         delay_v = check_int("decipher_delay", delay, minimum=0)
     warmup = check_int("warmup_steps", cfg["warmup_steps"], minimum=0)
     if warmup > MAX_WARMUP_STEPS:
-        raise ParameterError(f"warmup_steps must be <= {MAX_WARMUP_STEPS} (MAX_WARMUP_STEPS), got {warmup}")
+        raise ParameterError(f"warmup_steps must be <= {MAX_WARMUP_STEPS} (MAX_WARMUP_STEPS), got {format_value(warmup)}")
+    input_history = check_int("input_history", cfg["input_history"], minimum=0)
+    if input_history > MAX_INPUT_HISTORY:
+        raise ParameterError(
+            f"input_history must be <= {MAX_INPUT_HISTORY} (MAX_INPUT_HISTORY), got {format_value(input_history)}"
+        )
 
     delta = check_int("delta", cfg["delta"], minimum=2)
+    if delta > MAX_DELTA:
+        raise ParameterError(f"delta must be <= 2^53 (MAX_DELTA: exact in float64), got {format_value(delta)}")
     action_scale = check_positive("action_scale", cfg["action_scale"])
+    u_max = action_scale * math.sqrt(sigma_u2)
+    if not math.isfinite(u_max):
+        raise ParameterError(
+            f"action_scale * sqrt(sigma_u2) (the actuator bound u_max) must be finite, got action_scale = "
+            f"{format_value(action_scale)} and sigma_u2 = {format_value(sigma_u2)}"
+        )
     crypto_seed = cfg["crypto_seed"]
     if crypto_seed is not None:
         crypto_seed = check_int("crypto_seed", crypto_seed, minimum=0)
@@ -458,8 +483,8 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         crypto=crypto,
         delta=delta,
         x_bound=check_positive("x_bound", cfg["x_bound"]),
-        u_max=action_scale * math.sqrt(sigma_u2),
-        input_history=check_int("input_history", cfg["input_history"], minimum=0),
+        u_max=u_max,
+        input_history=input_history,
         gamma_opt=check_bool("gamma_opt", cfg["gamma_opt"]),
         crypto_seed=crypto_seed,
         breaker=breaker,

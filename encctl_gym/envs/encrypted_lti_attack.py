@@ -8,6 +8,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from .._validation import format_value
 from ..errors import ParameterError
 from ..loop import LoopBackend, make_loop
 from .config import AttackParams, default_config, resolve_params
@@ -24,7 +25,7 @@ def check_seed(seed: Any) -> int | None:
     if seed is None:
         return None
     if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ParameterError(f"seed must be None or a non-negative integer, got {seed!r}")
+        raise ParameterError(f"seed must be None or a non-negative integer, got {format_value(seed)}")
     return int(seed)
 
 
@@ -39,10 +40,10 @@ def reset_options(options: dict[str, Any] | None) -> dict[str, Any]:
     if options is None:
         return {}
     if not isinstance(options, dict):
-        raise ParameterError(f"reset options must be a dict, got {options!r}")
+        raise ParameterError(f"reset options must be a dict, got {format_value(options)}")
     unknown = sorted(set(options) - set(RESET_OPTIONS))
     if unknown:
-        raise ParameterError(f"unknown reset option(s) {unknown}; known: {list(RESET_OPTIONS)}")
+        raise ParameterError(f"unknown reset option(s) {format_value(unknown)}; known: {list(RESET_OPTIONS)}")
     return dict(options)
 
 
@@ -182,14 +183,16 @@ class EncryptedLTIAttackEnv(gym.Env):
     ) -> None:
         self.params: AttackParams = resolve_params(config, **kwargs)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ParameterError(f"unknown render_mode {render_mode!r}; choose one of {self.metadata['render_modes']}")
+            raise ParameterError(
+                f"unknown render_mode {format_value(render_mode)}; choose one of {self.metadata['render_modes']}"
+            )
         self.render_mode = render_mode
         p = self.params
         check_episode_memory(p, 1, schedule)  # before anything is sized by the parameters
+        self._loop = make_loop(p)  # refuses a loop it cannot build (the quantisation table) before the spaces are sized
         self.action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
         self.observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
         self.design = attack_design_for(p) if p.gamma_opt else None
-        self._loop = make_loop(p)
         self._core = EpisodeCore(p, self._loop, self.design, schedule=schedule)
 
     @staticmethod

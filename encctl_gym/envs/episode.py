@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import as_finite_array, check_int, check_positive
+from .._validation import as_finite_array, check_int, check_positive, format_value
 from ..errors import EncodingOverflowError, ParameterError, ShapeError
 from ..ident.ordinary import OrdinaryLeastSquares
 from ..ident.registry import make_estimator
@@ -109,7 +109,7 @@ def episode_bytes(params: AttackParams, num_envs: int, schedule: EpisodeSchedule
     )
     generators = 2048  # a numpy Generator with its bit generator, per copy
     tables = 4 * (N + 1)
-    return int(1.5 * (8 * (K * per_copy + tables) + K * generators))
+    return 3 * (8 * (K * per_copy + tables) + K * generators) // 2  # integers: exact for any K
 
 
 def check_episode_memory(
@@ -119,7 +119,7 @@ def check_episode_memory(
     :data:`encctl_gym.resources.MEMORY_LIMIT`), before anything is allocated."""
     p = params
     check_memory(
-        f"an episode of num_envs = {num_envs} copies, horizon N = {p.horizon}, n = {p.n}, m = {p.m}, "
+        f"an episode of num_envs = {format_value(num_envs)} copies, horizon N = {p.horizon}, n = {p.n}, m = {p.m}, "
         f"input_history = {p.input_history}",
         episode_bytes(p, num_envs, schedule),
         memory_limit,
@@ -603,11 +603,11 @@ class EpisodeCore:
         if not (isinstance(a, np.ndarray) and a.dtype.char in "fd"):  # float32 and float64 are read as they are
             try:
                 a = np.asarray(a)
-                if a.dtype.kind not in "biuf":
+                if a.dtype.kind not in "iuf":  # booleans, complex numbers, strings and objects are refused
                     raise TypeError(a.dtype)
                 a = a.astype(np.float64)
-            except (TypeError, ValueError):
-                raise ParameterError(f"action must be a real numeric array, got {action!r}") from None
+            except (TypeError, ValueError, OverflowError):
+                raise ParameterError(f"action must be a real numeric array, got {format_value(action)}") from None
         if a.ndim < 2:
             a = a.reshape(1, -1)
         if a.shape != (self.K, self.m):

@@ -136,11 +136,18 @@ class AOptimalityReward(GramReward):
     sign = -1.0
 
     def initial(self) -> float:
-        return math.log(self._d / self._delta)
+        ratio = self._d / self._delta
+        # a subnormal delta makes d / delta overflow: the same log, as a difference
+        return math.log(ratio) if math.isfinite(ratio) else math.log(self._d) - math.log(self._delta)
 
     def measure(self, G: np.ndarray) -> np.ndarray:
         lam = np.clip(np.linalg.eigvalsh(G), 0.0, None)  # G is PSD; clip rounding below 0
-        return np.log((1.0 / (lam + self._delta)).sum(axis=-1))
+        with np.errstate(divide="ignore", over="ignore"):
+            value = np.log((1.0 / (lam + self._delta)).sum(axis=-1))
+        bad = ~np.isfinite(value)
+        if bad.any():  # 1 / (0 + delta) overflows for a subnormal delta: log-sum-exp of -log(lam + delta)
+            value[bad] = np.logaddexp.reduce(-np.log(lam[bad] + self._delta), axis=-1)
+        return value
 
 
 #: Rewards by the name the ``reward`` configuration key gives.

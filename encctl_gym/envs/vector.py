@@ -18,7 +18,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from .._validation import check_int
+from .._validation import check_int, format_value
 from ..errors import ParameterError
 from ..loop import make_loop
 from .config import AttackParams, resolve_params
@@ -78,11 +78,20 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         self.num_envs = check_int("num_envs", num_envs, minimum=1)
         self.params: AttackParams = resolve_params(config, **kwargs)
         if self.params.crypto != "ideal":
-            raise ParameterError(f"the vector environment batches the ideal backend only, got crypto={self.params.crypto!r}")
+            raise ParameterError(
+                f"the vector environment batches the ideal backend only, got crypto={format_value(self.params.crypto)}"
+            )
         if max_episode_steps is not None:
-            raise ParameterError("the attack length is set by tau_c or max_samples, not max_episode_steps")
+            raise ParameterError(
+                f"the attack length is set by tau_c or max_samples, not max_episode_steps (got {format_value(max_episode_steps)})"
+            )
         p = self.params
         check_episode_memory(p, self.num_envs, schedule, memory_limit)  # before anything is sized by the parameters
+        if not isinstance(parallel, (bool, np.bool_)):
+            raise ParameterError(f"parallel must be a bool, got {format_value(parallel)}")
+        if not isinstance(helper_thread, (bool, np.bool_, HelperThread)):
+            raise ParameterError(f"helper_thread must be a bool or a HelperThread, got {format_value(helper_thread)}")
+        loop = make_loop(p)  # refuses a loop it cannot build (the quantisation table) before the spaces are sized
         self.single_action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
         self.single_observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
@@ -90,15 +99,11 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         self.design = attack_design_for(p) if p.gamma_opt else None
         if isinstance(helper_thread, HelperThread):
             self.helper: HelperThread | None = helper_thread
-        elif isinstance(helper_thread, bool):
-            self.helper = HelperThread() if helper_thread else None
         else:
-            raise ParameterError(f"helper_thread must be a bool or a HelperThread, got {helper_thread!r}")
-        if not isinstance(parallel, bool):
-            raise ParameterError(f"parallel must be a bool, got {parallel!r}")
+            self.helper = HelperThread() if helper_thread else None
         self._core = EpisodeCore(
             p,
-            make_loop(p),
+            loop,
             self.design,
             num_envs=self.num_envs,
             parallel=parallel,

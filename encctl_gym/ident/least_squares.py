@@ -25,8 +25,9 @@ from typing import Any, Literal
 
 import numpy as np
 
-from .._validation import as_finite_array, check_int, check_system
+from .._validation import as_finite_array, check_int, check_system, format_value
 from ..errors import ParameterError, ShapeError
+from ..resources import check_memory
 from .error import estimation_error
 
 __all__ = [
@@ -176,8 +177,17 @@ def solve_normal_equations(G: Any, C: Any) -> tuple[np.ndarray, np.ndarray]:
         Cholesky factorisation, or a Jacobi-scaled reciprocal condition number (estimated from
         the Cholesky factor) below ``d * eps``.
     """
-    G = np.asarray(G, dtype=np.float64)
-    C = np.asarray(C, dtype=np.float64)
+    G = as_finite_array("G", G)
+    C = as_finite_array("C", C)
+    if G.ndim < 2 or G.shape[-1] != G.shape[-2]:
+        raise ShapeError(f"G must be a stack of square matrices (..., d, d), got shape {G.shape}")
+    if C.shape[:-1] != G.shape[:-1]:
+        raise ShapeError(f"C must have shape {(*G.shape[:-1], 'k')} to match G of shape {G.shape}, got {C.shape}")
+    return _solve_normal_equations(G, C)
+
+
+def _solve_normal_equations(G: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`solve_normal_equations` for checked float64 arrays (the package's own callers)."""
     lead, d, k = G.shape[:-2], G.shape[-1], C.shape[-1]
     Gf = G.reshape(-1, d, d)
     Cf = C.reshape(-1, d, k)
@@ -240,6 +250,11 @@ class RecursiveLeastSquares:
         self.n = check_int("n", n, minimum=1)
         self.m = check_int("m", m, minimum=1)
         self._d = self.n + self.m
+        check_memory(
+            f"recursive least squares for n = {format_value(self.n)}, m = {format_value(self.m)}",
+            8 * (self._d + self.n) * (self._d + self.n + self.BLOCK),
+            advice="the Gram matrix has (2 n + m)^2 entries",
+        )
         # M = sum_t v_t v_t^T with v_t = [x_t; u_t; x_{t+1}]: G = M[:d, :d], C = M[:d, d:].
         self._M = np.zeros((self._d + self.n, self._d + self.n))
         self._buf = np.empty((self.BLOCK, self._d + self.n))
@@ -297,14 +312,13 @@ class RecursiveLeastSquares:
                 f"{np.shape(x_t)}, {np.shape(u_t)}, {np.shape(x_next)}"
             )
         row = self._buf[self._k]
-        try:
-            row[:n] = x_t
-            row[n:d] = u_t
-            row[d:] = x_next
-        except (TypeError, ValueError):
-            raise ParameterError("update expects numeric x_t, u_t and x_next") from None
-        if not np.isfinite(row).all():
-            raise ParameterError("update got non-finite entries in x_t, u_t or x_next")
+        for name, value, part in (("x_t", x_t, slice(None, n)), ("u_t", u_t, slice(n, d)), ("x_next", x_next, slice(d, None))):
+            kind = value.dtype.kind if isinstance(value, np.ndarray) else np.asarray(value).dtype.kind
+            if kind not in "iuf":  # complex, boolean, string and object data are never cast
+                raise ParameterError(f"update expects a real numeric {name}, got {format_value(value)}")
+            row[part] = value
+            if not np.isfinite(row[part]).all():
+                raise ParameterError(f"update expects finite entries in {name}, got {format_value(value)}")
         self._k += 1
         self._count += 1
         self._cache = None
@@ -334,7 +348,7 @@ class RecursiveLeastSquares:
         G, C = self._M[:d, :d], self._M[:d, d:]
         if not np.all(np.diag(G) > 0):
             raise ParameterError("the regressor Gram matrix is singular (a regressor has been identically zero)")
-        theta, ok = solve_normal_equations(G, C)
+        theta, ok = _solve_normal_equations(G, C)
         if not ok:
             raise ParameterError("the regressor Gram matrix is numerically singular: the data do not excite all of [x; u]")
         self._cache = (np.ascontiguousarray(theta[:, : self.n]), np.ascontiguousarray(theta[:, self.n :]))

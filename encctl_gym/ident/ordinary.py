@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .estimator import MomentEstimator
-from .least_squares import least_squares, prefix_estimates, solve_normal_equations
+from .least_squares import _solve_normal_equations, least_squares, prefix_estimates
 
 __all__ = ["OrdinaryLeastSquares", "gram_solve"]
 
@@ -31,7 +31,7 @@ def gram_solve(M: np.ndarray, n: int, m: int) -> np.ndarray:
     """
     d = n + m
     G, C = M[..., :d, :d], M[..., :d, d:]
-    theta, ok = solve_normal_equations(G, C)
+    theta, ok = _solve_normal_equations(G, C)
     if not np.all(ok):
         bad = ~ok
         theta[bad] = np.swapaxes(np.linalg.pinv(G[bad], hermitian=True) @ C[bad], -1, -2)

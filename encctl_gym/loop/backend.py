@@ -22,6 +22,8 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 import scipy.linalg
 
+from .._validation import format_value
+from ..errors import ResourceLimitError
 from .quantize import Quantization
 
 __all__ = ["LoopBackend", "lqr_gain", "table_limit", "loop_group"]
@@ -73,9 +75,21 @@ def lqr_gain(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 
 
 def table_limit(params: Any, Phi: np.ndarray) -> int:
-    """Largest ``|round(Delta v)|`` the loop must quantise: states, inputs, controller entries."""
+    """Largest ``|round(Delta v)|`` the loop must quantise: states, inputs, controller entries.
+
+    Raises
+    ------
+    ResourceLimitError
+        If ``Delta * max(x_bound, u_max, |Phi|)`` is not a finite float (nothing could quantise it).
+    """
     span = max(params.x_bound, params.u_max, float(np.abs(Phi).max()) if Phi.size else 0.0, 1.0)
-    return int(math.ceil(params.delta * span)) + 1
+    scaled = float(params.delta) * span
+    if not math.isfinite(scaled):
+        raise ResourceLimitError(
+            f"the loop would quantise values up to Delta * max(x_bound, u_max, |Phi|) = {format_value(params.delta)} * "
+            f"{format_value(span)}, beyond the float range; use a smaller delta, x_bound or action_scale"
+        )
+    return int(math.ceil(scaled)) + 1
 
 
 def loop_group(key_length: int) -> Any:

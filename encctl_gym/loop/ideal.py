@@ -15,11 +15,18 @@ from typing import Any
 
 import numpy as np
 
+from .._validation import format_value
 from ..errors import EncodingOverflowError, ResourceLimitError
 from .backend import lqr_gain, table_limit
 from .quantize import OK, Quantization, collect_states, forge_inputs
 
-__all__ = ["IdealLoop"]
+__all__ = ["IdealLoop", "MAX_TABLE_LIMIT"]
+
+#: Largest ``|round(Delta v)|`` the ideal backend tabulates (:func:`~encctl_gym.loop.backend.table_limit`):
+#: the table is built when the environment is made, at about a second per 10^6 entries on the
+#: development machine, so 2^24 bounds that to seconds (the default x_bound = 256 and Delta = 4096
+#: need about 2^20).
+MAX_TABLE_LIMIT = 2**24
 
 
 class IdealLoop:
@@ -45,6 +52,13 @@ class IdealLoop:
         self.n, self.m = params.n, params.m
         self.Phi = -lqr_gain(params.A, params.B)
         limit = table_limit(params, self.Phi)
+        if limit > MAX_TABLE_LIMIT:
+            raise ResourceLimitError(
+                f"the quantisation table for x_bound = {format_value(params.x_bound)}, Delta = {format_value(params.delta)}, "
+                f"u_max = {params.u_max:.4g} would tabulate |round(Delta v)| <= {format_value(limit)}, above "
+                f"MAX_TABLE_LIMIT = 2^{MAX_TABLE_LIMIT.bit_length() - 1} (the table is built when the environment is made); "
+                "use a smaller x_bound or delta"
+            )
         try:
             self.table = residue_table(group, limit)
         except ResourceLimitError as exc:

@@ -16,15 +16,19 @@ from typing import Any, Literal
 
 import numpy as np
 
-from .._validation import check_int, check_nonnegative
+from .._validation import check_int, check_nonnegative, format_value
 from ..errors import ParameterError
 from ..ident.estimator import check_grid
 from ..ident.least_squares import check_sample_sizes, identification_errors
 from ..ident.registry import make_estimator
 from ..parallel import SeedLike, run_tasks
+from ..resources import check_memory
 from .plant import LinearPlant, simulate_gaussian_attack
 
 __all__ = ["AttackSpec", "gaussian_attack_errors", "sweep_gaussian_attack", "log_grid"]
+
+
+_N_MAX = 2**53  # the grid is spaced in float64 and rounded: integers beyond 2^53 are not exact
 
 
 def log_grid(N_min: int, N_max: int, points: int) -> np.ndarray:
@@ -33,7 +37,8 @@ def log_grid(N_min: int, N_max: int, points: int) -> np.ndarray:
     Parameters
     ----------
     N_min, N_max
-        First and last sample size (``2 <= N_min <= N_max``).
+        First and last sample size (``2 <= N_min <= N_max <= 2^53``: the grid is spaced in
+        float64, exact for integers up to 2^53).
     points
         Requested number of points (>= 1); rounding may merge a few at the low end.
 
@@ -43,8 +48,9 @@ def log_grid(N_min: int, N_max: int, points: int) -> np.ndarray:
         Strictly increasing, starting at ``N_min`` and ending at ``N_max``.
     """
     N_min = check_int("N_min", N_min, minimum=2)
-    N_max = check_int("N_max", N_max, minimum=N_min)
+    N_max = check_int("N_max", N_max, minimum=N_min, maximum=_N_MAX)
     points = check_int("points", points, minimum=1)
+    check_memory(f"a grid of points = {format_value(points)}", 3 * 8 * points, advice="ask for fewer points")
     if points == 1:
         return np.array([N_max], dtype=np.int64)
     return np.unique(np.round(np.geomspace(N_min, N_max, points)).astype(np.int64))

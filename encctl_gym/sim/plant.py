@@ -25,9 +25,10 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import as_finite_array, check_int, check_nonnegative, check_positive, check_system
+from .._validation import as_finite_array, check_int, check_nonnegative, check_positive, check_system, format_value
 from ..errors import ParameterError, ShapeError
 from ..parallel import SeedLike, as_seed_sequence
+from ..resources import check_memory
 
 Size = int | tuple[int, ...] | None
 """A batch shape for drawn states and noise (``None``: one draw)."""
@@ -250,6 +251,12 @@ def simulate_gaussian_attack(plant: LinearPlant, *, N: int, runs: int, sigma_u2:
     N = check_int("N", N, minimum=1)
     runs = check_int("runs", runs, minimum=1)
     su = float(np.sqrt(check_nonnegative("sigma_u2", sigma_u2)))
+    n, m = plant.n, plant.m
+    check_memory(
+        f"a Gaussian attack of runs = {format_value(runs)} trajectories of N = {format_value(N)} samples (n = {n}, m = {m})",
+        2 * 8 * runs * (N * (2 * n + m) + n),  # noise, inputs and states, and as much again while they are made
+        advice="use fewer runs or a shorter N",
+    )
     n, m = plant.n, plant.m
     x0 = np.empty((runs, n))
     w = np.empty((runs, N - 1, n))

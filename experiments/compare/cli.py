@@ -23,7 +23,8 @@ import sys
 from pathlib import Path
 from typing import Sequence
 
-from agents.runs import find_runs
+from agents.runs import MODEL_FILES, check_output_dir, find_runs
+from encctl_gym._validation import format_value
 from encctl_gym.errors import ConfigError
 
 from .attackers import ATTACKERS
@@ -33,7 +34,7 @@ from .report import summary_markdown
 from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, parse_delays
 from .tables import write_csvs
 
-__all__ = ["QUICK_SYSTEMS", "QUICK_CAP", "QUICK_EPISODES", "add_arguments", "run", "main", "write_outputs", "positive", "names"]
+__all__ = ["QUICK_SYSTEMS", "QUICK_CAP", "QUICK_EPISODES", "MAX_COUNT", "add_arguments", "run", "main", "write_outputs", "positive", "names"]
 
 QUICK_SYSTEMS = ("paper-example",)
 QUICK_CAP = 60
@@ -43,10 +44,16 @@ FULL_EPISODES = 50
 FULL_POINTS = 10
 
 
-def positive(name: str, value: int | None, minimum: int = 1) -> int | None:
-    """A command-line count checked against its minimum (``None`` passes: the default applies)."""
+#: Largest count on the command line: attack lengths, episodes and grid sizes are int64 arrays.
+MAX_COUNT = 2**63 - 1
+
+
+def positive(name: str, value: int | None, minimum: int = 1, maximum: int = MAX_COUNT) -> int | None:
+    """A command-line count checked against its range (``None`` passes: the default applies)."""
     if value is not None and value < minimum:
-        raise ConfigError(f"--{name} must be >= {minimum}, got {value}")
+        raise ConfigError(f"--{name} must be >= {minimum}, got {format_value(value)}")
+    if value is not None and value > maximum:
+        raise ConfigError(f"--{name} must be <= {maximum}, got {format_value(value)}")
     return value
 
 
@@ -71,7 +78,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"comma-separated registered attackers (default all: {','.join(ATTACKERS)}); learned ones come from --runs")
     parser.add_argument("--max-samples", type=int, default=None, help=f"evaluation cap on N (default {DEFAULT_CAP})")
     parser.add_argument("--points", type=int, default=None,
-                        help=f"attack lengths N on the log grid of every curve, in every setting (default {FULL_POINTS}; quick {QUICK_POINTS})")
+                        help=f"attack lengths N on the log grid of every curve, in every setting, at most --max-samples "
+                        f"(default {FULL_POINTS}; quick {QUICK_POINTS})")
     parser.add_argument("--runs", action="append", default=[], help="training run directory or a parent of runs (repeatable; "
                         "default results/train if it exists)")
     parser.add_argument("--which", choices=("best", "final"), default="best",
@@ -95,15 +103,19 @@ def write_outputs(result: Result, out: Path, *, command: str, title: str | None 
 def run(args: argparse.Namespace) -> int:
     """Run, write CSV, PNG and summary.md; print the summary."""
     quick = args.quick
-    systems = names(args.systems, "systems") if args.systems else (QUICK_SYSTEMS if quick else DEFAULT_SYSTEMS)
-    delays = parse_delays(args.delays) if args.delays else DELAYS
-    attackers = names(args.attackers, "attackers") if args.attackers else tuple(ATTACKERS)
+    # an empty list given on the command line is an error, not the default
+    systems = names(args.systems, "systems") if args.systems is not None else (QUICK_SYSTEMS if quick else DEFAULT_SYSTEMS)
+    delays = parse_delays(args.delays) if args.delays is not None else DELAYS
+    attackers = names(args.attackers, "attackers") if args.attackers is not None else tuple(ATTACKERS)
     episodes = positive("episodes", args.episodes) or (QUICK_EPISODES if quick else FULL_EPISODES)
     cap = positive("max-samples", args.max_samples, 2) or (QUICK_CAP if quick else DEFAULT_CAP)
-    points = positive("points", args.points) or (QUICK_POINTS if quick else FULL_POINTS)
+    points = positive("points", args.points, 1, cap) or (QUICK_POINTS if quick else FULL_POINTS)
     positive("elgamal-episodes", args.elgamal_episodes, 0)
+    check_output_dir(args.out)  # before the work, not after it
     roots = args.runs or (["results/train"] if Path("results/train").exists() and not quick else [])
     runs = find_runs(roots)
+    for r in runs:  # every model that may play is a readable archive, checked before the work
+        r.model_path(args.which if args.which == "final" or (r.path / MODEL_FILES["best"]).exists() else "final")
     result = compute(systems, delays=delays, episodes=episodes, seed=args.seed, cap=cap, points=points, runs=runs,
                      which=args.which, elgamal_episodes=args.elgamal_episodes, elgamal_N=min(40, cap),
                      progress=not args.no_progress, attackers=attackers)

@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from agents import Attacker
-from agents.runs import RunInfo, read_run
+from agents.runs import MODEL_FILES, RunInfo, check_output_dir, read_run
 from agents.sb3 import load_attacker  # the [rl] extra: without it the CLI says which extra to install
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ConfigError
@@ -110,19 +110,20 @@ def run(args: argparse.Namespace) -> int:
     if args.deterministic:
         print("encctl-gym evaluate: warning: --deterministic plays the policy's mean action; its noise is its excitation, "
               "and without it a state-feedback policy leaves [x; u] nearly rank deficient (expect a larger error)", file=sys.stderr)
-    systems = names(args.systems, "systems") if args.systems else None
-    delays = parse_delays(args.delays) if args.delays else None
+    systems = names(args.systems, "systems") if args.systems is not None else None  # an empty list is an error
+    delays = parse_delays(args.delays) if args.delays is not None else None
     settings = run_settings(info, systems, delays, length)
+    which = args.which if args.which == "final" or (info.path / MODEL_FILES["best"]).exists() else "final"
+    info.model_path(which)  # a readable archive, checked before the work
+    out = check_output_dir(Path(args.out) if args.out else info.path / "evaluation")
 
     def learned(setting: Setting) -> list[Attacker]:
-        w = args.which if args.which == "final" or (info.path / "best_model.zip").exists() else "final"
         label = info.algo + ("-blind" if info.observation == "blind" else "")
-        return [load_attacker(info.path, which=w, params=setting.params, name=label, deterministic=args.deterministic)]
+        return [load_attacker(info.path, which=which, params=setting.params, name=label, deterministic=args.deterministic)]
 
     result = compute(settings=settings, episodes=episodes, seed=args.seed, points=args.points, attackers=BASELINES,
                      elgamal_episodes=args.elgamal_episodes, elgamal_N=min(40, min(s.params.horizon for s in settings)),
                      progress=not args.no_progress, players=learned)
-    out = Path(args.out) if args.out else info.path / "evaluation"
     cmd = [f"encctl-gym evaluate {info.path}", f"--episodes {episodes}", f"--seed {args.seed}", f"--points {args.points}",
            f"--which {args.which}", "--full-budget" if length is None else f"--samples {length}"]
     if systems:

@@ -32,14 +32,16 @@ import numpy as np
 from agents import Attacker, GaussianAttacker, rollout
 from agents.evaluate import budget_config, elgamal_config
 from agents.runs import RunInfo, read_run
+from encctl_gym._validation import format_value
 from encctl_gym.envs.config import resolve_params
+from encctl_gym.resources import check_memory
 from encctl_gym.sim.montecarlo import log_grid
 
 from .attackers import ATTACKERS, learned_attackers, make_attackers
 from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, Setting, length_grid, make_setting
 from .statistics import mean_se
 
-__all__ = ["Curve", "evaluate", "planned_steps", "elgamal_check", "Result", "compute"]
+__all__ = ["Curve", "evaluate", "planned_steps", "record_bytes", "elgamal_check", "Result", "compute"]
 
 #: The name the Gaussian baseline plays under (the reference of the paired ratios).
 GAUSSIAN_NAME = GaussianAttacker.name
@@ -132,6 +134,19 @@ def planned_steps(setting: Setting, n_attackers: int, episodes: int, points: int
     padded = batch * math.ceil(episodes / batch)  # rollout plays whole batches
     per = int(length_grid(setting.params, points).sum())
     return n_attackers * per * padded
+
+
+def record_bytes(plan: Sequence[tuple[Setting, Sequence[Attacker]]], episodes: int, points: int) -> int:
+    """Estimated bytes of what :func:`compute` keeps per episode (float64): each curve's errors at
+    every grid point and its finals, and, with delivered states, the largest running record of one
+    full-length attack (error and energy at every step)."""
+    kept, along = 0, 0
+    for setting, atts in plan:
+        P = len(length_grid(setting.params, points))
+        kept += 8 * episodes * (P + 2) * len(atts)
+        if setting.params.decipher_delay is not None:
+            along = max(along, 16 * episodes * setting.params.horizon)
+    return kept + along
 
 
 def elgamal_check(setting: Setting, attacker: Attacker, *, episodes: int, N: int, seed: int, key_length: int = 64) -> list[dict[str, Any]]:
@@ -233,6 +248,12 @@ def compute(
         Ready settings (then ``systems``, ``delays``, ``cap`` and ``configs`` are not used).
     players : callable, optional
         Further attackers for a setting (played after the learned ones of ``runs``).
+
+    Raises
+    ------
+    ResourceLimitError
+        If the per-episode records (:func:`record_bytes`) would exceed
+        :data:`encctl_gym.resources.MEMORY_LIMIT`, before any episode is played.
     """
     from .tables import bound_rows, security_row
 
@@ -242,9 +263,13 @@ def compute(
         cfgs = dict(configs or {})
         settings = [make_setting(s, d, cap, config=cfgs.get(s)) for s in systems for d in delays]
     settings = list(settings)
+    for s in settings:  # the grid of every setting is checked before any attacker is built or loaded
+        length_grid(s.params, points)
     plan = [(s, [*make_attackers(s, attackers), *learned_attackers(s, infos, which, deterministic=deterministic),
                  *(players(s) if players is not None else ())]) for s in settings]
     total = sum(planned_steps(s, len(a), episodes, points) for s, a in plan)
+    check_memory(f"keeping the per-episode records of episodes = {format_value(episodes)} over {len(plan)} setting(s) at points = "
+                 f"{format_value(points)}", record_bytes(plan, episodes, points), advice="use fewer episodes")
     bar = None
     if progress:
         from tqdm import tqdm

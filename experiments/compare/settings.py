@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from agents.evaluate import budget_config
+from encctl_gym._validation import format_value
 from encctl_gym.envs.config import AttackParams, resolve_params
 from encctl_gym.errors import ConfigError
 from encctl_gym.security.attack_design import AttackDesign, gaussian_attack_design, optimal_attack_design
@@ -108,7 +109,17 @@ def make_setting(system: str, delay: Any, cap: int | None, *, config: dict[str, 
 
 
 def length_grid(params: AttackParams, points: int) -> np.ndarray:
-    """Attack lengths of the curves: a log grid of ``points`` sizes from ``2 (n + m) + 1`` to the horizon."""
+    """Attack lengths of the curves: a log grid of ``points`` sizes from ``2 (n + m) + 1`` to the horizon.
+
+    Raises
+    ------
+    ConfigError
+        If ``points`` exceeds the horizon N: a grid of distinct lengths up to N has at most N
+        points (and a larger request would allocate its float grid before merging it).
+    """
+    if isinstance(points, (int, np.integer)) and not isinstance(points, bool) and points > params.horizon:
+        raise ConfigError(f"points = {format_value(points)} attack lengths exceed the horizon N = {params.horizon}: "
+                          f"a grid of distinct lengths up to N has at most N points")
     return log_grid(min(2 * (params.n + params.m) + 1, params.horizon), params.horizon, points)
 
 

@@ -171,11 +171,31 @@ def _train() -> list[Case]:
                           timeout=90))
     for setting in ("policy_kwargs.activation_fn=bogus", "bogus.key=1", "env.max_samples=abc", "env.bogus=1", "hyperparams.gamma=2.5",
                     "hyperparams.learning_rate=-1", "noequals", "=1", "env.gamma_opt=maybe", "hyperparams.n_steps=0", "env.x_bound=2e4",
-                    "hyperparams.batch_size=" + "9" * 401, "n_timesteps=!!python/object/apply:os.getcwd []"):
+                    "hyperparams.batch_size=" + "9" * 401, "n_timesteps=!!python/object/apply:os.getcwd []",
+                    # found while fixing the above: seeds NumPy cannot take, counts no float holds, networks no memory holds
+                    "seed=4294967296", "eval.seed=" + "9" * 401, "horizon=" + "9" * 401, "eval.final_episodes=" + "9" * 401,
+                    "n_envs=" + "9" * 401, "eval.elgamal.key_length=100000", "hyperparams.policy_kwargs.net_arch=[100000000]"):
         out.append(_agent(f"train --set {setting[:40]}", lambda tmp, s=setting: [*_train_base(tmp), "--set", s], "silent", timeout=90))
     out.append(_agent("train --out an existing file", lambda tmp: [*_train_base(tmp)[:-1], _touch(tmp / "afile")], timeout=90))
     out.append(_agent("train --name ../escape", lambda tmp: [*_train_base(tmp), "--name", "../../escape"], "security", timeout=90))
     out.append(_agent("train --name /abs", lambda tmp: [*_train_base(tmp), "--name", "/tmp/encctl-probe-abs"], "security", timeout=90))
+    out += _tune()
+    return out
+
+
+def _tune() -> list[Case]:
+    """``tune`` (agents/tune.py) shares train's configuration and the CLI's one-line path."""
+    out: list[Case] = []
+    base = lambda tmp: ["tune", "--algo", "ars", "--preset", "small", "--quick", "--no-progress", "--out", tmp / "tune"]  # noqa: E731
+    out.append(_agent("tune --algo bogus", ["tune", "--algo", "bogus"]))
+    for opt, vals in (("--trials", ("0", "-1", "abc", "9" * 401)), ("--episodes", ("1", "abc", "9" * 401)),
+                      ("--seed", ("-1", "abc", "4294967296")), ("--n-timesteps", ("0", "9" * 401))):
+        for v in vals:
+            out.append(_agent(f"tune {opt} {v[:12]!r}", lambda tmp, o=opt, v=v: [*base(tmp), o, v], "silent", timeout=90))
+    for setting in ("bogus.key=1", "hyperparams.n_delta=0", "noequals"):
+        out.append(_agent(f"tune --set {setting}", lambda tmp, s=setting: [*base(tmp), "--set", s], "silent", timeout=90))
+    out.append(_agent("tune --config deep_nesting_yaml", lambda tmp: [*base(tmp), "--config", write_file(tmp, "deep_nesting_yaml")], timeout=90))
+    out.append(_agent("tune --out an existing file", lambda tmp: [*base(tmp)[:-1], _touch(tmp / "afile")], timeout=90))
     return out
 
 
@@ -222,7 +242,7 @@ def _evaluate() -> list[Case]:
                           timeout=90))
     good_meta = lambda tmp: _run_dir(tmp, _META, b"PK\x03\x04" + b"\x00" * 40)  # noqa: E731
     for opt, vals in (("--episodes", ("0", "-1", "abc")), ("--systems", ("bogus", "")), ("--delays", ("abc", "-1", "2.5", "")),
-                      ("--samples", ("0", "-1", "abc")), ("--points", ("0", "-1", "abc")), ("--seed", ("-1", "abc")),
+                      ("--samples", ("0", "-1", "abc", "9" * 401)), ("--points", ("0", "-1", "abc", "100000000")), ("--seed", ("-1", "abc")),
                       ("--elgamal-episodes", ("-1", "abc")), ("--which", ("bogus",))):
         for v in vals:
             out.append(_agent(f"evaluate {opt} {v!r}", lambda tmp, o=opt, v=v: ["evaluate", good_meta(tmp), o, v, "--no-progress", "--out", tmp / "ev"],
@@ -234,7 +254,7 @@ def _compare() -> list[Case]:
     out: list[Case] = []
     base = lambda tmp: ["compare", "--quick", "--episodes", "1", "--no-progress", "--elgamal-episodes", "0", "--out", tmp / "cmp"]  # noqa: E731
     for opt, vals in (("--delays", ("abc", "-1", "2.5", "", "0,abc")), ("--systems", ("bogus", "", "small,bogus")), ("--attackers", ("bogus", "", "gaussian,bogus")),
-                      ("--episodes", ("0", "-1", "abc")), ("--max-samples", ("0", "-1", "abc", "9" * 401)), ("--points", ("0", "-1", "abc", "100000000")),
+                      ("--episodes", ("0", "-1", "abc", "1000000000000")), ("--max-samples", ("0", "-1", "abc", "9" * 401)), ("--points", ("0", "-1", "abc", "100000000")),
                       ("--seed", ("-1", "abc")), ("--elgamal-episodes", ("-1", "abc")), ("--which", ("bogus",))):
         for v in vals:
             out.append(_agent(f"compare {opt} {v[:12]!r}", lambda tmp, o=opt, v=v: [*base(tmp), o, v], "silent", timeout=120))

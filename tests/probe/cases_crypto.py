@@ -381,38 +381,35 @@ def _cross_group_decrypt(_: Path) -> None:
     prop()
 
 
+def _refused(call: Any, finding: str) -> None:
+    """``call()`` must raise KeyMismatchError; a result is a :class:`SecurityFinding`."""
+    try:
+        out = call()
+    except api("encctl_gym.errors:KeyMismatchError"):
+        return
+    raise SecurityFinding(f"{finding} returned {out!r}")
+
+
 def _cross_group_modified(_: Path) -> None:
-    errors = api("encctl_gym.errors:KeyMismatchError")
     (pk_a, sk_a), (_, sk_b) = _other_group_keys()
     enc = api("encctl_gym.crypto.elgamal:encrypt")
     ct = api("encctl_gym.crypto.modified:modified_eval")(pk_a, enc(pk_a, 4, rng=_stream(1)), enc(pk_a, 9, rng=_stream(2)))
-    try:
-        out = api("encctl_gym.crypto.modified:modified_decrypt")(sk_a, sk_b, ct)
-    except errors:
-        return
-    raise SecurityFinding(f"modified_decrypt with keys of two groups returned {out}")
+    _refused(lambda: api("encctl_gym.crypto.modified:modified_decrypt")(sk_a, sk_b, ct),
+             "modified_decrypt with keys of two groups")
 
 
 def _cross_group_mult(_: Path) -> None:
-    errors = api("encctl_gym.errors:KeyMismatchError")
     (pk_a, _), (pk_b, _) = _other_group_keys()
     enc = api("encctl_gym.crypto.elgamal:encrypt")
-    try:
-        out = api("encctl_gym.crypto.elgamal:mult")(pk_a, enc(pk_a, 4, rng=_stream(1)), enc(pk_b, 9, rng=_stream(2)))
-    except errors:
-        return
-    raise SecurityFinding(f"mult of ciphertexts of two groups returned {out!r}")
+    _refused(lambda: api("encctl_gym.crypto.elgamal:mult")(pk_a, enc(pk_a, 4, rng=_stream(1)), enc(pk_b, 9, rng=_stream(2))),
+             "mult of ciphertexts of two groups")
 
 
 def _cross_group_token(_: Path) -> None:
-    errors = api("encctl_gym.errors:KeyMismatchError")
     (pk_a, sk_a), (pk_b, sk_b) = _other_group_keys()
     _, _, tok_b = api("encctl_gym.crypto.dyn_elgamal:key_update")(pk_b, sk_b, rng=_stream(3))
-    try:
-        out = api("encctl_gym.crypto.dyn_elgamal:recover_next_secret_key")(sk_a, tok_b)
-    except errors:
-        return
-    raise SecurityFinding(f"a token of another group updated a secret key: {out!r}")
+    _refused(lambda: api("encctl_gym.crypto.dyn_elgamal:recover_next_secret_key")(sk_a, tok_b),
+             "recover_next_secret_key with a token of another group")
 
 
 def _seeded_secret_far_from_q(bits: int, seed: int) -> Any:
@@ -613,6 +610,63 @@ def _security() -> list[Case]:
     return out
 
 
+def _more() -> list[Case]:
+    """Cases of the same classes found beyond the issue's reproducers: values shown in messages
+    (an integer over 4300 digits makes ``repr`` raise), helpers without type checks, flags that
+    took any truthy value, and an encoder that could never encode."""
+    out: list[Case] = []
+    enc = "encctl_gym.crypto.encoding"
+    grp = Lazy(lambda: api("encctl_gym.crypto.group:get_group")(64), "<64-bit group>")
+    out += bad_args(A, f"{enc}:nearest_member", {"group": grp, "v": 5, "max_shift": 64},
+                    {"group": explicit(["abc", 64, None], "traceback"), "v": explicit([2.5, "5", None, True]),
+                     "max_shift": explicit([-1, 2.5, "a"], "traceback")}, drawn=0)
+    out += bad_args(A, f"{enc}:lift", {"group": grp, "m": 5},
+                    {"group": explicit(["abc", None], "traceback"), "m": explicit([2.5, "5", None], "traceback")}, drawn=0)
+    out += bad_args(A, f"{enc}:default_max_shift", {"group": grp}, {"group": explicit(["abc", 64, None], "traceback")}, drawn=0)
+    out += bad_args(A, f"{enc}:Encoder", {"group": grp, "delta": 1024.0},
+                    {"max_shift": explicit([2**63, HUGE], "silent")}, name="Encoder(no x_bound)", drawn=0)
+
+    def group_method(name: str) -> Any:
+        def call(kw: dict[str, Any]) -> Any:
+            return getattr(api("encctl_gym.crypto.group:get_group")(64), name)(**kw)
+        return call
+
+    out += bad_args(A, group_method("contains"), {"m": 4}, {"m": explicit(["4", 2.5, None, [4]], "traceback")},
+                    name="GroupParams.contains", drawn=0)
+    out += bad_args(A, group_method("verify"), {"recheck": False}, {"recheck": explicit(["no", 1, None, [True]])},
+                    name="GroupParams.verify(recheck)", drawn=0)
+    out += bad_args(A, "encctl_gym.crypto.group:generate_safe_prime_group", {"bits": 32, "rng": 1},
+                    {"progress": explicit(["no", 2, None])}, name="generate_safe_prime_group.progress", drawn=0)
+    gp = "encctl_gym.crypto.group:GroupParams"
+    out += bad_args(A, lambda kw: api(gp + ".load")(**kw), {"path": "g.json"},
+                    {"path": explicit([42, None, ["g.json"], HUGER], "traceback")}, name="GroupParams.load(path)", drawn=0)
+    out += bad_args(A, lambda kw: api(gp + ".from_dict")(**kw), {"data": {"p": 23, "q": 11, "g": 4}},
+                    {"data": explicit([np.array([23, 11, 4]), HUGER], "traceback")}, name="GroupParams.from_dict(array)", drawn=0)
+    # values beyond the int-to-str limit, shown in a message
+    eg = "encctl_gym.crypto.elgamal"
+    out += bad_args(A, f"{eg}:encrypt", {"pk": PK, "m": 4, "rng": Lazy(_stream, "<stream>")},
+                    {"pk": explicit([HUGER], "traceback")}, name="encrypt(huge pk)", drawn=0)
+    out += bad_args(A, "encctl_gym.crypto.schemes:get_scheme", {"name": "modified"}, {"name": explicit([HUGER], "traceback")},
+                    name="get_scheme(huge)", drawn=0)
+    out += bad_args(A, lambda kw: _stream().spawn(**kw), {"purpose": "x"}, {"purpose": explicit([HUGER, None], "traceback")},
+                    name="RandomSource.spawn", drawn=0)
+    out += bad_args(A, "encctl_gym.crypto.quantized:QuantizedLinearController",
+                    {"Phi": np.eye(2), "encoder": ENCODER, "x_bound": 10.0}, {"encoder": explicit([HUGER], "traceback")},
+                    name="QuantizedLinearController(huge encoder)", drawn=0)
+
+    def server_call(method: str, scheme: str = "modified") -> Any:
+        def call(kw: dict[str, Any]) -> Any:
+            c = api("encctl_gym.crypto.controller:EncryptedLinearController")(np.eye(2) * 0.1, 64, 256.0, 10.0, scheme=scheme, rng=1)
+            return getattr(c.server, method)(**kw)
+        return call
+
+    out += bad_args(A, server_call("evaluate"), {"ct_xi": None}, {"ct_xi": explicit([42, 2.5, HUGER], "traceback")},
+                    name="server.evaluate", drawn=0)
+    out += bad_args(A, server_call("receive_token", "token"), {"token": None}, {"token": explicit([HUGER, "abc"], "traceback")},
+                    name="server.receive_token", drawn=0)
+    return out
+
+
 def _valid() -> list[Case]:
     """Valid inputs with known answers (a broken happy path is a silent wrong number)."""
     def roundtrip(_: Path) -> None:
@@ -653,7 +707,7 @@ def _valid() -> list[Case]:
 
 def cases() -> list[Case]:
     """Every crypto case."""
-    return [*_arith(), *_group(), *_encoding(), *_elgamal(), *_dynamic(), *_controller(), *_security(), *_valid()]
+    return [*_arith(), *_group(), *_encoding(), *_elgamal(), *_dynamic(), *_controller(), *_more(), *_security(), *_valid()]
 
 
 _ = FILES, HUGER  # re-exported names used by other case modules
