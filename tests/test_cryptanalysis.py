@@ -446,8 +446,8 @@ def test_index_calculus_refuses_a_factor_base_beyond_its_memory_limits() -> None
         ({"chunks": 2.5}, "chunks must be an integer, got 2.5"),
         ({"seed": -1}, "seed must be >= 0, got -1"),
         ({"seed": "a"}, "seed must be an integer, got 'a'"),
-        ({"n_jobs": -5}, "n_jobs must be -1 or >= 1, got -5"),
-        ({"scheduler": "tcp://"}, "got 'tcp://'"),
+        ({"n_jobs": -5}, "n_jobs must be -1 (all cores) or >= 1, got -5"),
+        ({"scheduler": "tcp://"}, "scheduler address 'tcp://' names no host:port"),
         ({"scheduler": 3}, "got 3"),
     ],
 )

@@ -241,7 +241,7 @@ def test_models_figure_and_from_csv(quick_rows: list, tmp_path) -> None:
         (["--bits", "32", "--keys", "1000000000000"], "--keys = 1000000000000"),
         (["--bits", "32", "--keys", "9" * 401], "--keys = <integer of 1333 bits"),
         (["--bits", "712", "--keys", "1", "--breaker", "rho", "--max-bits", "100000"], "MAX_EXPECTED_SECONDS"),
-        (["--bits", "32", "--keys", "2", "--scheduler", "tcp://"], "got 'tcp://'"),
+        (["--bits", "32", "--keys", "2", "--scheduler", "tcp://"], "scheduler address 'tcp://' names no host:port"),
     ],
 )
 def test_crack_refuses_unbounded_work_in_one_line(capsys: pytest.CaptureFixture, args: list, message: str) -> None:

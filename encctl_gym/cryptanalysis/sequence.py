@@ -26,6 +26,7 @@ from .._validation import check_bool, check_int, format_value
 from ..crypto import arith
 from ..crypto.group import GroupParams
 from ..errors import ParameterError
+from ..parallel import check_n_jobs, check_scheduler
 from .base import Breaker, Cost, Precomputation, RecoveredKey, as_list, check_element
 from .registry import get_breaker
 
@@ -89,19 +90,15 @@ def _clock(clock: str) -> str:
 
 
 def _check_scheduler(scheduler: Any) -> None:
-    """Refuse a scheduler that :func:`~encctl_gym.parallel.run_tasks` cannot use, before any work:
-    it takes ``None``, ``"local"``, an address ``"protocol://host:port"`` or a
-    ``distributed.Client``."""
-    if scheduler is None or scheduler == "local":
-        return
+    """:func:`~encctl_gym.parallel.check_scheduler`, before the precomputation, and two checks it
+    leaves to :func:`~encctl_gym.parallel.run_tasks` (which runs after it): an address must name a
+    location after its ``protocol://`` (``"tcp://"`` alone reached ``distributed.Client`` as a
+    ``ValueError``), and an object must be a ``distributed.Client``."""
+    check_scheduler(scheduler)
     if isinstance(scheduler, str):
-        protocol, sep, location = scheduler.partition("://")
-        if not (sep and protocol and location):
-            raise ParameterError(
-                f"scheduler must be 'local' or a Dask scheduler address like 'tcp://host:8786', got {format_value(scheduler)}"
-            )
-        return
-    if not type(scheduler).__module__.startswith("distributed"):
+        if scheduler != "local" and not scheduler.partition("://")[2]:
+            raise ParameterError(f"scheduler address {format_value(scheduler)} names no host:port after its protocol")
+    elif scheduler is not None and not type(scheduler).__module__.startswith("distributed"):
         raise ParameterError(
             f"scheduler must be None, 'local', a Dask scheduler address or a distributed.Client, got {format_value(scheduler)}"
         )
@@ -180,9 +177,7 @@ def break_sequence(
     if tokens is not None:
         tokens = as_list("tokens", tokens, "update tokens")
     # Every option is checked before the precomputation, which may be the expensive part.
-    n_jobs = check_int("n_jobs", n_jobs)
-    if n_jobs == 0 or n_jobs < -1:
-        raise ParameterError(f"n_jobs must be -1 or >= 1, got {n_jobs}")
+    n_jobs = check_n_jobs(n_jobs)
     if chunks is not None:
         chunks = check_int("chunks", chunks, minimum=1)
     if not isinstance(seed, np.random.SeedSequence):
