@@ -373,3 +373,147 @@ def test_random_draws_cover_the_exponent_range() -> None:
     pre = precomputed("rho", 24)
     for s in (1, 2, grp.q - 1, grp.q // 2, rng.randrange(1, grp.q)):
         assert pre.break_key(int(gmpy2.powmod(grp.g, s, grp.p))).s == s
+
+
+# ----------------------------------------------------------------------------- hardening (issue 16)
+@pytest.mark.parametrize("name", list(BREAKERS))
+def test_an_unknown_option_is_named_with_the_options_of_the_breaker(name: str) -> None:
+    with pytest.raises(ParameterError, match="has no option 'bogus_option'") as err:
+        get_breaker(name, bogus_option=1)
+    assert "max_bits" in str(err.value) and "rng" in str(err.value)
+    assert isinstance(get_breaker(name, rng=1), BREAKERS[name])  # a known option still builds it
+
+
+def test_no_breaker_starts_a_first_key_expected_beyond_a_year(monkeypatch: pytest.MonkeyPatch) -> None:
+    from encctl_gym.cryptanalysis.base import MAX_EXPECTED_SECONDS
+    from encctl_gym.cryptanalysis.rho import SECONDS_PER_STEP
+
+    monkeypatch.setattr(PollardRho, "_precompute", lambda *a, **k: pytest.fail("work started"))
+    year = 365.25 * 86400
+    assert MAX_EXPECTED_SECONDS == year
+    big = shipped_group(712)
+    with pytest.raises(BreakerLimitError, match="MAX_EXPECTED_SECONDS") as err:
+        PollardRho(max_bits=100_000).precompute(big)
+    # Hand computation of rho's cost model: sqrt(pi q / 2) steps of SECONDS_PER_STEP.
+    years = math.sqrt(math.pi * big.q / 2) * SECONDS_PER_STEP / year
+    assert f"{years:.3g} years" in str(err.value) and "max_bits = 100000" in str(err.value)
+    # 64 bits: about sqrt(pi 2^62) steps, some ten minutes, well under the ceiling: accepted.
+    small = shipped_group(64)
+    assert math.sqrt(math.pi * small.q / 2) * SECONDS_PER_STEP < 3600
+    PollardRho(max_bits=64).check_feasible(small)
+
+
+def test_multi_log_rho_refuses_a_table_beyond_its_memory_limit() -> None:
+    from encctl_gym.cryptanalysis.rho import MAX_TABLE_WALKS
+
+    for walks in (MAX_TABLE_WALKS + 1, 10**12, 10**400):
+        with pytest.raises(BreakerLimitError, match="MAX_TABLE_WALKS") as err:
+            MultiLogRho(table_walks=walks)
+        assert ("table_walks = " + ("<integer of 1329 bits" if walks == 10**400 else str(walks))) in str(err.value)
+    assert MultiLogRho(table_walks=MAX_TABLE_WALKS).table_walks == MAX_TABLE_WALKS  # nothing is built yet
+
+
+def test_index_calculus_refuses_a_factor_base_beyond_its_memory_limits() -> None:
+    import sympy
+
+    from encctl_gym.cryptanalysis.index_calculus import MATRIX_BYTES_PER_ENTRY, MAX_MATRIX_BYTES
+    from encctl_gym.cryptanalysis.smoothness import MAX_BOUND
+    from encctl_gym.errors import ResourceLimitError
+
+    with pytest.raises(ResourceLimitError, match="MAX_BOUND") as err:
+        IndexCalculus(bound=10**12)
+    assert "1000000000000" in str(err.value)
+    grp = group(32)
+    ic = IndexCalculus(bound=100_000)
+    # Independently: pi(10^5) = 9592 unknowns, (1.05 * 9592 + 20) rows of 9593 entries.
+    k = int(sympy.primepi(100_000))
+    assert k == 9592
+    assert ic.matrix_bytes(grp) == pytest.approx((1.05 * k + 20) * (k + 1) * MATRIX_BYTES_PER_ENTRY, rel=0.01)
+    with pytest.raises(BreakerLimitError, match="bound 100000") as err:
+        ic.precompute(grp)
+    assert "MAX_MATRIX_BYTES" in str(err.value) and ic.matrix_bytes(grp) > MAX_MATRIX_BYTES
+    assert MAX_BOUND == 2**24 and IndexCalculus(bound=MAX_BOUND).bound == MAX_BOUND
+    # The default bound of the largest group the breaker takes (128 bits) stays within the limit.
+    assert IndexCalculus(max_bits=128).matrix_bytes(shipped_group(128)) < MAX_MATRIX_BYTES
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"hs": None}, "hs must be an iterable"),
+        ({"hs": 42}, "got 42"),
+        ({"chunks": 0}, "chunks must be >= 1, got 0"),
+        ({"chunks": 2.5}, "chunks must be an integer, got 2.5"),
+        ({"seed": -1}, "seed must be >= 0, got -1"),
+        ({"seed": "a"}, "seed must be an integer, got 'a'"),
+        ({"n_jobs": -5}, "n_jobs must be -1 (all cores) or >= 1, got -5"),
+        ({"scheduler": "tcp://"}, "scheduler address 'tcp://' names no host:port"),
+        ({"scheduler": 3}, "got 3"),
+    ],
+)
+def test_break_sequence_checks_every_option_before_the_precomputation(
+    monkeypatch: pytest.MonkeyPatch, kwargs: dict, message: str
+) -> None:
+    breaker = get_breaker("bsgs")
+    monkeypatch.setattr(breaker, "precompute", lambda *a, **k: pytest.fail("work started"))
+    hs, _, _ = sequence(24, 2)
+    with pytest.raises(ParameterError) as err:
+        break_sequence(breaker, group(24), **{"hs": list(hs), **kwargs})
+    assert message in str(err.value)
+
+
+def test_break_sequence_takes_a_seed_sequence_and_one_chunk() -> None:
+    import numpy as np
+
+    hs, secrets, _ = sequence(24, 3)
+    report = break_sequence("bsgs", group(24), hs, n_jobs=1, chunks=1, seed=np.random.SeedSequence(4))
+    assert report.secrets == list(secrets)
+
+
+def test_options_given_with_a_breaker_instance_are_refused_not_ignored() -> None:
+    rho = PollardRho()
+    with pytest.raises(ParameterError, match="'max_bits' apply to a breaker built by name"):
+        get_breaker(rho, max_bits=20)
+    assert get_breaker(rho) is rho
+    with pytest.raises(ParameterError, match="max_bits applies to an inner breaker built by name"):
+        TokenChain(rho, max_bits=20)
+    assert TokenChain(rho).max_bits == rho.max_bits == 64
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"pre": 3}, "pre must be a Precomputation, got 3"),
+        ({"breaker": "token-chain", "tokens": 5}, "tokens must be an iterable of update tokens, got 5"),
+        ({"progress": "no"}, "progress must be True or False, got 'no'"),
+    ],
+)
+def test_break_sequence_refuses_a_bad_precomputation_tokens_or_progress(kwargs: dict, message: str) -> None:
+    hs, _, _ = sequence(24, 1)
+    with pytest.raises(ParameterError) as err:
+        break_sequence(**{"breaker": "bsgs", "group": group(24), "hs": list(hs), **kwargs})
+    assert message in str(err.value)
+
+
+@needs_pari
+def test_a_pari_failure_is_a_one_line_breaker_error(monkeypatch: pytest.MonkeyPatch) -> None:
+    # cypari's own PariError, built without running PARI: once an alarm has interrupted znlog
+    # (test_pari_time_limit_uses_an_alarm), any later PARI error crashes the process (a cypari
+    # bug, see the pari module), so the failure is raised where znlog would give up.
+    import cypari._pari as cp
+
+    failure = cp.PariError(1, "sorry, solve recovery [too many iterations] is not yet implemented")
+
+    class GivesUp:
+        def Mod(self, *args: object) -> None:
+            return None
+
+        def znlog(self, *args: object) -> None:
+            raise failure
+
+    pre = get_breaker("pari").precompute(TOY)
+    pre._objects = (None, None)
+    monkeypatch.setattr(pari_mod, "_pari", lambda: GivesUp())
+    with pytest.raises(BreakerError, match="pari: znlog failed for h = 4") as err:
+        pre.break_key(4)
+    assert "\n" not in str(err.value) and type(failure).__name__ == "PariError"

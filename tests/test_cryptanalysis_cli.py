@@ -232,3 +232,138 @@ def test_models_figure_and_from_csv(quick_rows: list, tmp_path) -> None:
     assert (out / "deciphering_models.png").is_file()
     assert (out / "deciphering_time.csv").read_text() == path.read_text()
     assert deciphering_time.main(["--from-csv", str(tmp_path / "missing.csv"), "--out", str(out)]) == 2
+
+
+# ----------------------------------------------------------------------------- hardening (issue 16)
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--bits", "32", "--keys", "1000000000000"], "--keys = 1000000000000"),
+        (["--bits", "32", "--keys", "9" * 401], "--keys = <integer of 1333 bits"),
+        (["--bits", "712", "--keys", "1", "--breaker", "rho", "--max-bits", "100000"], "MAX_EXPECTED_SECONDS"),
+        (["--bits", "32", "--keys", "2", "--scheduler", "tcp://"], "scheduler address 'tcp://' names no host:port"),
+    ],
+)
+def test_crack_refuses_unbounded_work_in_one_line(capsys: pytest.CaptureFixture, args: list, message: str) -> None:
+    assert main(["crack", *args, "--no-progress", "--json"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0], err
+
+
+def test_crack_keys_limit_and_its_memory_estimate() -> None:
+    from encctl_gym.cryptanalysis.cli import MAX_KEYS, check_keys
+    from encctl_gym.errors import ResourceLimitError
+
+    assert check_keys(MAX_KEYS) == MAX_KEYS and check_keys(1) == 1
+    with pytest.raises(ResourceLimitError, match="MAX_KEYS") as err:
+        check_keys(10**12)
+    assert "2.79e+06 GiB" in str(err.value)  # 10^12 keys of 3000 bytes: 3e15 / 2^30 = 2.794e6 GiB
+    with pytest.raises(ParameterError, match="keys must be an integer, got 2.5"):
+        check_keys(2.5)
+
+
+@pytest.mark.parametrize("u", ["a", None, 2 + 1j, 10**400, float("nan"), -1.0, True])
+def test_dickman_rho_refuses_what_is_not_a_real_u(u: object) -> None:
+    with pytest.raises(ParameterError, match="^u must be") as err:
+        dickman_rho(u)  # type: ignore[arg-type]
+    assert ("integer of 1329 bits" if u == 10**400 else repr(u)) in str(err.value)
+
+
+def test_dickman_rho_takes_an_integer_u() -> None:
+    assert dickman_rho(2) == pytest.approx(1 - math.log(2), rel=1e-14)
+    assert dickman_rho(3) == pytest.approx(0.04860838829, rel=1e-9)  # rho(3), de Bruijn's table
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"p": "a"}, "p must be an integer, got 'a'"),
+        ({"p": None}, "p must be an integer, got None"),
+        ({"p": 1}, "p must be >= 2, got 1"),
+        ({"y": 2.5}, "y must be an integer, got 2.5"),
+        ({"y": None}, "y must be an integer, got None"),
+        ({"y": 101}, "y must lie in [1, p), got y = 101 for p = 101"),
+        ({"bound": 0}, "bound must be >= 1, got 0"),
+        ({"bound": -1}, "bound must be >= 1, got -1"),
+        ({"bound": 2.5}, "bound must be an integer, got 2.5"),
+        ({"bound": "a"}, "bound must be an integer, got 'a'"),
+        ({"bound": 101}, "bound must lie in [1, p), got bound = 101"),
+    ],
+)
+def test_rational_reconstruction_refuses_bad_arguments(kwargs: dict, message: str) -> None:
+    with pytest.raises(ParameterError) as err:
+        rational_reconstruction(**{"y": 5, "p": 101, **kwargs})
+    assert message in str(err.value)
+
+
+def test_rational_reconstruction_at_the_edges_of_its_bound() -> None:
+    # bound = 1: a = 1 and b = 5^-1 = 81 = -20 (mod 101), |b| < 101 (5 * 81 = 405 = 4 * 101 + 1).
+    assert rational_reconstruction(5, 101, 1) == (1, -20)
+    assert -20 % 101 == 81
+    # bound = p - 1: y itself, b = 1.
+    assert rational_reconstruction(5, 101, 100) == (5, 1)
+
+
+def test_factor_base_refuses_a_bound_beyond_its_limit() -> None:
+    from encctl_gym.cryptanalysis.smoothness import MAX_BOUND
+    from encctl_gym.errors import ResourceLimitError
+
+    for bound, shown in ((MAX_BOUND + 1, str(MAX_BOUND + 1)), (10**12, "1000000000000"), (10**400, "<integer of 1329 bits")):
+        with pytest.raises(ResourceLimitError, match="MAX_BOUND") as err:
+            FactorBase(bound)
+        assert shown in str(err.value)
+    with pytest.raises(ResourceLimitError):
+        primes_up_to(10**12)
+
+
+def test_crack_json_of_one_key_has_null_not_nan(capsys: pytest.CaptureFixture) -> None:
+    assert main(["crack", "--bits", "32", "--keys", "1", "--breaker", "bsgs", "--json", "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    out = json.loads(text, parse_constant=lambda c: pytest.fail(f"non-JSON constant {c}"))
+    assert out["mean_later_key"] is None and out["ratio"] is None and len(out["keys"]) == 1
+
+
+@pytest.mark.parametrize(
+    "bits, bound, message",
+    [
+        (10**400, 100, "bits must be <= 1048576"),
+        ("a", 100, "bits must be an integer, got 'a'"),
+        (64, 1, "bound must be >= 2, got 1"),
+        (64, 0.5, "bound must be >= 2, got 0.5"),
+        (64, "a", "bound must be a real number, got 'a'"),
+    ],
+)
+def test_cost_model_refuses_arguments_outside_its_domain(bits: object, bound: object, message: str) -> None:
+    for fn in (cost_model, relation_probability):
+        with pytest.raises(ParameterError) as err:
+            fn(bits, bound)  # type: ignore[arg-type]
+        assert message in str(err.value)
+    with pytest.raises(ParameterError, match="bits must be <= 1048576"):
+        choose_bound(10**400)
+
+
+def test_relation_probability_at_the_smallest_bound() -> None:
+    # B = 2, 64 bits: u = 32 ln 2 / ln 2 = 32, so rho(32)^2 (beyond the closed forms: check u only).
+    assert relation_probability(64, 2) == pytest.approx(dickman_rho(32.0) ** 2, rel=1e-12)
+    assert relation_probability(4000, 2) == 0.0  # u = 2000 > 40: zero, not an error
+
+
+def test_factor_base_tests_refuse_non_integers() -> None:
+    fb = FactorBase(100)
+    for bad in (2.5, "a", None):
+        with pytest.raises(ParameterError, match="x must be an integer"):
+            fb.is_smooth(bad)  # type: ignore[arg-type]
+        with pytest.raises(ParameterError, match="x must be an integer"):
+            fb.factor(bad)  # type: ignore[arg-type]
+    assert fb.factor(2 * 3 * 97) == {0: 1, 1: 1, 24: 1}  # 97 is the 25th prime
+    assert fb.is_smooth(-(2**10) * 97) and not fb.is_smooth(101)
+
+
+def test_solve_mod_prime_refuses_a_bad_modulus_or_column() -> None:
+    with pytest.raises(ParameterError, match="q must be >= 2, got 0"):
+        solve_mod_prime([{0: 1}], [1], 1, 0)
+    with pytest.raises(ParameterError, match="column 5, outside"):
+        solve_mod_prime([{5: 1}], [1], 1, 7)
+    with pytest.raises(ParameterError, match="ncols must be an integer"):
+        solve_mod_prime([{0: 1}], [1], 1.5, 7)
+    assert solve_mod_prime([{0: 3}], [1], 1, 7) == ([5], 1)  # 3 x = 1 (mod 7): x = 5

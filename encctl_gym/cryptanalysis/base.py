@@ -18,8 +18,9 @@ whose costs that definition lumps together:
 Every exponent is checked (``g^s = h``) before it is returned: a failed check raises
 :class:`~encctl_gym.errors.BreakerError`, never a wrong key. A group too large for a breaker
 is refused before any work (:class:`~encctl_gym.errors.BreakerLimitError`, naming the limit
-and the expected time from the breaker's cost model); a call past its ``time_limit`` stops with
-:class:`~encctl_gym.errors.BreakerTimeoutError`.
+and the expected time from the breaker's cost model), and so is a group whose first key that
+model expects to take more than :data:`MAX_EXPECTED_SECONDS` (one year) whatever ``max_bits``
+allows; a call past its ``time_limit`` stops with :class:`~encctl_gym.errors.BreakerTimeoutError`.
 
 This layer imports only :mod:`encctl_gym.crypto.arith`, :mod:`encctl_gym.crypto.group`,
 :mod:`encctl_gym.errors` and :mod:`encctl_gym._validation` (plus numpy, gmpy2, python-flint
@@ -33,7 +34,7 @@ import dataclasses
 import math
 import threading
 import time
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Any, ClassVar
 
 from .._validation import check_int, check_positive, format_value
@@ -42,7 +43,19 @@ from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, KeyMismatchError, ParameterError
 
-__all__ = ["Cost", "RecoveredKey", "Deadline", "Precomputation", "Breaker", "check_element", "verify_exponent", "format_seconds"]
+__all__ = [
+    "Cost",
+    "RecoveredKey",
+    "Deadline",
+    "Precomputation",
+    "Breaker",
+    "check_element",
+    "as_list",
+    "verify_exponent",
+    "format_seconds",
+    "format_bytes",
+    "MAX_EXPECTED_SECONDS",
+]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -111,6 +124,18 @@ def format_seconds(seconds: float) -> str:
     return f"{seconds / (86400 * 365.25):.3g} years"
 
 
+def format_bytes(n: int | float) -> str:
+    """A memory size in the most readable unit (``"512 MiB"``, ``"2.79e+06 GiB"``); an integer of
+    any size (``10**400`` bytes is ``"10^400 bytes"``, rounded to a power of ten)."""
+    if isinstance(n, int) and n.bit_length() > 1000:
+        return f"10^{(n.bit_length() - 1) * math.log10(2):.0f} bytes"
+    v = float(n)
+    for unit, size in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if v >= size:
+            return f"{v / size:.3g} {unit}"
+    return f"{v:.0f} bytes"
+
+
 class Deadline:
     """The time limit of one breaker call; :meth:`check` raises once it has passed.
 
@@ -172,6 +197,14 @@ def check_element(group: GroupParams, h: Any) -> int:
     return h
 
 
+def as_list(name: str, values: Any, what: str) -> list[Any]:
+    """``values`` as a list, after checking that it is an iterable (not a string or bytes) of
+    ``what`` (named in the message)."""
+    if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
+        raise ParameterError(f"{name} must be an iterable of {what}, got {format_value(values)}")
+    return list(values)
+
+
 def verify_exponent(group: GroupParams, h: int, s: int, who: str) -> int:
     """Return ``s mod q`` after checking ``g^s = h mod p`` (one exponentiation).
 
@@ -184,6 +217,12 @@ def verify_exponent(group: GroupParams, h: int, s: int, who: str) -> int:
     if int(arith.powmod(group.g, s, group.p)) != h:
         raise BreakerError(f"{who}: the recovered exponent fails the check g^s = h for h = {format_int(h)}")
     return s
+
+
+#: The longest expected time of a first key (precomputation included) that any breaker starts,
+#: whatever its ``max_bits``: one year. Raising ``max_bits`` lets a breaker take on larger groups,
+#: never a run that its own cost model puts beyond this (a 712-bit group for rho: about 6e92 years).
+MAX_EXPECTED_SECONDS = 365.25 * 86400.0
 
 
 def _check_time_limit(time_limit: float | None) -> float | None:
@@ -298,7 +337,9 @@ class Breaker(abc.ABC):
         each later key, from the algorithm's complexity and a documented calibration constant."""
 
     def check_feasible(self, group: GroupParams) -> None:
-        """Refuse a group larger than :attr:`max_bits`, before any work.
+        """Refuse a group larger than :attr:`max_bits`, or one whose first key the cost model
+        (:meth:`expected_seconds`) expects to take longer than :data:`MAX_EXPECTED_SECONDS`,
+        before any work.
 
         Raises
         ------
@@ -311,6 +352,13 @@ class Breaker(abc.ABC):
                 f"breaker {self.name!r} refuses a {group.bits}-bit group: its limit is {self.max_bits} bits "
                 f"(max_bits); expected time on this machine about {format_seconds(first)} for the first key "
                 f"and {format_seconds(per_key)} for each later one"
+            )
+        first, per_key = self.expected_seconds(group)
+        if not first <= MAX_EXPECTED_SECONDS:
+            raise BreakerLimitError(
+                f"breaker {self.name!r} refuses a {group.bits}-bit group even with max_bits = {self.max_bits}: "
+                f"the expected time of the first key on this machine, about {format_seconds(first)}, exceeds "
+                f"the ceiling of {MAX_EXPECTED_SECONDS / (86400 * 365.25):g} year (MAX_EXPECTED_SECONDS)"
             )
 
     def _check_group(self, group: GroupParams) -> None:

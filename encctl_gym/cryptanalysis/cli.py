@@ -15,6 +15,11 @@ runs once; the table lists each key's wall time, CPU time and operation counts, 
 ``T_first`` (precomputation + first key), the mean wall time of a later key and their ratio. Every recovered key
 is checked (g^s = h) and compared with the sequence's secret key.
 
+Work that cannot finish is refused in one line before it starts: more than :data:`MAX_KEYS`
+keys, a group beyond the breaker's ``--max-bits``, and a first key that the breaker's cost
+model expects to take more than a year whatever ``--max-bits`` says
+(:data:`~encctl_gym.cryptanalysis.base.MAX_EXPECTED_SECONDS`).
+
 With ``--scheduler`` (``local`` starts a Dask ``LocalCluster``; needs ``encctl-gym[dask]``) the
 keys are split into chunks that run as tasks of :func:`encctl_gym.parallel.run_tasks`, each with
 a copy of the precomputation; ``--n-jobs`` above 1 alone uses joblib processes.
@@ -24,18 +29,45 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from typing import Any
 
-from .._validation import check_int, check_positive
+from .._validation import check_int, check_positive, format_value
 from ..crypto import arith
 from ..crypto.group import SHIPPED_BITS, GroupParams, generate_safe_prime_group, shipped_group
-from ..errors import BreakerError, ParameterError
-from .base import format_seconds
+from ..errors import BreakerError, ParameterError, ResourceLimitError
+from .base import format_bytes, format_seconds
 from .registry import BREAKERS, get_breaker
 from .sequence import BreakReport, break_sequence
 
-__all__ = ["add_arguments", "run", "key_sequence", "crack_group"]
+__all__ = ["add_arguments", "run", "key_sequence", "crack_group", "check_keys", "MAX_KEYS"]
+
+#: Largest number of keys of ``encctl-gym crack``: the sequence, its tokens, the report and its
+#: JSON are held in memory, about 3 KB per key (measured: 55 MB more for 20000 keys than for 1000,
+#: 64-bit group, ``--json``), so 10^5 keys take about 0.3 GB (the paper's N* = 13159 fits).
+MAX_KEYS = 100_000
+_BYTES_PER_KEY = 3000
+
+
+def check_keys(n: object, name: str = "keys") -> int:
+    """Return the number of keys ``n`` after checking ``1 <= n <=`` :data:`MAX_KEYS`; ``name``
+    is the name of the value in the error message.
+
+    Raises
+    ------
+    ParameterError
+        If ``n`` is not an integer >= 1.
+    ResourceLimitError
+        If ``n`` exceeds :data:`MAX_KEYS` (the message names the memory it would take).
+    """
+    n = check_int(name, n, minimum=1)
+    if n > MAX_KEYS:
+        raise ResourceLimitError(
+            f"{name} = {format_value(n)} would hold about {format_bytes(n * _BYTES_PER_KEY)} of keys, tokens and "
+            f"report in memory; the limit is {MAX_KEYS} keys (MAX_KEYS)"
+        )
+    return n
 
 
 def key_sequence(group: GroupParams, n: int, rng: arith.RngLike) -> tuple[list[int], list[int], list[Any]]:
@@ -45,7 +77,7 @@ def key_sequence(group: GroupParams, n: int, rng: arith.RngLike) -> tuple[list[i
     ----------
     group : GroupParams
     n : int
-        Number of keys (>= 1).
+        Number of keys, ``1 <= n <=`` :data:`MAX_KEYS`.
     rng : None, int, RandomSource or numpy.random.Generator
         Randomness of KeyGen and KeyUpd (a seed is reproducible and unsafe for deployment).
 
@@ -57,7 +89,7 @@ def key_sequence(group: GroupParams, n: int, rng: arith.RngLike) -> tuple[list[i
     from ..crypto.dyn_elgamal import key_update
     from ..crypto.elgamal import keygen
 
-    n = check_int("keys", n, minimum=1)
+    n = check_keys(n)
     src = arith.as_random_source(rng)
     pk, sk = keygen(group, rng=src)
     hs, secrets, tokens = [pk.h], [sk.s], []
@@ -88,7 +120,7 @@ def crack_group(bits: int, source: str, seed: int) -> tuple[GroupParams, str]:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the options of ``encctl-gym crack``."""
     parser.add_argument("--bits", type=int, default=64, help="bit length of p (default 64)")
-    parser.add_argument("--keys", type=int, default=32, help="number N of keys of the sequence (default 32)")
+    parser.add_argument("--keys", type=int, default=32, help=f"number N of keys of the sequence (default 32, at most {MAX_KEYS})")
     parser.add_argument(
         "--breaker", default="index-calculus", choices=list(BREAKERS), help="key breaker (default index-calculus)"
     )
@@ -135,7 +167,8 @@ def _ops(ops: dict[str, int]) -> str:
 
 
 def summary(report: BreakReport) -> dict[str, float]:
-    """``T_first`` (precomputation + first key), the mean later key, their ratio, the total."""
+    """``T_first`` (precomputation + first key), the mean later key, their ratio, the total
+    (NaN for the later key and the ratio of a one-key report; ``null`` in the JSON output)."""
     t = report.key_seconds()
     first = report.precomputation.seconds + float(t[0])
     later = float(t[1:].mean()) if t.size > 1 else float("nan")
@@ -151,7 +184,7 @@ def run(args: argparse.Namespace) -> int:
     """Build the group and the key sequence, break it, print the table (or JSON)."""
     if args.time_limit is not None:
         check_positive("--time-limit", args.time_limit)
-    n = check_int("--keys", args.keys, minimum=1)
+    n = check_keys(args.keys, "--keys")
     seed = check_int("--seed", args.seed, minimum=0)
     kwargs: dict[str, Any] = {"rng": arith.seeded_random(seed + 2)}
     if args.max_bits is not None:
@@ -178,7 +211,9 @@ def run(args: argparse.Namespace) -> int:
     stats = summary(report)
     if args.json:
         out = report.to_dict()
-        out.update({"bits": group.bits, "group_source": source, "keys_match": True, **stats})
+        # JSON has no NaN: a figure without a value (the later keys of a one-key run) is null.
+        finite = {k: (v if math.isfinite(v) else None) for k, v in stats.items()}
+        out.update({"bits": group.bits, "group_source": source, "keys_match": True, **finite})
         print(json.dumps(out, indent=1))
         return 0
     print(f"crack: {breaker.name} on a {group.bits}-bit {source} group (p = {group.p:#x}), {n} keys of one dynamic-key sequence")
@@ -192,7 +227,7 @@ def run(args: argparse.Namespace) -> int:
     later = "n/a" if n == 1 else format_seconds(stats["mean_later_key"])
     print(
         f"T_first = {format_seconds(stats['T_first'])} (precomputation + key 0), mean later key = {later}, "
-        f"T_1 / T_first = {stats['ratio']:.3g}, total = {format_seconds(stats['total'])}"
+        f"T_1 / T_first = {'n/a' if n == 1 else format(stats['ratio'], '.3g')}, total = {format_seconds(stats['total'])}"
     )
     print(f"all {n} keys checked (g^s = h) and equal to the sequence's secret keys")
     return 0

@@ -51,14 +51,14 @@ from typing import ClassVar
 
 import gmpy2
 
-from .._validation import check_int, check_positive
+from .._validation import check_int, check_positive, format_value
 from ..crypto import arith
 from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
-from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, GroupError
-from .base import Breaker, Deadline, Precomputation
+from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, GroupError, ParameterError
+from .base import Breaker, Deadline, Precomputation, format_bytes
 from .linalg import flint_backend, solve_mod_prime
-from .smoothness import RHO_MAX_U, FactorBase, dickman_rho, rational_reconstruction
+from .smoothness import RHO_MAX_U, FactorBase, check_bound, dickman_rho, rational_reconstruction
 
 __all__ = [
     "IndexCalculus",
@@ -68,6 +68,7 @@ __all__ = [
     "choose_bound",
     "cost_model",
     "relation_probability",
+    "MAX_MODEL_BITS",
 ]
 
 #: Calibration of the cost model, measured on this machine (2 cores, Python 3.11, gmpy2 2.3,
@@ -85,16 +86,43 @@ MATRIX_ENTRY = 5.0e-7
 #: Relations collected beyond the number of unknowns (fraction, plus a constant).
 EXTRA_FRACTION = 0.05
 EXTRA_CONSTANT = 20
+#: Peak bytes per entry of the dense system ``[R | r]`` in :func:`~.linalg.solve_mod_prime` (the
+#: Python entry list, the FLINT matrix, its echelon form and the entries read back), measured for
+#: a 2120 x 2001 system with a 61-bit q: 91 bytes.
+MATRIX_BYTES_PER_ENTRY = 91
+#: Largest expected peak memory of the linear algebra (bytes): 4 GiB. The default bound of a
+#: 128-bit group (6547 unknowns, about 3.8 GiB) fits.
+MAX_MATRIX_BYTES = 4 * 2**30
 #: Share of the primes occurring in the relations whose logarithm must be determined.
 SOLVED_FRACTION = 0.97
 _CHECK_EVERY = 2048
+
+
+#: Largest bit length of p the cost model takes (far beyond any group the package builds; it keeps
+#: every quantity of the model within the float range).
+MAX_MODEL_BITS = 1 << 20
+
+
+def _model_args(bits: object, bound: object) -> tuple[int, float]:
+    bits = check_int("bits", bits, minimum=2, maximum=MAX_MODEL_BITS)
+    bound = check_positive("bound", bound)
+    if bound < 2:
+        raise ParameterError(f"bound must be >= 2, got {format_value(bound)}")
+    return bits, bound
 
 
 def relation_probability(bits: int, bound: float) -> float:
     """Probability that ``y = a / b`` (both about ``bits / 2`` bits) has a and b ``bound``-smooth:
     ``rho(u)^2`` with ``u = (bits / 2) ln 2 / ln B`` (Dickman's rho, :func:`~.smoothness.dickman_rho`);
     0 past the range of the tabulated rho (``u > 40``, a probability below 1e-142), so that the
-    cost model of a group far beyond reach is infinite rather than an error."""
+    cost model of a group far beyond reach is infinite rather than an error.
+
+    Raises
+    ------
+    ParameterError
+        Unless ``2 <= bits <=`` :data:`MAX_MODEL_BITS` is an integer and ``bound >= 2`` a real number.
+    """
+    bits, bound = _model_args(bits, bound)
     u = (bits / 2) * math.log(2) / math.log(bound)
     if u > RHO_MAX_U:
         return 0.0
@@ -115,8 +143,7 @@ def cost_model(bits: int, bound: float) -> dict[str, float]:
         (seconds of phase 2), ``linear_algebra`` (phase 3, dense elimination and the matrix
         build), ``descent`` (phase 4, per key), ``first`` (phases 2-4) and ``per_key``.
     """
-    bits = check_int("bits", bits, minimum=2)
-    bound = check_positive("bound", bound)
+    bits, bound = _model_args(bits, bound)
     k = _prime_count(bound)
     trials = 1.0 / max(relation_probability(bits, bound), 1e-300)
     trial = TRIAL_BASE + TRIAL_PER_BIT * bits + TRIAL_PER_BOUND * bound
@@ -137,8 +164,8 @@ def cost_model(bits: int, bound: float) -> dict[str, float]:
 
 def choose_bound(bits: int) -> int:
     """The factor-base bound B minimising the expected time of the first key (:func:`cost_model`),
-    searched over ``B = 2^(x/8)``, ``x/8`` from 5 to 22."""
-    bits = check_int("bits", bits, minimum=2)
+    searched over ``B = 2^(x/8)``, ``x/8`` from 5 to 22 (``2 <= bits <=`` :data:`MAX_MODEL_BITS`)."""
+    bits = check_int("bits", bits, minimum=2, maximum=MAX_MODEL_BITS)
     best = min(range(40, 177), key=lambda x: cost_model(bits, 2 ** (x / 8))["first"])
     return max(2, int(2 ** (best / 8)))
 
@@ -180,7 +207,7 @@ class Relation(tuple):
 def _split(fb: FactorBase, y: int, p: int, half: int) -> dict[int, int] | None:
     """The exponent vector of lambda(y) = lambda(a) - lambda(|b|), or None if a or b is not smooth."""
     a, b = rational_reconstruction(y, p, half)
-    if not (fb.is_smooth(a) and fb.is_smooth(b)):
+    if not (fb._is_smooth(a) and fb._is_smooth(b)):
         return None
     fa, fb_ = fb.factor(a), fb.factor(b)
     assert fa is not None and fb_ is not None  # both smooth
@@ -306,7 +333,9 @@ class IndexCalculus(Breaker):
     Parameters
     ----------
     bound : int, optional
-        The factor-base bound B (default: :func:`choose_bound` for the group's size).
+        The factor-base bound B, at most :data:`~.smoothness.MAX_BOUND` (default:
+        :func:`choose_bound` for the group's size); a bound whose linear algebra would need more
+        than :data:`MAX_MATRIX_BYTES` is refused by :meth:`check_feasible`.
     max_bits : int, optional
         Size limit (default 112 bits: about six minutes and a dense matrix of about 3500 x 3500
         on this machine; at most 128, where the halves a and b still fit in 64 bits).
@@ -323,7 +352,7 @@ class IndexCalculus(Breaker):
         super().__init__(max_bits=max_bits, rng=rng)
         if self.max_bits > 128:
             raise BreakerLimitError(f"index-calculus supports at most 128 bits (max_bits), got {self.max_bits}")
-        self.bound = None if bound is None else check_int("bound", bound, minimum=2)
+        self.bound = None if bound is None else check_bound(bound)
 
     def factor_base_bound(self, group: GroupParams) -> int:
         """B for this group: the ``bound`` given, else :func:`choose_bound` (at least 2, below p)."""
@@ -334,6 +363,26 @@ class IndexCalculus(Breaker):
         """``(first, per_key)`` of :func:`cost_model` at :meth:`factor_base_bound`."""
         model = cost_model(group.bits, self.factor_base_bound(group))
         return model["first"], model["per_key"]
+
+    def matrix_bytes(self, group: GroupParams) -> float:
+        """Expected peak memory of the first linear algebra (bytes): ``k (1 + EXTRA_FRACTION) +
+        EXTRA_CONSTANT`` rows of ``k + 1`` entries, k the (estimated) size of the factor base, at
+        :data:`MATRIX_BYTES_PER_ENTRY` each."""
+        k = _prime_count(self.factor_base_bound(group))
+        return (k * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT) * (k + 1) * MATRIX_BYTES_PER_ENTRY
+
+    def check_feasible(self, group: GroupParams) -> None:
+        """The limits of :class:`~.base.Breaker`, and the memory of the dense linear algebra
+        (:meth:`matrix_bytes` at most :data:`MAX_MATRIX_BYTES`)."""
+        super().check_feasible(group)
+        need = self.matrix_bytes(group)
+        if need > MAX_MATRIX_BYTES:
+            bound = self.factor_base_bound(group)
+            raise BreakerLimitError(
+                f"index-calculus refuses factor-base bound {bound} for this {group.bits}-bit group: about "
+                f"{_prime_count(bound):.0f} unknowns make a dense system of about {format_bytes(need)}, above the "
+                f"limit of {format_bytes(MAX_MATRIX_BYTES)} (MAX_MATRIX_BYTES)"
+            )
 
     def _check_group(self, group: GroupParams) -> None:
         n = group.cofactor

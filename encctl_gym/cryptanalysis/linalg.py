@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
+from .._validation import check_int, format_value
 from ..errors import BreakerError, OptionalDependencyError, ParameterError
 
 __all__ = ["solve_mod_prime", "flint_backend"]
@@ -53,13 +54,20 @@ def solve_mod_prime(rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols
 
     Raises
     ------
+    ParameterError
+        If ``q < 2``, ``ncols < 0``, a column lies outside ``[0, ncols)`` or the lengths differ.
     BreakerError
         If the system is inconsistent (a relation is wrong: never expected).
     """
     if len(rows) != len(rhs):
         raise ParameterError(f"rows and rhs differ in length: {len(rows)} != {len(rhs)}")
+    ncols = check_int("ncols", ncols, minimum=0)
+    q = check_int("q", q, minimum=2)
     flint = _flint()
     used = sorted({j for row in rows for j, c in row.items() if c % q})
+    if used and not (0 <= used[0] and used[-1] < ncols):
+        bad = used[0] if used[0] < 0 else used[-1]
+        raise ParameterError(f"a row has a coefficient in column {format_value(bad)}, outside [0, ncols = {ncols})")
     if not used:
         return [None] * ncols, 0
     pos = {j: i for i, j in enumerate(used)}

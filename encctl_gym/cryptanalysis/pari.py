@@ -12,6 +12,12 @@ from a self-contained manylinux wheel for current Pythons (it bundles PARI 2.15)
 publishes a cp311 wheel only for its old release 2.2.0 and falls back to a source build, which
 needs a system PARI, for newer ones. PARI runs only in the main thread of a process (its stack
 is per thread): this breaker refuses to run in another thread instead of crashing.
+
+A PARI error inside ``znlog`` (PARI gives up: "too many iterations", its stack) is a one-line
+:class:`~encctl_gym.errors.BreakerError`. Known limitation of the binding (cypari with PARI
+2.15, reproduced without this package): once an ``alarm`` (the ``time_limit``) has interrupted
+a ``znlog``, the next PARI *error* in the same process crashes it with a segmentation fault;
+calls that succeed are unaffected. Run PARI attacks that may time out in their own process.
 """
 
 from __future__ import annotations
@@ -95,18 +101,21 @@ class PariContext(Precomputation):
                 "break these keys without a thread-based scheduler"
             )
         pari = _pari()
+        import cypari._pari as cp
+
         g, order = self._pari_objects()
         target = pari.Mod(h, self.group.p)
-        if deadline.limit is None:
-            result = pari.znlog(target, g, order)
-        else:
-            import cypari._pari as cp
-
-            seconds = max(1, math.ceil(deadline.remaining))
-            try:
+        try:
+            if deadline.limit is None:
+                result = pari.znlog(target, g, order)
+            else:
+                seconds = max(1, math.ceil(deadline.remaining))
                 result = _ZNLOG_ALARM(target, g, order, seconds)
-            except cp.AlarmInterrupt:
-                raise deadline.error() from None
+        except cp.AlarmInterrupt:
+            raise deadline.error() from None
+        except cp.PariError as exc:  # PARI gives up (an algorithm it lacks, its stack): one line, ours
+            said = " ".join(str(exc).split())
+            raise BreakerError(f"pari: znlog failed for h = {format_int(h)}: {format_value(said, 200)}") from None
         if result.type() != "t_INT":
             raise BreakerError(f"pari: znlog found no logarithm of h = {format_int(h)} (result {format_value(str(result))})")
         return int(result), {}, ""

@@ -14,8 +14,10 @@ name                class                                        per key after p
 
 from __future__ import annotations
 
+import inspect
 from typing import Any
 
+from .._validation import format_value
 from ..errors import ParameterError
 from .base import Breaker
 from .bsgs import BabyStepGiantStep
@@ -24,7 +26,7 @@ from .pari import PariZnlog
 from .rho import MultiLogRho, PollardRho
 from .token_chain import TokenChain
 
-__all__ = ["BREAKERS", "get_breaker"]
+__all__ = ["BREAKERS", "get_breaker", "breaker_options"]
 
 #: Registry name -> breaker class.
 BREAKERS: dict[str, type[Breaker]] = {
@@ -34,17 +36,35 @@ BREAKERS: dict[str, type[Breaker]] = {
 
 def get_breaker(name: str | Breaker, **kwargs: Any) -> Breaker:
     """Build the breaker registered as ``name`` with keyword arguments ``kwargs`` (a
-    :class:`~.base.Breaker` instance is returned as is).
+    :class:`~.base.Breaker` instance is returned as is, and takes no ``kwargs``).
 
     Raises
     ------
     ParameterError
-        For an unknown name (the message lists the registered ones).
+        For an unknown name (the message lists the registered ones), an option the breaker
+        does not have (the message lists its options), or options given with an instance.
     """
     if isinstance(name, Breaker):
+        if kwargs:
+            raise ParameterError(
+                f"options {', '.join(format_value(k) for k in kwargs)} apply to a breaker built by name; "
+                f"set them on the instance {format_value(name)} instead"
+            )
         return name
     try:
         cls = BREAKERS[name]
     except (KeyError, TypeError):
-        raise ParameterError(f"unknown breaker {name!r}; registered: {', '.join(BREAKERS)}") from None
+        raise ParameterError(f"unknown breaker {format_value(name)}; registered: {', '.join(BREAKERS)}") from None
+    options = breaker_options(cls)
+    unknown = [k for k in kwargs if k not in options]
+    if unknown:
+        raise ParameterError(
+            f"breaker {cls.name!r} has no option {', '.join(format_value(k) for k in unknown)}; its options: {', '.join(options)}"
+        )
     return cls(**kwargs)
+
+
+def breaker_options(cls: type[Breaker]) -> tuple[str, ...]:
+    """The keyword options of a breaker class (the parameters of its constructor)."""
+    params = list(inspect.signature(cls.__init__).parameters.values())[1:]
+    return tuple(p.name for p in params if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY))

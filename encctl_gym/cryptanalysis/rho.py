@@ -29,14 +29,14 @@ from typing import ClassVar
 
 import gmpy2
 
-from .._validation import check_int
+from .._validation import check_int, format_value
 from ..crypto import arith
 from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
-from ..errors import BreakerError
-from .base import Breaker, Deadline, Precomputation
+from ..errors import BreakerError, BreakerLimitError
+from .base import Breaker, Deadline, Precomputation, format_bytes
 
-__all__ = ["RandomWalk", "PollardRho", "MultiLogRho", "SECONDS_PER_STEP"]
+__all__ = ["RandomWalk", "PollardRho", "MultiLogRho", "SECONDS_PER_STEP", "MAX_TABLE_WALKS"]
 
 #: Seconds per step of the walk (one multiplication in G and one exponent addition, Python
 #: integers), measured on this machine with ``python benchmarks/bench_cryptanalysis.py``.
@@ -51,6 +51,11 @@ _WALKS_PER_SQRT_Q = 64
 #: distinguished point and abandoned (probability about e^-20 for a walk that is not).
 _CAP_FACTOR = 20
 _CHUNK = 4096
+#: Largest ``table_walks`` of :class:`MultiLogRho`: each walk may add one distinguished point to
+#: the table, a dict entry of about 140 bytes (two Python integers and the slot; 138 bytes
+#: measured for a million 64-bit points), so 2^22 walks keep at most about 0.55 GiB.
+MAX_TABLE_WALKS = 1 << 22
+_BYTES_PER_POINT = 140
 
 
 class RandomWalk(Precomputation):
@@ -193,7 +198,9 @@ class MultiLogRho(PollardRho):
     Parameters
     ----------
     table_walks : int, default 0
-        Walks from known powers of g run during the precomputation to fill the table.
+        Walks from known powers of g run during the precomputation to fill the table, at most
+        :data:`MAX_TABLE_WALKS` (a larger table is refused with
+        :class:`~encctl_gym.errors.BreakerLimitError`; its time counts in :meth:`expected_seconds`).
     max_bits, rng
         See :class:`~encctl_gym.cryptanalysis.base.Breaker`.
     """
@@ -204,6 +211,12 @@ class MultiLogRho(PollardRho):
     def __init__(self, *, table_walks: int = 0, max_bits: int | None = None, rng: RngLike = None) -> None:
         super().__init__(max_bits=max_bits, rng=rng)
         self.table_walks = check_int("table_walks", table_walks, minimum=0)
+        if self.table_walks > MAX_TABLE_WALKS:
+            raise BreakerLimitError(
+                f"rho-multi refuses table_walks = {format_value(self.table_walks)}: each walk may keep a distinguished "
+                f"point (about {_BYTES_PER_POINT} bytes), {format_bytes(self.table_walks * _BYTES_PER_POINT)} in all; "
+                f"the limit is {MAX_TABLE_WALKS} (MAX_TABLE_WALKS)"
+            )
 
     def expected_seconds(self, group: GroupParams) -> tuple[float, float]:
         first, per_key = super().expected_seconds(group)

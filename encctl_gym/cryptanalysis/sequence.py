@@ -22,11 +22,12 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_int
+from .._validation import check_bool, check_int, format_value
 from ..crypto import arith
 from ..crypto.group import GroupParams
 from ..errors import ParameterError
-from .base import Breaker, Cost, Precomputation, RecoveredKey, check_element
+from ..parallel import check_n_jobs, check_scheduler
+from .base import Breaker, Cost, Precomputation, RecoveredKey, as_list, check_element
 from .registry import get_breaker
 
 __all__ = ["BreakReport", "break_sequence"]
@@ -88,6 +89,21 @@ def _clock(clock: str) -> str:
     return "seconds" if clock == "wall" else "cpu_seconds"
 
 
+def _check_scheduler(scheduler: Any) -> None:
+    """:func:`~encctl_gym.parallel.check_scheduler`, before the precomputation, and two checks it
+    leaves to :func:`~encctl_gym.parallel.run_tasks` (which runs after it): an address must name a
+    location after its ``protocol://`` (``"tcp://"`` alone reached ``distributed.Client`` as a
+    ``ValueError``), and an object must be a ``distributed.Client``."""
+    check_scheduler(scheduler)
+    if isinstance(scheduler, str):
+        if scheduler != "local" and not scheduler.partition("://")[2]:
+            raise ParameterError(f"scheduler address {format_value(scheduler)} names no host:port after its protocol")
+    elif scheduler is not None and not type(scheduler).__module__.startswith("distributed"):
+        raise ParameterError(
+            f"scheduler must be None, 'local', a Dask scheduler address or a distributed.Client, got {format_value(scheduler)}"
+        )
+
+
 def _break_chunk(task: tuple[Precomputation, list[int], float | None], seed: np.random.SeedSequence) -> list[RecoveredKey]:
     # One task of the parallel path: a copy of the precomputation and a run of consecutive keys.
     pre, hs, time_limit = task
@@ -107,7 +123,7 @@ def break_sequence(
     scheduler: Any = None,
     n_jobs: int = 1,
     chunks: int | None = None,
-    seed: int = 0,
+    seed: int | np.random.SeedSequence = 0,
 ) -> BreakReport:
     """Break the public-key elements ``hs`` of one group with one precomputation.
 
@@ -131,12 +147,12 @@ def break_sequence(
         Run the per-key work through :func:`~encctl_gym.parallel.run_tasks` (with ``n_jobs``):
         ``None`` and ``n_jobs == 1`` break the keys in this process, in order.
     n_jobs : int
-        Workers of the parallel path (``-1``: all cores).
+        Workers of the parallel path (``-1``: all cores, else >= 1).
     chunks : int, optional
-        Number of tasks of the parallel path (default: the number of workers); each carries a
-        copy of the precomputation and a run of consecutive keys.
-    seed : int
-        Seed of the parallel path's per-task randomness.
+        Number of tasks of the parallel path, >= 1 (default: the number of workers); each
+        carries a copy of the precomputation and a run of consecutive keys.
+    seed : int or numpy.random.SeedSequence
+        Seed (>= 0) of the parallel path's per-task randomness.
 
     Returns
     -------
@@ -147,24 +163,36 @@ def break_sequence(
     KeyMismatchError
         If a key is not in G of ``group``.
     ParameterError
-        If tokens are given to a breaker that does not use them, or on bad options.
+        If tokens are given to a breaker that does not use them, or on bad options (checked
+        before the precomputation, whichever path the options serve).
     """
     from tqdm.auto import tqdm
 
     breaker = get_breaker(breaker) if isinstance(breaker, str) else breaker
     if not isinstance(breaker, Breaker):
-        raise ParameterError(f"breaker must be a registry name or a Breaker, got {breaker!r}")
+        raise ParameterError(f"breaker must be a registry name or a Breaker, got {format_value(breaker)}")
     if not isinstance(group, GroupParams):
-        raise ParameterError(f"group must be a GroupParams, got {group!r}")
-    hs = [check_element(group, h) for h in hs]
-    n_jobs = check_int("n_jobs", n_jobs)
+        raise ParameterError(f"group must be a GroupParams, got {format_value(group)}")
+    hs = [check_element(group, h) for h in as_list("hs", hs, "public-key elements")]
+    if tokens is not None:
+        tokens = as_list("tokens", tokens, "update tokens")
+    # Every option is checked before the precomputation, which may be the expensive part.
+    n_jobs = check_n_jobs(n_jobs)
+    if chunks is not None:
+        chunks = check_int("chunks", chunks, minimum=1)
+    if not isinstance(seed, np.random.SeedSequence):
+        seed = check_int("seed", seed, minimum=0)
+    _check_scheduler(scheduler)
     if breaker.MAIN_THREAD_ONLY and scheduler is not None:
         raise ParameterError(
             f"breaker {breaker.name!r} runs only in a process's main thread and Dask runs tasks in threads: "
             "break its keys without a scheduler"
         )
+    progress = check_bool("progress", progress)
     if pre is None:
         pre = breaker.precompute(group, time_limit=time_limit)
+    elif not isinstance(pre, Precomputation):
+        raise ParameterError(f"pre must be a Precomputation, got {format_value(pre)}")
     elif pre.breaker != breaker.name or pre.group != group:
         raise ParameterError(f"pre is a precomputation of {pre.breaker!r} for another group or breaker")
     if tokens is not None:
@@ -177,7 +205,7 @@ def break_sequence(
             keys.append(breaker.break_key(h, pre, time_limit=time_limit))
         return BreakReport(breaker.name, group, pre.cost, keys)
     workers = (os.cpu_count() or 1) if n_jobs == -1 else n_jobs
-    n_chunks = max(1, min(len(hs), check_int("chunks", chunks if chunks is not None else workers, minimum=1)))
+    n_chunks = max(1, min(len(hs), chunks if chunks is not None else workers))
     bounds = np.linspace(0, len(hs), n_chunks + 1).round().astype(int)
     tasks = [(pre, hs[a:b], time_limit) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
     from ..parallel import run_tasks

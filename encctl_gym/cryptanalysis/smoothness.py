@@ -18,11 +18,45 @@ from functools import lru_cache
 import gmpy2
 import numpy as np
 
-from .._validation import check_int, check_positive
+from .._validation import check_int, check_nonnegative, check_positive, format_value
 from ..crypto.group import _small_primes
-from ..errors import ParameterError
+from ..errors import ParameterError, ResourceLimitError
 
-__all__ = ["primes_up_to", "FactorBase", "rational_reconstruction", "dickman_rho", "smooth_probability"]
+__all__ = [
+    "primes_up_to",
+    "check_bound",
+    "FactorBase",
+    "rational_reconstruction",
+    "dickman_rho",
+    "smooth_probability",
+    "MAX_BOUND",
+]
+
+#: Largest smoothness bound B of a factor base: 2^24, 1077871 primes, built in about 4 s with a
+#: peak of about 260 MB (sieve, Python integers, tuple and index). The index calculus's own choice
+#: (:func:`~.index_calculus.choose_bound`) never exceeds 2^22.
+MAX_BOUND = 1 << 24
+
+
+def check_bound(bound: object) -> int:
+    """Return the smoothness bound ``bound`` as an int after checking ``2 <= bound <= MAX_BOUND``.
+
+    Raises
+    ------
+    ParameterError
+        If ``bound`` is not an integer >= 2.
+    ResourceLimitError
+        If ``bound`` exceeds :data:`MAX_BOUND` (the sieve and the prime table would not fit).
+    """
+    bound = check_int("bound", bound, minimum=2)
+    if bound > MAX_BOUND:
+        log10_primes = math.log10(bound) - math.log10(math.log(bound) - 1.08)  # pi(B) ~ B / (ln B - 1.08)
+        raise ResourceLimitError(
+            f"a factor base of bound {format_value(bound)} would hold about 10^{log10_primes:.1f} primes (a sieve "
+            f"of 10^{math.log10(bound):.1f} bytes and far more in Python integers); the limit is bound <= {MAX_BOUND} "
+            "(MAX_BOUND)"
+        )
+    return bound
 
 
 def primes_up_to(bound: int) -> tuple[int, ...]:
@@ -33,8 +67,10 @@ def primes_up_to(bound: int) -> tuple[int, ...]:
     ------
     ParameterError
         If ``bound < 2``.
+    ResourceLimitError
+        If ``bound > MAX_BOUND``.
     """
-    bound = check_int("bound", bound, minimum=2)
+    bound = check_bound(bound)
     return (2, *_small_primes(bound + 1))
 
 
@@ -44,7 +80,8 @@ class FactorBase:
     Parameters
     ----------
     bound : int
-        The smoothness bound B (>= 2).
+        The smoothness bound B, ``2 <= B <=`` :data:`MAX_BOUND` (a larger one raises
+        :class:`~encctl_gym.errors.ResourceLimitError`).
 
     Attributes
     ----------
@@ -57,7 +94,7 @@ class FactorBase:
     """
 
     def __init__(self, bound: int) -> None:
-        self.bound = check_int("bound", bound, minimum=2)
+        self.bound = check_bound(bound)
         self.primes = primes_up_to(self.bound)
         self.index = {ell: i for i, ell in enumerate(self.primes)}
         self.product = _product(self.primes)
@@ -75,7 +112,16 @@ class FactorBase:
         With P the product of the factor base, ``|x|`` is B-smooth iff ``|x|`` divides P^(2^e)
         once ``2^e >= log2 |x|`` (no prime occurs in ``|x|`` more than ``log2 |x|`` times), i.e.
         iff ``(P mod |x|)^(2^e) = 0 (mod |x|)``: one remainder of P and e squarings.
+
+        Raises
+        ------
+        ParameterError
+            If ``x`` is not an integer.
         """
+        return self._is_smooth(check_int("x", x))
+
+    def _is_smooth(self, x: int) -> bool:
+        # is_smooth without the check: the relation search calls it for every trial.
         x = abs(x)
         if x <= 1:
             return x == 1
@@ -83,11 +129,17 @@ class FactorBase:
         return gmpy2.powmod(self.product % x, 1 << e, x) == 0
 
     def factor(self, x: int) -> dict[int, int] | None:
-        """The exponents ``{column: e}`` of a B-smooth ``|x|`` (``None`` if it is not smooth)."""
-        x = abs(int(x))
+        """The exponents ``{column: e}`` of a B-smooth ``|x|`` (``None`` if it is not smooth).
+
+        Raises
+        ------
+        ParameterError
+            If ``x`` is not a nonzero integer.
+        """
+        x = abs(check_int("x", x))
         if x == 0:
             raise ParameterError("0 has no factorisation over a factor base")
-        if not self.is_smooth(x):
+        if not self._is_smooth(x):
             return None
         out: dict[int, int] = {}
         if x < (1 << 64):
@@ -129,16 +181,26 @@ def rational_reconstruction(y: int, p: int, bound: int | None = None) -> tuple[i
     p : int
         The modulus (> 1).
     bound : int, optional
-        The size of ``a`` (default ``isqrt(p)``).
+        The size of ``a``, in ``[1, p)`` (default ``isqrt(p)``).
 
     Returns
     -------
     (int, int)
         ``a`` and ``b``; ``b`` may be negative, never 0.
+
+    Raises
+    ------
+    ParameterError
+        If ``p < 2``, ``y`` is not in ``[1, p)`` or ``bound`` is not in ``[1, p)``, or one of them
+        is not an integer.
     """
+    p = check_int("p", p, minimum=2)
+    y = check_int("y", y)
     if not 0 < y < p:
-        raise ParameterError(f"y must lie in [1, p), got y = {y} for p = {p}")
-    bound = math.isqrt(p) if bound is None else bound
+        raise ParameterError(f"y must lie in [1, p), got y = {format_value(y)} for p = {format_value(p)}")
+    bound = math.isqrt(p) if bound is None else check_int("bound", bound, minimum=1)
+    if bound >= p:
+        raise ParameterError(f"bound must lie in [1, p), got bound = {format_value(bound)} for p = {format_value(p)}")
     r0, r1, t0, t1 = p, y, 0, 1
     while r1 > bound:
         k = r0 // r1
@@ -185,11 +247,15 @@ def dickman_rho(u: float) -> float:
     Parameters
     ----------
     u : float
-        ``>= 0``; values above 40 are refused (rho(40) is about 1e-71).
+        A real number ``>= 0``; values above 40 are refused (rho(40) is about 1e-71).
+
+    Raises
+    ------
+    ParameterError
+        If ``u`` is not a finite real number (a string, None, complex, NaN, beyond the float64
+        range), is negative or exceeds 40.
     """
-    u = float(u)
-    if not math.isfinite(u) or u < 0:
-        raise ParameterError(f"u must be a finite number >= 0, got {u!r}")
+    u = check_nonnegative("u", u)
     if u <= 1:
         return 1.0
     if u > RHO_MAX_U:

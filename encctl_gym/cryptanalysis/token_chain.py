@@ -24,7 +24,7 @@ from .._validation import check_int, format_value
 from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import KeyMismatchError, ParameterError
-from .base import Breaker, Deadline, Precomputation, RecoveredKey, check_element
+from .base import Breaker, Deadline, Precomputation, RecoveredKey, as_list, check_element
 
 __all__ = ["TokenChain", "TokenChainState", "as_token"]
 
@@ -76,8 +76,14 @@ class TokenChainState(Precomputation):
         self.reachable: dict[int, int] = {}
 
     def add_tokens(self, tokens: Iterable[Any]) -> None:
-        """Record update tokens ``sigma_t = (h_t, d_t)`` (any order)."""
-        for token in tokens:
+        """Record update tokens ``sigma_t = (h_t, d_t)`` (any order).
+
+        Raises
+        ------
+        ParameterError
+            If ``tokens`` is not an iterable of tokens.
+        """
+        for token in as_list("tokens", tokens, "update tokens"):
             h, d = as_token(self.group, token)
             self.tokens[h] = d
             if h in self.known:
@@ -116,7 +122,8 @@ class TokenChain(Breaker):
         The breaker of the first key (a registry name, built with ``rng`` and ``max_bits``, or
         an instance).
     max_bits : int, optional
-        Passed to the inner breaker when it is built here (its limit is the limit).
+        Passed to the inner breaker when it is built here (its limit is the limit); refused with
+        an instance, whose own ``max_bits`` holds.
     rng
         See :class:`~encctl_gym.cryptanalysis.base.Breaker`.
     """
@@ -128,6 +135,10 @@ class TokenChain(Breaker):
         from .registry import get_breaker
 
         if isinstance(inner, Breaker):
+            if max_bits is not None:
+                raise ParameterError(
+                    f"max_bits applies to an inner breaker built by name; set it on the instance {format_value(inner)} instead"
+                )
             self.inner = inner
         else:
             if inner == self.name:

@@ -119,7 +119,21 @@ def _crack() -> list[Case]:
     out.append(cli(K, "crack --scheduler bogus", [*base, "--bits", "32", "--keys", "2", "--scheduler", "bogus"], "traceback", timeout=30))
     out.append(cli(K, "crack --breaker token-chain --inner token-chain", [*base, "--breaker", "token-chain", "--inner", "token-chain"]))
     out.append(cli_valid(K, "valid: crack --bits 32 --keys 3", [*base, "--bits", "32", "--keys", "3", "--breaker", "bsgs"], _crack_ok))
+    for breaker in ("rho-multi", "pari"):
+        out.append(cli(K, f"crack --breaker {breaker} --max-bits 100000 --bits 712 refused", [*base, "--bits", "712", "--keys", "1", "--max-bits",
+                                                                                              "100000", "--breaker", breaker], "hang", timeout=30))
+    out.append(cli(K, "crack --scheduler tcp:// (no address)", [*base, "--bits", "32", "--keys", "2", "--scheduler", "tcp://"]))
+    out.append(cli_valid(K, "valid: crack --keys 1 --json is strict JSON", [*base, "--bits", "32", "--keys", "1", "--breaker", "bsgs"],
+                         _crack_strict_json))
     return out
+
+
+def _crack_strict_json(run: CliRun) -> None:
+    def refuse(constant: str) -> None:
+        raise AssertionError(f"the JSON holds {constant}, which is not JSON")
+
+    data = json.loads(run.stdout, parse_constant=refuse)
+    assert len(data["keys"]) == 1 and data["keys_match"] is True, run.stdout[:300]
 
 
 def _crack_ok(run: CliRun) -> None:

@@ -94,6 +94,33 @@ def _cryptanalysis() -> list[Case]:
                 raise SecurityFinding(f"{name} returned an exponent that fails g^s = h")
 
     out.append(case(C, "valid: every breaker's exponent satisfies g^s = h", "silent", recovered_checked, expect="result"))
+
+    # Found while hardening the cases above: the cost model, the factor-base tests, the linear
+    # algebra, options given with an instance (silently ignored), and more of break_sequence.
+    for fn in ("cost_model", "relation_probability"):
+        out += bad_args(C, f"{CA}.index_calculus:{fn}", {"bits": 64, "bound": 100.0},
+                        {"bits": explicit([HUGE, "a", None, 1], "traceback"), "bound": explicit([1, 0.5, "a", NAN], "traceback")}, drawn=0)
+    out += bad_args(C, f"{CA}.index_calculus:choose_bound", {"bits": 64}, {"bits": explicit([HUGE, "a", 1], "traceback")}, drawn=0)
+    out += bad_args(C, lambda kw: api(f"{CA}.smoothness:FactorBase")(100).factor(**kw), {}, {"x": explicit([2.5, 6.0 + 0j])},
+                    name="FactorBase.factor", drawn=0)
+    out += bad_args(C, lambda kw: api(f"{CA}.smoothness:FactorBase")(100).is_smooth(**kw), {}, {"x": explicit(["a", None, 2.5], "traceback")},
+                    name="FactorBase.is_smooth", drawn=0)
+    out += bad_args(C, f"{CA}.linalg:solve_mod_prime", {"rows": [{0: 3}], "rhs": [1], "ncols": 1, "q": 7},
+                    {"q": explicit([0, 1, 2.5, "a"], "traceback"), "ncols": explicit([-1, 1.5, "a"], "traceback"),
+                     "rows": explicit([[{5: 1}], [{-1: 1}]], "traceback")}, drawn=0)
+    out.append(case(C, "get_breaker(instance, max_bits=20) refused, not ignored", "silent",
+                    lambda _: api(f"{CA}.registry:get_breaker")(api(f"{CA}.rho:PollardRho")(), max_bits=20)))
+    out.append(case(C, "TokenChain(instance, max_bits=20) refused, not ignored", "silent",
+                    lambda _: api(f"{CA}.token_chain:TokenChain")(api(f"{CA}.rho:PollardRho")(), max_bits=20)))
+    out += bad_args(C, sequence, {}, {"pre": explicit([3, "abc"], "traceback"), "progress": explicit(["no", 1]),
+                                      "tokens": explicit([5], "traceback")}, name="break_sequence", drawn=0)
+    out += bad_args(C, f"{CA}.rho:MultiLogRho", {}, {"table_walks": explicit([HUGE, 10**12], "hang")}, name="MultiLogRho(no group)", drawn=0)
+
+    def one_key_rho(bits: int) -> Any:
+        grp = api("encctl_gym.crypto.group:get_group")(bits)
+        return api(f"{CA}.registry:get_breaker")("rho", max_bits=100_000).precompute(grp).break_key(_h(grp))
+
+    out.append(case(C, "rho(max_bits=100000) on the 712-bit group refused before any work", "hang", lambda _: one_key_rho(712), timeout=30))
     return out
 
 
