@@ -279,7 +279,7 @@ def test_corrupt_or_missing_model_is_a_config_error(tmp_path, capsys):
     _one_line_error(capsys, ["evaluate", str(d)], "unknown algorithm 'dqn'")
 
 
-# ------------------------------------------------------------------ hardening (issue 16)
+# ------------------------------------------------------------------ hardening
 def _depth(v: object) -> int:
     return 1 + max((_depth(x) for x in v), default=0) if isinstance(v, list) else 0
 

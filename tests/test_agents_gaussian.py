@@ -1,6 +1,6 @@
 """The paper's Gaussian attacker through the environment agrees with the engine's simulation.
 
-Issue 5: ``GaussianAttacker`` played through ``EncryptedLTIAttack-v0`` (ideal backend: encoding,
+``GaussianAttacker`` played through ``EncryptedLTIAttack-v0`` (ideal backend: encoding,
 quantisation, the forged input, the energy budget) must give the mean final error of the
 engine's batched Monte Carlo simulation of the same attack (:mod:`encctl_gym.sim.montecarlo`,
 plain floating point, no loop) within Monte Carlo error, and that error must lie above

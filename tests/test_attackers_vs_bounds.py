@@ -246,7 +246,7 @@ def test_the_old_module_path_still_imports():
     assert cli.SUBCOMMANDS["compare"][0] == "experiments.compare.cli"
 
 
-# ------------------------------------------------------------------ hardening (issue 16)
+# ------------------------------------------------------------------ hardening
 def test_compare_refuses_empty_lists_huge_counts_and_a_file_as_out(tmp_path, capsys):
     afile = tmp_path / "afile"
     afile.write_text("x")

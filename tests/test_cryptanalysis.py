@@ -375,7 +375,7 @@ def test_random_draws_cover_the_exponent_range() -> None:
         assert pre.break_key(int(gmpy2.powmod(grp.g, s, grp.p))).s == s
 
 
-# ----------------------------------------------------------------------------- hardening (issue 16)
+# ----------------------------------------------------------------------------- hardening
 @pytest.mark.parametrize("name", list(BREAKERS))
 def test_an_unknown_option_is_named_with_the_options_of_the_breaker(name: str) -> None:
     with pytest.raises(ParameterError, match="has no option 'bogus_option'") as err:

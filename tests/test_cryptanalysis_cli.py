@@ -234,7 +234,7 @@ def test_models_figure_and_from_csv(quick_rows: list, tmp_path) -> None:
     assert deciphering_time.main(["--from-csv", str(tmp_path / "missing.csv"), "--out", str(out)]) == 2
 
 
-# ----------------------------------------------------------------------------- hardening (issue 16)
+# ----------------------------------------------------------------------------- hardening
 @pytest.mark.parametrize(
     "args, message",
     [

@@ -1,4 +1,4 @@
-"""Key material and group membership (issue 16, security): degenerate keys and groups are
+"""Key material and group membership (security): degenerate keys and groups are
 refused, and every operation that combines keys, tokens and ciphertexts detects objects of
 another group or another time step (KeyMismatchError) instead of returning garbage."""
 

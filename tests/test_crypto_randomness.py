@@ -1,5 +1,5 @@
 """Seeded randomness of the cryptographic core (crypto.arith): streams keyed by purpose,
-independent children, and the rule for int seeds (issue 16, security)."""
+independent children, and the rule for int seeds (security)."""
 
 from __future__ import annotations
 
@@ -35,7 +35,7 @@ def _square(grp, x: int) -> int:
     return x * x % grp.p
 
 
-# ---------------------------------------------------------------------------- the attack of issue 16
+# ---------------------------------------------------------------------------- the attack on seeded keys
 @pytest.mark.parametrize("bits", [80, 96, 300])
 @pytest.mark.parametrize("seed", range(4))
 def test_seeded_secret_key_does_not_follow_from_the_public_prime(bits, seed):

@@ -1,5 +1,5 @@
 """Tests of the vectorised quantisation table (crypto.residue_table) against the encoder's
-nearest-member search of Definition def:ec, and of its memory bound (issue 16)."""
+nearest-member search of Definition def:ec, and of its memory bound."""
 
 from __future__ import annotations
 
@@ -64,7 +64,7 @@ def test_nearest_refuses_floats_and_out_of_range():
 
 def test_memory_is_estimated_and_refused_before_allocating():
     assert DEFAULT_MAX_TABLE_BYTES == 1 << 30
-    # x_bound = 2e4 at Delta = 4096 (issue 16: 6 GB before): limit 8.2e7, now within 1 GiB.
+    # x_bound = 2e4 at Delta = 4096 (6 GB before the bound): limit 8.2e7, now within 1 GiB.
     assert residue_table_bytes(81_920_001) < DEFAULT_MAX_TABLE_BYTES
     # x_bound = 1e6: refused at once, with the number.
     tracemalloc.start()

@@ -516,7 +516,7 @@ def _step_past_a_chunk() -> None:
     venv.close()
 
 
-# ------------------------------------------------------------------ hardening (issue 16 classes)
+# ------------------------------------------------------------------ hardening (the probe's classes)
 @pytest.mark.parametrize(
     "overrides,error,text",
     [
@@ -595,7 +595,7 @@ def test_a_quantisation_table_too_large_is_refused_with_its_size(x_bound):
         EncryptedLTIAttackEnv(config={**SMALL, "x_bound": x_bound})
 
 
-# ------------------------------------------------------------------ estimators (issue 14)
+# ------------------------------------------------------------------ estimators (beyond least squares)
 @pytest.mark.parametrize("estimator", ["bayes", "forgetting", "iv", {"name": "bayes", "prior_variance": 1.0, "noise_variance": 0.1}])
 def test_a_configured_estimator_gives_epsilon_and_reward_of_its_own_fit(estimator):
     """info["epsilon"] is the error of the estimator's fit on the delivered data (its batch fit
@@ -638,7 +638,7 @@ def test_a_bad_estimator_is_refused_at_construction(estimator, text):
         EncryptedLTIAttackEnv(config={**SMALL, "estimator": estimator})
 
 
-# ---------------------------------------------------------------- hardening (issue 16)
+# ---------------------------------------------------------------- hardening
 @pytest.mark.parametrize("action", [np.array([True, False]), [True, False], np.array([[0.1 + 1j, 0.0]]), np.array(["a", "b"])])
 def test_boolean_complex_and_string_actions_are_refused_naming_them(action):
     """A boolean action is not read as 0/1, a complex one is not cut to its real part."""

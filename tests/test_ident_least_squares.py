@@ -286,7 +286,7 @@ def test_property_prefix_grid_equals_least_squares(n: int, m: int, seed: int, cu
         np.testing.assert_allclose(theta[:, k], ref, rtol=0, atol=1e-8 * max(1.0, np.abs(ref).max()))
 
 
-# ---------------------------------------------------------------- hardening (issue 16)
+# ---------------------------------------------------------------- hardening
 @pytest.mark.parametrize("which", ["x_t", "u_t", "x_next"])
 @pytest.mark.parametrize("bad", [np.array([1j, 0.0]), np.array([True, False]), np.array(["a", "b"])])
 def test_rls_update_refuses_complex_boolean_and_string_data(which, bad) -> None:

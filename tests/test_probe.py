@@ -1,4 +1,4 @@
-"""The hardening probe of issue 16 as tests: every case of ``tests/probe`` runs in a forked child
+"""The hardening probe as tests: every case of ``tests/probe`` runs in a forked child
 with a memory cap and a timeout and must end ``ok`` (a package error naming the value, or a
 correct result for a valid input).
 

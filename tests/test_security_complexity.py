@@ -147,7 +147,7 @@ def test_bad_parameters_named() -> None:
         sample_identifying_complexity(5, 1.5 * np.eye(2), np.eye(2), sigma_u2=1.0, sigma_w2=1.0)
 
 
-# --------------------------------------------------------------------------- counts beyond the float range (issue 16)
+# --------------------------------------------------------------------------- counts beyond the float range
 @pytest.mark.parametrize("big", [10**400, 10**5000], ids=["10^400", "10^5000"])
 def test_counts_beyond_the_float_range_are_named(big: int) -> None:
     # a ParameterError that names the size, never an OverflowError from float(N) or (m + n) * sigma_w2

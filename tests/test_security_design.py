@@ -241,7 +241,7 @@ def test_bad_inputs() -> None:
         is_secure(10, gamma=lambda N: 1.0, gamma_c=0.1, tau_c=-1, upsilon=1)
 
 
-# --------------------------------------------------------------------------- the complexity gamma is checked (issue 16)
+# --------------------------------------------------------------------------- the complexity gamma is checked
 @pytest.mark.parametrize("bad", ["abc", None, 3])
 def test_gamma_must_be_callable(bad: object) -> None:
     with pytest.raises(ParameterError, match=f"gamma must be a callable.*got {re.escape(format_value(bad))}"):

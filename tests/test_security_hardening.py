@@ -245,7 +245,7 @@ def test_every_plant_file_error_is_a_package_error(tmp_path: Path) -> None:
         assert str(path) in str(info.value), text
 
 
-# --------------------------------------------------------------------------- plant files: entries, YAML floats, duplicates (issue 16)
+# --------------------------------------------------------------------------- plant files: entries, YAML floats, duplicates
 @pytest.mark.parametrize("text,match", [
     ('{"A": [[0.5, 0], [0, NaN]], "B": [[1], [0]]}', r"A must hold finite numbers, got nan at A\[1\]\[1\]"),
     ('{"A": [[0.5, Infinity], [0, 0.3]], "B": [[1], [0]]}', r"A must hold finite numbers, got inf at A\[0\]\[1\]"),

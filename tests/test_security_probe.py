@@ -1,7 +1,7 @@
 """Probe: inputs that used to hang or exhaust memory, each run in a forked child with a memory cap
 and a timeout (the shared harness, :func:`probe.harness.run_bounded`). Every case must end quickly
 with an error of the package's hierarchy (or a correct result), never a hang, an out-of-memory
-kill or another exception. The whole probe of issue 16 is ``tests/test_probe.py``.
+kill or another exception. The whole probe is ``tests/test_probe.py``.
 """
 
 from __future__ import annotations

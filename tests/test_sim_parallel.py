@@ -156,7 +156,7 @@ def test_log_grid() -> None:
         log_grid(10, 5, 3)
 
 
-# ---------------------------------------------------------------- hardening (issue 16)
+# ---------------------------------------------------------------- hardening
 def test_log_grid_refuses_sizes_beyond_int64_and_grids_beyond_memory() -> None:
     with pytest.raises(ParameterError, match=r"N_max must be <= 9007199254740992, got <integer of 1329 bits"):
         log_grid(10, 10**400, 5)

@@ -1,4 +1,4 @@
-"""The hardening probe of issue 16: bad inputs and security properties, each case run in a forked
+"""The hardening probe: bad inputs and security properties, each case run in a forked
 child with a memory cap and a timeout.
 
 * :mod:`.harness` - :class:`~.harness.Case`, the outcome classes, :func:`~.harness.run_bounded`

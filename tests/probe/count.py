@@ -1,4 +1,4 @@
-"""Run every probe case and print the count per class (issue 16: "the count of cases per class
+"""Run every probe case and print the count per class ("the count of cases per class
 before and after").
 
 Usage::

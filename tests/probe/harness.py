@@ -1,4 +1,4 @@
-"""The probe's harness: cases, outcome classes and bounded children (issue 16).
+"""The probe's harness: cases, outcome classes and bounded children.
 
 A :class:`Case` states what a call must do: ``expect="error"`` (the input is invalid: an error of
 :mod:`encctl_gym.errors` is due), ``"result"`` (the input is valid: a result is due, checked by
@@ -73,7 +73,7 @@ __all__ = [
     "fork_available",
 ]
 
-#: The failure classes of issue 16, in the order of its sections.
+#: The failure classes of the probe.
 CLASSES: tuple[str, ...] = ("security", "hang", "silent", "traceback")
 #: Every outcome of a case.
 OUTCOMES: tuple[str, ...] = ("ok", *CLASSES, "n/a")
