@@ -141,8 +141,8 @@ def main(argv: list[str] | None = None) -> int:
         vsps = vector_steps_per_second(vec, vec_acts[:est_steps])
         vec.close()
         est_rows.append((est, single, vsps))
-        print(f"estimator {est:<10}: single {single:10,.0f} steps/s ({single / our_sps:.2f}x ls), "
-              f"vector {vsps:12,.0f} env-steps/s ({vsps / vec_sps:.2f}x ls)")
+        print(f"estimator {est:<10}: single {single:10,.0f} steps/s ({single / our_sps:.2g}x ls), "
+              f"vector {vsps:12,.0f} env-steps/s ({vsps / vec_sps:.2g}x ls)")
 
     floor = powmod_seconds(712)
     per_step = elgamal_seconds_per_step(5 if args.quick else 30)
@@ -160,8 +160,8 @@ def main(argv: list[str] | None = None) -> int:
              f"{vec_sps / our_sps:.1f}x as constructed (helper thread); {one_sps / our_sps:.1f}x with `helper_thread=False`; "
              f"{par_sps / our_sps:.1f}x with `parallel=True`"),
             ("environment step through real ElGamal at 712 bits", f"{per_step * 1e3:.2f} ms = {per_step / floor:.1f} powmod times"),
-            ("estimators other than least squares (single env / vector env, against least squares)",
-             "; ".join(f"`{e}` {s1 / our_sps:.2f}x / {v / vec_sps:.2f}x" for e, s1, v in est_rows)),
+            ("estimators other than least squares: steps per second, single env / vector env (their share of least squares')",
+             "; ".join(f"`{e}` {s1:,.0f} ({s1 / our_sps:.2g}x) / {v:,.0f} ({v / vec_sps:.2g}x)" for e, s1, v in est_rows)),
         ], argv)
     return 0
 
