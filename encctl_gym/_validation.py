@@ -24,6 +24,7 @@ import numpy as np
 from .errors import ParameterError, ShapeError, UnstableSystemError
 
 __all__ = [
+    "one_line",
     "format_value",
     "check_positive",
     "check_nonnegative",
@@ -91,10 +92,10 @@ def format_value(value: Any, limit: int = 120) -> str:
             return repr(bytes(value[:limit])) + (f"... ({len(value)} bytes)" if len(value) > limit else "")
         if isinstance(value, np.ndarray):
             if value.dtype.kind in "biufc" and value.size <= 6:
-                body = _one_line(np.array2string(value, threshold=6, edgeitems=2, separator=", "))
+                body = one_line(np.array2string(value, threshold=6, edgeitems=2, separator=", "))
                 return f"array({body}, dtype={value.dtype})"
             if value.dtype.kind in "biufc":
-                body = _one_line(np.array2string(value.ravel()[:_MAX_ITEMS_SHOWN], separator=", "))
+                body = one_line(np.array2string(value.ravel()[:_MAX_ITEMS_SHOWN], separator=", "))
                 return f"<array of shape {value.shape}, dtype {value.dtype}, first entries {body[:limit]}>"
             return f"<array of shape {value.shape}, dtype {value.dtype}>"
         if isinstance(value, (list, tuple)):
@@ -107,18 +108,20 @@ def format_value(value: Any, limit: int = 120) -> str:
             items = ", ".join(f"{format_value(k, limit // 4)}: {format_value(value[k], limit // 2)}" for k in keys)
             more = f", ... ({len(value)} keys)" if len(value) > _MAX_ITEMS_SHOWN else ""
             return "{" + items + more + "}"
-        text = _one_line(repr(value))
+        text = one_line(repr(value))
     except Exception:  # noqa: BLE001 - a repr that fails must not hide the real error
         return f"<{type(value).__name__} object>"
     return text if len(text) <= limit else text[:limit] + f"... ({len(text)} characters)"
 
 
-def _one_line(text: str) -> str:
+def one_line(text: str) -> str:
     """``text`` with its line breaks and the indentation after them folded into single spaces
-    (NumPy prints a matrix on several lines; an error message is one line)."""
-    if "\n" not in text and "\r" not in text:
+    (NumPy prints a matrix on several lines; an error message, and the command line's print of
+    it, is one line)."""
+    lines = text.splitlines()
+    if lines == [text]:  # no line break at all
         return text
-    return " ".join(part.strip() for part in text.replace("\r", "\n").split("\n") if part.strip())
+    return " ".join(part.strip() for part in lines if part.strip())
 
 
 def _as_float(name: str, value: Any) -> float:

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from typing import NoReturn
 
 from . import __version__
+from ._validation import one_line
 from .errors import EncctlError
 
 # name -> (module, one-line help)
@@ -47,12 +48,6 @@ class OneLineParser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
-
-
-def one_line(message: str) -> str:
-    """``message`` on one line: its lines joined by spaces (an array's repr in a message spans
-    several lines; the command line prints every error as one)."""
-    return " ".join(part.strip() for part in message.splitlines() if part.strip())
 
 
 def build_parser(selected: str | None = None) -> argparse.ArgumentParser:
