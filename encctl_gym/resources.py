@@ -13,13 +13,14 @@ allocation that would end in ``MemoryError`` is refused with its estimate instea
 
 from __future__ import annotations
 
+import math
 import resource
 from pathlib import Path
 
 from ._validation import check_int
 from .errors import ResourceLimitError
 
-__all__ = ["MEMORY_LIMIT", "check_memory", "memory_headroom", "default_memory_limit"]
+__all__ = ["MEMORY_LIMIT", "check_memory", "memory_headroom", "default_memory_limit", "format_bytes"]
 
 #: Default largest allocation (bytes) of one structure; pass ``limit`` to allow more.
 MEMORY_LIMIT = 8 * 2**30
@@ -49,11 +50,17 @@ def default_memory_limit() -> int:
     return MEMORY_LIMIT if room is None else min(MEMORY_LIMIT, room)
 
 
-def _gib(n: int) -> str:
-    try:
-        return f"{n / 2**30:.3g}"
-    except OverflowError:  # an estimate beyond the float range (a count of 10**400)
-        return f"10^{int(n.bit_length() * 0.30103) - 9}"
+def format_bytes(n: int | float) -> str:
+    """A memory size in the most readable unit (``"512 MiB"``, ``"2.79e+06 GiB"``); an integer of
+    any size (``10**400`` bytes is ``"10^400 bytes"``, rounded to a power of ten: an estimate
+    beyond the float range)."""
+    if isinstance(n, int) and n.bit_length() > 1000:
+        return f"10^{(n.bit_length() - 1) * math.log10(2):.0f} bytes"
+    v = float(n)
+    for unit, size in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if v >= size:
+            return f"{v / size:.3g} {unit}"
+    return f"{v:.0f} bytes"
 
 
 def check_memory(what: str, need: int, limit: int | None = None, advice: str = "") -> None:
@@ -77,5 +84,5 @@ def check_memory(what: str, need: int, limit: int | None = None, advice: str = "
     else:
         cap, which = check_int("memory_limit", limit, minimum=1), "memory_limit"
     if need > cap:
-        msg = f"{what} needs about {_gib(need)} GiB, above the limit of {_gib(cap)} GiB ({which})"
+        msg = f"{what} needs about {format_bytes(need)}, above the limit of {format_bytes(cap)} ({which})"
         raise ResourceLimitError(msg + (f"; {advice}" if advice else ""))

@@ -42,6 +42,7 @@ from ..crypto import arith
 from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, KeyMismatchError, ParameterError
+from ..resources import format_bytes
 
 __all__ = [
     "Cost",
@@ -122,18 +123,6 @@ def format_seconds(seconds: float) -> str:
     if seconds < 86400 * 365:
         return f"{seconds / 3600:.3g} h"
     return f"{seconds / (86400 * 365.25):.3g} years"
-
-
-def format_bytes(n: int | float) -> str:
-    """A memory size in the most readable unit (``"512 MiB"``, ``"2.79e+06 GiB"``); an integer of
-    any size (``10**400`` bytes is ``"10^400 bytes"``, rounded to a power of ten)."""
-    if isinstance(n, int) and n.bit_length() > 1000:
-        return f"10^{(n.bit_length() - 1) * math.log10(2):.0f} bytes"
-    v = float(n)
-    for unit, size in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
-        if v >= size:
-            return f"{v / size:.3g} {unit}"
-    return f"{v:.0f} bytes"
 
 
 class Deadline:
