@@ -76,19 +76,36 @@ def check_n_jobs(n_jobs: Any) -> int:
 
 
 def check_scheduler(scheduler: Any) -> Any:
-    """A ``scheduler`` given by name (the command line's ``--scheduler``), checked before any work:
-    ``None``, ``"local"`` or a Dask scheduler address (``"tcp://host:8786"``: a string with
-    ``://``); any other object is passed through (:func:`run_tasks` accepts a
-    ``distributed.Client`` and refuses the rest when it uses it).
+    """A ``scheduler`` of :func:`run_tasks`, checked before any work: ``None``, ``"local"``, a Dask
+    scheduler address (``"tcp://host:8786"``: a location after ``protocol://``) or a
+    ``distributed.Client``.
 
     Raises
     ------
     ParameterError
-        For a string that is neither ``"local"`` nor an address.
+        For anything else (``"tcp://"`` alone, a string without ``://``, another object).
     """
-    if isinstance(scheduler, str) and scheduler != "local" and "://" not in scheduler:
+    if scheduler is None:
+        return None
+    if isinstance(scheduler, str):
+        if scheduler == "local":
+            return scheduler
+        if "://" not in scheduler:
+            raise ParameterError(
+                f"scheduler must be 'local' or a Dask scheduler address like 'tcp://host:8786', got {format_value(scheduler)}"
+            )
+        if not scheduler.partition("://")[2]:
+            raise ParameterError(f"scheduler address {format_value(scheduler)} names no host:port after its protocol")
+        return scheduler
+    try:  # an object can be a Client only where distributed is installed
+        from distributed import Client
+
+        is_client = isinstance(scheduler, Client)
+    except ImportError:
+        is_client = False
+    if not is_client:
         raise ParameterError(
-            f"scheduler must be 'local' or a Dask scheduler address like 'tcp://host:8786', got {format_value(scheduler)}"
+            f"scheduler must be None, 'local', a Dask scheduler address or a distributed.Client, got {format_value(scheduler)}"
         )
     return scheduler
 
@@ -152,20 +169,15 @@ def _dask_client(scheduler: Any, n_jobs: int, cluster_kwargs: dict[str, Any] | N
         with distributed.LocalCluster(**kwargs) as cluster, distributed.Client(cluster) as client:
             yield client
         return
-    if isinstance(scheduler, str) and "://" in scheduler:
-        if cluster_kwargs:
-            raise ParameterError("cluster_kwargs only apply to scheduler='local'")
-        try:
-            client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, TimeoutError) as exc:
-            raise ConfigError(f"cannot connect to the Dask scheduler at {scheduler!r}: {exc}") from exc
-        with client:
-            yield client
-        return
-    raise ParameterError(
-        f"scheduler must be None, 'local', a Dask scheduler address like 'tcp://host:8786' "
-        f"or a distributed.Client, got {format_value(scheduler)}"
-    )
+    # an address: check_scheduler (run_tasks) has refused everything else
+    if cluster_kwargs:
+        raise ParameterError("cluster_kwargs only apply to scheduler='local'")
+    try:
+        client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT)
+    except (OSError, TimeoutError) as exc:
+        raise ConfigError(f"cannot connect to the Dask scheduler at {scheduler!r}: {exc}") from exc
+    with client:
+        yield client
 
 
 def run_tasks(

@@ -69,6 +69,18 @@ def test_run_tasks_rejects_bad_options(kwargs) -> None:  # type: ignore[no-untyp
         run_tasks(draw, range(2), seed=0, **{"n_jobs": 2, **kwargs})
 
 
+@pytest.mark.parametrize(
+    "scheduler, message",
+    [("tcp://", "names no host:port"), (5, "or a distributed.Client, got 5"), (object(), "or a distributed.Client")],
+)
+def test_run_tasks_refuses_a_scheduler_before_any_task(scheduler, message) -> None:  # type: ignore[no-untyped-def]
+    def never(task, seed):  # type: ignore[no-untyped-def]
+        pytest.fail("a task ran")
+
+    with pytest.raises(ParameterError, match=message):
+        run_tasks(never, range(2), seed=0, scheduler=scheduler)
+
+
 def test_missing_dask_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "distributed", None)  # makes `import distributed` fail
     with pytest.raises(ConfigError, match=r"encctl-gym\[dask\]"):

@@ -89,21 +89,6 @@ def _clock(clock: str) -> str:
     return "seconds" if clock == "wall" else "cpu_seconds"
 
 
-def _check_scheduler(scheduler: Any) -> None:
-    """:func:`~encctl_gym.parallel.check_scheduler`, before the precomputation, and two checks it
-    leaves to :func:`~encctl_gym.parallel.run_tasks` (which runs after it): an address must name a
-    location after its ``protocol://`` (``"tcp://"`` alone reached ``distributed.Client`` as a
-    ``ValueError``), and an object must be a ``distributed.Client``."""
-    check_scheduler(scheduler)
-    if isinstance(scheduler, str):
-        if scheduler != "local" and not scheduler.partition("://")[2]:
-            raise ParameterError(f"scheduler address {format_value(scheduler)} names no host:port after its protocol")
-    elif scheduler is not None and not type(scheduler).__module__.startswith("distributed"):
-        raise ParameterError(
-            f"scheduler must be None, 'local', a Dask scheduler address or a distributed.Client, got {format_value(scheduler)}"
-        )
-
-
 def _break_chunk(task: tuple[Precomputation, list[int], float | None], seed: np.random.SeedSequence) -> list[RecoveredKey]:
     # One task of the parallel path: a copy of the precomputation and a run of consecutive keys.
     pre, hs, time_limit = task
@@ -182,7 +167,7 @@ def break_sequence(
         chunks = check_int("chunks", chunks, minimum=1)
     if not isinstance(seed, np.random.SeedSequence):
         seed = check_int("seed", seed, minimum=0)
-    _check_scheduler(scheduler)
+    check_scheduler(scheduler)
     if breaker.MAIN_THREAD_ONLY and scheduler is not None:
         raise ParameterError(
             f"breaker {breaker.name!r} runs only in a process's main thread and Dask runs tasks in threads: "
