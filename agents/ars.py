@@ -44,6 +44,7 @@ from sb3_contrib import ARS
 from sb3_contrib.ars.policies import ARSPolicy
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.evaluation import evaluate_policy
+from stable_baselines3.common.policies import BasePolicy
 from stable_baselines3.common.type_aliases import GymEnv, Schedule
 
 from encctl_gym.errors import ConfigError
@@ -78,7 +79,8 @@ class PairedARS(ARS):
         Adam's decay rates of the first and second moments (``step_rule="adam"``).
     """
 
-    policy_aliases: ClassVar[dict[str, type[ARSPolicy]]] = ARS.policy_aliases
+    policy_aliases: ClassVar[dict[str, type[BasePolicy]]] = ARS.policy_aliases
+    weights: th.Tensor  # type: ignore[assignment]  # the flat policy parameters; sb3-contrib declares None
 
     def __init__(
         self,
@@ -137,6 +139,7 @@ class PairedARS(ARS):
             returns, played = self._evaluate_batched(base, candidate_weights, seed)
         else:
             returns, played = self._evaluate_sequential(candidate_weights, seed)
+        assert self.env is not None  # set by the constructor (SB3 keeps it Optional for loading)
         n_envs = max(int(self.env.num_envs), 1)
         callback.on_rollout_start()
         for _ in range(max(played // n_envs, 1)):
@@ -146,8 +149,9 @@ class PairedARS(ARS):
         callback.on_rollout_end()
         return returns
 
-    def learn(self, total_timesteps: int, callback: Any = None, log_interval: int = 1, tb_log_name: str = "ARS",
-              reset_num_timesteps: bool = True, async_eval: Any = None, progress_bar: bool = False) -> "PairedARS":
+    def learn(  # type: ignore[override]  # sb3-contrib's ARS.learn adds async_eval before progress_bar
+        self, total_timesteps: int, callback: Any = None, log_interval: int = 1, tb_log_name: str = "ARS",
+              reset_num_timesteps: bool = True, async_eval: Any = None, progress_bar: bool = False) -> PairedARS:
         """As :meth:`sb3_contrib.ARS.learn`, and a callback returning False stops training."""
         total_steps, callback = self._setup_learn(total_timesteps, callback, reset_num_timesteps, tb_log_name, progress_bar)
         callback.on_training_start(locals(), globals())
@@ -225,7 +229,8 @@ class PairedARS(ARS):
             for i in range(self.pop_size):
                 if vn is not None:
                     vn.training = training and i == 0
-                policy.load_from_vector(candidate_weights[i].cpu())
+                policy.load_from_vector(candidate_weights[i].cpu())  # type: ignore[arg-type]  # SB3 accepts a tensor
+                assert self.env is not None
                 self.env.seed(seed)
                 rew, lens = evaluate_policy(policy, self.env, n_eval_episodes=self.n_eval_episodes, return_episode_rewards=True, warn=False)
                 returns[i] = float(np.mean(rew))
@@ -257,7 +262,7 @@ class PairedARS(ARS):
         m_hat = st["m"] / (1.0 - b1 ** st["t"])
         v_hat = st["v"] / (1.0 - b2 ** st["t"])
         self.weights = self.weights + lr * m_hat / (v_hat.sqrt() + 1e-8)
-        self.policy.load_from_vector(self.weights.cpu())
+        self.policy.load_from_vector(self.weights.cpu())  # type: ignore[arg-type]  # SB3 accepts a tensor
         self.logger.record("train/iterations", self._n_updates, exclude="tensorboard")
         self.logger.record("train/delta_std", delta_std)
         self.logger.record("train/learning_rate", lr)

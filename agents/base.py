@@ -84,7 +84,7 @@ class Attacker(ABC):
         self._batch: int | None = None
 
     @classmethod
-    def from_env(cls, env: Any, **kwargs: Any) -> "Attacker":
+    def from_env(cls, env: Any, **kwargs: Any) -> Attacker:
         """Build the attacker for ``env`` (single or vector, wrapped or not)."""
         return cls(params_of(env), **kwargs)
 

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from encctl_gym._validation import check_int
-from encctl_gym.envs.config import AttackParams, resolve_params
+from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ParameterError
 
 from .base import Attacker
@@ -149,7 +149,7 @@ class Rollout:
 
 def rollout(
     attacker: Attacker,
-    config: dict[str, Any] | AttackParams,
+    config: dict[str, Any],
     *,
     episodes: int,
     seed: int = 0,
@@ -244,14 +244,14 @@ def rollout(
             attacker.reset(seed=np.random.SeedSequence([seed, e]))
             eps_t, en_t, Ns = [], [], []
             while True:
-                obs, _, te, tr, info = env1.step(attacker.act(obs))
+                obs, _, te1, tr1, info = env1.step(attacker.act(obs))
                 if record:
                     eps_t.append(info["epsilon"])
                     en_t.append(info["input_energy"])
                     Ns.append(info["samples_delivered"])
                 if progress is not None:
                     progress.update(1)
-                if te or tr:
+                if te1 or tr1:
                     break
             if covariance:
                 add_gram(env1.episode, 1)

@@ -26,7 +26,8 @@ A new feature is a subclass of :class:`Feature` and a row of :data:`FEATURES`.
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 

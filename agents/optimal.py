@@ -71,7 +71,7 @@ class OptimalDesignAttacker(Attacker):
         self._A, self._B = params.A, params.B
 
     @classmethod
-    def from_env(cls, env: Any, **kwargs: Any) -> "OptimalDesignAttacker":
+    def from_env(cls, env: Any, **kwargs: Any) -> OptimalDesignAttacker:
         """From an environment; reuses the environment's own design when it computed one."""
         from .base import params_of
 
@@ -98,6 +98,7 @@ class OptimalDesignAttacker(Attacker):
         if not self.feedback:
             return self._x
         d = self.params.decipher_delay
+        assert d is not None  # a feedback attacker needs delivered states (checked in __init__)
         j = self._k - d  # index of the latest delivered state
         if d == 0:
             return obs[:, self.layout.state]

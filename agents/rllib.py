@@ -22,7 +22,8 @@ RLlib env runner (one Python ``step`` per copy) does not.
 
 from __future__ import annotations
 
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 from encctl_gym.errors import EncctlError
 

@@ -249,7 +249,7 @@ class SB3Attacker(Attacker):
         self._episode_start: np.ndarray | None = None
 
     @classmethod
-    def from_env(cls, env: Any, **kwargs: Any) -> "SB3Attacker":
+    def from_env(cls, env: Any, **kwargs: Any) -> SB3Attacker:
         from .base import params_of
 
         return cls(params=params_of(env), **kwargs)

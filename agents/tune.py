@@ -32,8 +32,9 @@ from __future__ import annotations
 import argparse
 import copy
 import math
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import yaml

@@ -120,7 +120,7 @@ def bench_size(bits: int, reps: int, fresh_samples: int, fresh_timeout: float, s
         ctrl = EncryptedLinearController(PHI, grp, 2.0**16, 10.0, scheme=scheme)
         xs = np.random.default_rng(0).uniform(-10, 10, (reps + 1, 4))
         it = iter(xs)
-        t_step = timeit(lambda: ctrl.step(next(it)), reps)
+        t_step = timeit(lambda ctrl=ctrl, it=it: ctrl.step(next(it)), reps)
         with arith.PowmodCounter() as c:
             ctrl.step(xs[0])
         steps[scheme] = (t_step, c.count)

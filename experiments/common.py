@@ -12,9 +12,10 @@ import csv
 import os
 import sys
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -79,7 +80,7 @@ class Table:
     columns: dict[str, np.ndarray] = field(default_factory=dict)
 
     @classmethod
-    def concat(cls, parts: Sequence["Table"]) -> "Table":
+    def concat(cls, parts: Sequence[Table]) -> Table:
         """Stack tables with the same columns."""
         if not parts:
             return cls({c: np.array([]) for c in COLUMNS})
@@ -98,7 +99,7 @@ class Table:
         sigma_w2: float,
         sigma_u2: float,
         psi_u: float,
-    ) -> "Table":
+    ) -> Table:
         """Rows of one panel from ``errors`` of shape (runs, K) and per-N curves of shape (K,)."""
         runs, K = errors.shape
         N = np.tile(grid, runs)
@@ -128,7 +129,7 @@ class Table:
         _, idx = np.unique(labels.astype(str), return_index=True)
         return [str(labels[i]) for i in sorted(idx)]
 
-    def panel(self, label: str) -> "Table":
+    def panel(self, label: str) -> Table:
         """The rows of one panel."""
         mask = self.columns["panel"].astype(str) == label
         if not mask.any():
@@ -282,7 +283,7 @@ def preset_spec(name: str) -> Any:
 def figure_table(
     figure: str, number: int, panels: Sequence[tuple[str, Any]], config: GridConfig, *, seed: int, n_jobs: int,
     scheduler: Any, progress: bool, bound: bool = False,
-) -> "Table":
+) -> Table:
     """The data of one of the paper's figures: for each ``(letter, spec)`` of ``panels``,
     ``config.runs`` Gaussian attacks identified on the grid of N (Definition def:error), with
     ``gamma(N)`` of eq:sic2 and, with ``bound``, eq:bound (:func:`panel_table`).
@@ -301,29 +302,26 @@ def figure_table(
     return Table.concat([panel_table(figure, letter, spec, grid, errors, bound=bound) for (letter, spec), errors in zip(panels, errors_all)])
 
 
-def panel_table(figure: str, panel: str, spec: Any, grid: np.ndarray, errors: np.ndarray, *, bound: bool = False) -> "Table":
+def panel_table(figure: str, panel: str, spec: Any, grid: np.ndarray, errors: np.ndarray, *, bound: bool = False) -> Table:
     """The rows of one panel of Figure 1 or 2: the errors of its runs with ``gamma(N)`` of eq:sic2,
     ``psi_u`` (the scalar of ``Psi_u = psi_u I`` computed from ``(A, B)``) and, with ``bound``,
     the upper bound eq:bound ``(m+n) / ((N-1) m R_sigma)``."""
-    from encctl_gym.security.complexity import (
-        input_upper_bound,
-        sample_identifying_complexity_asymptotic,
-    )
+    from encctl_gym.security.complexity import input_upper_bound, sample_identifying_complexity_asymptotic
     from encctl_gym.security.gramians import controllability_gramian
 
     n, m = spec.B.shape
     r_sigma = spec.sigma_u2 / spec.sigma_w2
     gamma = sample_identifying_complexity_asymptotic(grid, spec.A, spec.B, r_sigma=r_sigma)
     psi_u = float(np.trace(controllability_gramian(spec.A, spec.B))) / n
-    extra = {"bound": input_upper_bound(grid, m, n, r_sigma)} if bound else {}
+    extra = {"bound": np.asarray(input_upper_bound(grid, m, n, r_sigma))} if bound else {}
     return Table.from_errors(
-        figure=figure, panel=panel, grid=grid, errors=errors, gamma=gamma,
+        figure=figure, panel=panel, grid=grid, errors=errors, gamma=np.asarray(gamma),
         sigma_w2=spec.sigma_w2, sigma_u2=spec.sigma_u2, psi_u=psi_u, **extra,
     )
 
 
 def panel_figure(
-    table: "Table", panels: Sequence[str], shape: tuple[int, int], figsize: tuple[float, float], title: Callable[[dict[str, Any]], str],
+    table: Table, panels: Sequence[str], shape: tuple[int, int], figsize: tuple[float, float], title: Callable[[dict[str, Any]], str],
     suptitle: str, path: str | Path, *, bound: bool = False, rect: tuple[float, float, float, float] = (0, 0.05, 1, 0.95),
 ) -> Path:
     """A grid of :func:`plot_panel` panels, one per label of ``panels`` (``title(summary)`` each),
@@ -351,7 +349,7 @@ def panel_figure(
     return path
 
 
-def run_figure(args: argparse.Namespace, compute: Callable[..., "Table"], plot: Callable[..., Path], stem: str, label: str) -> int:
+def run_figure(args: argparse.Namespace, compute: Callable[..., Table], plot: Callable[..., Path], stem: str, label: str) -> int:
     """Compute a figure's table, save ``<stem>.csv`` and ``<stem>.png`` under ``args.out``, print the paths."""
     out = ensure_out_dir(args.out)
     t0 = time.perf_counter()
@@ -381,7 +379,7 @@ def entry_point(
 
 
 def figure_entry_points(
-    stem: str, label: str, compute: Callable[..., "Table"], plot: Callable[..., Path], doc: str | None
+    stem: str, label: str, compute: Callable[..., Table], plot: Callable[..., Path], doc: str | None
 ) -> tuple[Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int], Callable[..., int]]:
     """``add_arguments``, ``run`` and ``main`` of a figure script: the common options, then
     :func:`run_figure` (``<stem>.csv`` and ``<stem>.png`` under ``--out``)."""

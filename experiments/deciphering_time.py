@@ -58,8 +58,9 @@ import csv
 import dataclasses
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -352,7 +353,7 @@ def plot(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
     return path
 
 
-def model_curves(bits: Sequence[int], n: Sequence[int], *, model_bits: int) -> dict[str, dict[str, np.ndarray]]:
+def model_curves(bits: Sequence[int] | np.ndarray, n: Sequence[int] | np.ndarray, *, model_bits: int) -> dict[str, dict[str, np.ndarray]]:
     """What each deciphering-cost model of :mod:`encctl_gym.security.cost_models` predicts, in the
     units the measurements can be compared with (ratios: the models count abstract operations):
 
@@ -437,7 +438,7 @@ def plot_models(rows: Sequence[dict[str, Any]], path: str | Path, *, model_bits:
 
 def format_table(fits: Sequence[dict[str, Any]]) -> str:
     """The measured table: bits, breaker, T_first, T_1, T_1 / T_first, and each breaker's largest size."""
-    largest = {}
+    largest: dict[str, int] = {}
     for f in fits:
         largest[f["breaker"]] = max(largest.get(f["breaker"], 0), f["bits"])
     lines = [f"{'bits':>5}  {'breaker':<15} {'T_first (s)':>12} {'T_1 (s)':>12} {'T_1/T_first':>12} {'N_max':>6} "

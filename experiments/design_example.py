@@ -24,8 +24,9 @@ import argparse
 import csv
 import math
 import sys
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -81,7 +82,7 @@ def cost_model_designs(N_star: int | None = None) -> list[KeyLengthDesign]:
     """``k*`` of the design example under every model, without and with the 11.91-bit GNFS correction
     (the generic model has no GNFS term and appears once)."""
     N = paper_design_example().N_star if N_star is None else N_star
-    kw = dict(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"])
+    kw: dict[str, Any] = dict(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"])
     rows = []
     for correction in (0.0, GUILLEVIC_CORRECTION):
         for name in DECIPHERING_MODELS:
@@ -95,14 +96,14 @@ def key_values(key_length: int | None = None) -> list[KeyValue]:
     """What the paper's ``k*`` (or ``key_length``) is worth under every model (no correction)."""
     d = paper_design_example()
     k = d.k_star if key_length is None else key_length
-    kw = dict(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"])
+    kw: dict[str, Any] = dict(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"])
     return [key_length_value(name, k, N_star=d.N_star, **kw) for name in DECIPHERING_MODELS]
 
 
 def dynamic_key_bits(samples: Sequence[int] = DYNAMIC_KEY_SAMPLES) -> list[tuple[int, float, int, float]]:
     """For each sample size ``N``: ``log2 N`` (what the dynamic keys add under the paper's cost), the
     precomputation model's ``k*`` for ``N`` and the bits the dynamic keys add there."""
-    kw = dict(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"])
+    kw: dict[str, Any] = dict(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"])
     out = []
     for N in samples:
         d = design_key_length("precomputation", N, **kw)
@@ -182,8 +183,8 @@ def run(args: argparse.Namespace) -> int:
         w = csv.writer(fh)
         fields = list(designs[0].to_dict())
         w.writerow(fields)
-        for d in designs:
-            dd = d.to_dict()
+        for kd in designs:
+            dd = kd.to_dict()
             w.writerow([repr(dd[f]) if isinstance(dd[f], float) else dd[f] for f in fields])
     print(f"  wrote {path}")
     return 0

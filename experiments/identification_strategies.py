@@ -45,9 +45,10 @@ import csv
 import math
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -62,11 +63,11 @@ from encctl_gym.ident.estimator import Estimator, estimate_errors
 from encctl_gym.ident.registry import estimator_names, make_estimator
 from encctl_gym.security.design import minimum_key_length, optimal_security_parameter, sample_size_for_rate
 from encctl_gym.sim.montecarlo import log_grid
+from experiments.common import add_common_arguments, ensure_out_dir, entry_point
 from experiments.compare.attackers import ATTACKERS, learned_attackers, make_attackers
 from experiments.compare.settings import Setting, make_setting
 from experiments.compare.statistics import fit_rate
 from experiments.compare.tables import bound_rows
-from experiments.common import add_common_arguments, ensure_out_dir, entry_point
 
 __all__ = [
     "DEFAULT_SYSTEMS",
@@ -149,7 +150,7 @@ def table_sizes(setting: Setting, cap: int | None) -> tuple[int, int, int, bool]
     p = setting.base
     N_star = int(bound_rows(setting)[0]["N_to_gamma_c"])
     capped = cap is not None and N_star > cap
-    top = int(cap) if capped else N_star
+    top = int(cap) if cap is not None and capped else N_star
     small = p.n + p.m + 1
     return small, int(round(math.sqrt(small * top))), top, capped
 
@@ -225,7 +226,10 @@ def compute(
         raise ParameterError("estimators must not be empty")
     if episodes < 2:
         raise ParameterError(f"episodes must be >= 2 (standard errors), got {episodes}")
-    settings, curves, checks, sizes = [], {}, {}, {}
+    settings: list[Any] = []
+    curves: dict[str, list[Curve]] = {}
+    checks: dict[str, Any] = {}
+    sizes: dict[str, Any] = {}
     for system in systems:
         s = make_setting(system, 0, cap)
         settings.append(s)
@@ -233,7 +237,7 @@ def compute(
         grid = attack_lengths(s, cap, points)
         p = s.params
         for est in ests:
-            est.check_dimensions(p.n, p.m)  # type: ignore[attr-defined]
+            est.check_dimensions(p.n, p.m)
         atts = make_attackers(s, tuple(ATTACKERS)) + learned_attackers(s, list(runs), which)
         curves[system] = []
         worst = 0.0
@@ -418,12 +422,12 @@ def plot(result: Result, out: Path) -> list[Path]:
     for i, system in enumerate(systems):
         for j, att in enumerate(attackers):
             ax = axes[i, j]
-            cs = {c.estimator: c for c in result.curves[system] if c.attacker == att}
-            ref = next((c for c in cs.values() if c.estimator == "ls"), None)
+            by_est = {c.estimator: c for c in result.curves[system] if c.attacker == att}
+            ref = by_est.get("ls")
             if ref is None:
                 ax.axis("off")
                 continue
-            for lab, c in cs.items():
+            for lab, c in by_est.items():
                 r = c.mean / ref.mean
                 ok = np.isfinite(r)
                 ax.plot(c.N[ok], r[ok], color=color[lab], lw=1.3, marker="o", ms=2, label=lab)

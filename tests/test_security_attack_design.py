@@ -139,7 +139,9 @@ def test_paper_example_values() -> None:
     cl = optimal_attack_design(A, B, sigma_u2=10, sigma_w2=0.1)
     # decoupled channels: each is the scalar problem a = sqrt(1/2), b = 1/2, q = 10:
     # p = sqrt(2) c + 5.2, minimise (p + 10) / (10 p - c^2) over c.
-    f = lambda c: (np.sqrt(2) * c + 15.2) / (10 * (np.sqrt(2) * c + 5.2) - c * c)
+    def f(c):
+        return (np.sqrt(2) * c + 15.2) / (10 * (np.sqrt(2) * c + 5.2) - c * c)
+
     res = scipy.optimize.minimize_scalar(f, bounds=(0, 10), method="bounded", options={"xatol": 1e-12})
     assert cl.trace_inv == pytest.approx(4 * res.fun, rel=1e-7)
     np.testing.assert_allclose(cl.K, res.x / (np.sqrt(2) * res.x + 5.2) * np.eye(4), atol=1e-5)

@@ -11,7 +11,7 @@ a ``blind`` policy in every setting.
 from __future__ import annotations
 
 from collections import Counter
-from typing import Callable, Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -71,7 +71,7 @@ def learned_attackers(setting: Setting, runs: Sequence[RunInfo], which: str = "b
                           "install the extra: pip install 'encctl-gym[rl]'") from exc
     names = [r.algo + ("-blind" if r.observation == "blind" else "") for r in chosen]
     count = Counter(names)
-    out = []
+    out: list[Attacker] = []
     for run, name in zip(chosen, names):
         label = name if count[name] == 1 else f"{name} ({run.path.name})"
         w = which if which == "final" or (run.path / "best_model.zip").exists() else "final"

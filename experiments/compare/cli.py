@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 from agents.runs import MODEL_FILES, check_output_dir, find_runs
 from encctl_gym._validation import format_value

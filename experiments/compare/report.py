@@ -8,8 +8,9 @@ Nothing here is fixed text about the outcome: every statement is computed from a
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 

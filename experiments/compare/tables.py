@@ -130,7 +130,7 @@ def curve_rows(result: Result) -> list[tuple[Any, ...]]:
     for key, cs in result.curves.items():
         s = by_key[key]
         for c in cs:
-            parts = [("fresh", c.N, c.mean, c.se, np.full(c.N.shape, np.nan))]
+            parts: list[tuple[str, Any, Any, Any, Any]] = [("fresh", c.N, c.mean, c.se, np.full(c.N.shape, np.nan))]
             if c.along_N is not None:
                 parts.append(("along", c.along_N, c.along_mean, c.along_se, c.along_energy))
             for protocol, Ns, means, ses, efrac in parts:
