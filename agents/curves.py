@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from encctl_gym.errors import ConfigError
+from encctl_gym.plotting import save_figure
 
 __all__ = ["CURVE_FILE", "LearningCurve", "reference_designs", "curve_for", "load_learning_curve", "plot_learning_curves"]
 
@@ -210,18 +211,24 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
     refs = [c.gamma_gauss / c.gamma_opt for c in cs] + [c.gamma / c.gamma_opt for c in cs]
     top = max(2.0, 1.3 * max(refs))
     peak = max(float(np.nanmax(c.ratio()[0])) for c in cs)
-    if peak > top:
-        low = min(0.9, min(float(np.nanmin(c.ratio()[0])) for c in cs) * 0.97)
+    low = min(0.9, min(float(np.nanmin(c.ratio()[0])) for c in cs) * 0.97)
+    # every curve keeps at least its last evaluation in view: a short (quick) run that never came
+    # near the optimum is drawn on a log axis instead of being cut away
+    last_below_cut = all(float(c.ratio()[0][np.isfinite(c.ratio()[0])][-1]) <= top for c in cs)
+    if peak > top and last_below_cut:
         ax.set_ylim(low, top)
         ax.text(0.5, 0.98, f"cut at {top:.2g}: early evaluations up to {peak:.3g}", transform=ax.transAxes,
                 fontsize=7, va="top", ha="center")
+    elif peak > top:
+        ax.set_yscale("log")
+        ax.set_ylim(low, 1.5 * peak)
     ax.set_ylabel("E[eps(N)] / gamma_opt(N)  (evaluation episodes)")
     ax.set_title(title or "Learning curves: evaluation error over the optimum", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=110, bbox_inches="tight")
+    save_figure(fig, path, dpi=110, tight=True)
     plt.close(fig)
     return path
 

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from encctl_gym.errors import ParameterError
+from encctl_gym.plotting import save_figure
 from encctl_gym.sim.montecarlo import log_grid
 
 __all__ = [
@@ -344,7 +345,7 @@ def panel_figure(
     fig.suptitle(suptitle, fontsize=10)
     fig.tight_layout(rect=rect)
     path = Path(path)
-    fig.savefig(path, dpi=130)
+    save_figure(fig, path, dpi=130)
     plt.close(fig)
     return path
 

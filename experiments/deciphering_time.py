@@ -74,6 +74,7 @@ from encctl_gym.crypto import arith
 from encctl_gym.crypto.group import generate_safe_prime_group
 from encctl_gym.errors import BreakerError, ParameterError
 from encctl_gym.parallel import child_seeds, run_tasks
+from encctl_gym.plotting import save_figure
 from experiments.common import add_common_arguments, ensure_out_dir, entry_point
 
 __all__ = [
@@ -348,7 +349,7 @@ def plot(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
     ax.legend(fontsize=8, ncol=4, frameon=False)
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path
 
@@ -431,7 +432,7 @@ def plot_models(rows: Sequence[dict[str, Any]], path: str | Path, *, model_bits:
     ax2.legend(fontsize=7, ncol=3, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.14))
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path
 

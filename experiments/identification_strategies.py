@@ -61,6 +61,7 @@ from agents.runs import RunInfo, find_runs
 from encctl_gym.errors import ParameterError
 from encctl_gym.ident.estimator import Estimator, estimate_errors
 from encctl_gym.ident.registry import estimator_names, make_estimator
+from encctl_gym.plotting import legend_below, save_figure
 from encctl_gym.security.design import minimum_key_length, optimal_security_parameter, sample_size_for_rate
 from encctl_gym.sim.montecarlo import log_grid
 from experiments.common import add_common_arguments, ensure_out_dir, entry_point
@@ -396,7 +397,6 @@ def plot(result: Result, out: Path) -> list[Path]:
                 ax.fill_between(c.N[ok], lo[ok], (mean + 1.96 * se)[ok], color=color[c.estimator], alpha=0.2, lw=0)
             ax.plot(Nl, s.params.gamma(Nl), "k--", lw=1.0, label="gamma(N), eq:sic")
             ax.plot(Nl, s.design.gamma(Nl), "k:", lw=1.4, label="gamma_opt(N)")
-            ax.axhline(s.base.gamma_c, color="0.5", lw=0.7, ls="-.", label="gamma_c")
             ax.set(xscale="log", yscale="log")
             ax.grid(True, which="major", alpha=0.3)
             if i == 0:
@@ -408,13 +408,15 @@ def plot(result: Result, out: Path) -> list[Path]:
             lo_y = float(np.nanmin([np.nanmin(c.mean) for c in cs] + [float(np.min(s.design.gamma(Nl)))]))
             hi_y = float(np.nanmax([np.nanmax(c.mean[np.isfinite(c.mean)]) if np.isfinite(c.mean).any() else lo_y for c in cs]))
             ax.set_ylim(0.5 * lo_y, 2.0 * max(hi_y, lo_y))
-    axes[0, 0].legend(fontsize=6, loc="lower left")
+            if 0.5 * lo_y <= s.base.gamma_c <= 2.0 * max(hi_y, lo_y):  # short runs end above gamma_c
+                ax.axhline(s.base.gamma_c, color="0.5", lw=0.7, ls="-.", label="gamma_c")
+    bottom = legend_below(fig, axes)
     E = result.curves[systems[0]][0].errors.shape[0]
     fig.suptitle(f"Identification strategies: mean error (95 % band, {E} attacks per N at energy m sigma_u2 N) "
                  "of each estimator on the same delivered data", fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     path = out / "identification_strategies.png"
-    fig.savefig(path, dpi=100)
+    save_figure(fig, path, dpi=100)
     plt.close(fig)
     paths.append(path)
 
@@ -440,11 +442,11 @@ def plot(result: Result, out: Path) -> list[Path]:
                 ax.set_ylabel(f"{system}\nE[eps] / E[eps of ls]", fontsize=9)
             if i == len(systems) - 1:
                 ax.set_xlabel("attack length N", fontsize=9)
-    axes[0, 0].legend(fontsize=6, loc="lower right")
+    bottom = legend_below(fig, axes)
     fig.suptitle("Each estimator's mean error over that of least squares (eq:estimate), same data", fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     path = out / "identification_strategies_ratio.png"
-    fig.savefig(path, dpi=100)
+    save_figure(fig, path, dpi=100)
     plt.close(fig)
     paths.append(path)
     return paths
