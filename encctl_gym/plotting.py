@@ -120,7 +120,7 @@ def layout_problems(fig: Any, *, tight: bool = False) -> list[str]:
             for a, b in _overlapping_pairs(labels, renderer):
                 problems.append(f"{name!r}: {axis_name} tick labels {a.get_text()!r} and {b.get_text()!r} overlap")
         for line in ax.get_lines():
-            if not line.get_visible() or line.get_label().startswith("_"):
+            if not line.get_visible() or str(line.get_label()).startswith("_"):
                 continue
             xy = np.column_stack([np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)])
             xy = xy[np.isfinite(xy).all(axis=1)]
@@ -130,7 +130,7 @@ def layout_problems(fig: Any, *, tight: bool = False) -> list[str]:
         if legend is not None and legend.get_visible():
             box = legend.get_window_extent(renderer)
             for line in ax.get_lines():
-                if not isinstance(line, Line2D) or not line.get_visible() or line.get_label().startswith("_"):
+                if not isinstance(line, Line2D) or not line.get_visible() or str(line.get_label()).startswith("_"):
                     continue
                 xy = np.column_stack([np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)])
                 xy = xy[np.isfinite(xy).all(axis=1)]
@@ -146,7 +146,8 @@ def layout_problems(fig: Any, *, tight: bool = False) -> list[str]:
     if not tight:
         canvas = fig.bbox
         # tick labels exist for ticks outside the view too; only the drawn ones count
-        all_ticks, drawn = set(), set()
+        all_ticks: set[int] = set()
+        drawn: set[int] = set()
         for ax in fig.axes:
             for axis in (ax.xaxis, ax.yaxis):
                 for tick in axis.get_major_ticks() + axis.get_minor_ticks():
