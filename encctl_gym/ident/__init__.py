@@ -9,6 +9,8 @@
   least squares, Bayesian least squares (Gaussian prior, ridge posterior mean), exponential
   forgetting, instrumental variables.
 * :mod:`.registry` -- estimators by name (``make_estimator("bayes")``).
+* :mod:`.subspace` -- identification from outputs ``y = C x + D u + v``: N4SID, PO-MOESP and
+  ARX on batches of runs, and the basis-free Markov-parameter error.
 
 Pure numerical code (numpy): it imports only the package's base modules. The sample
 identifying complexities of :mod:`encctl_gym.security` bound the expected error of these
@@ -27,12 +29,13 @@ from .instrumental import *  # noqa: F403
 from .least_squares import *  # noqa: F403
 from .ordinary import *  # noqa: F403
 from .registry import *  # noqa: F403
+from .subspace import *  # noqa: F403
 
 #: The public names of the modules above, in their order (each module's ``__all__``).
 __all__ = list(
     dict.fromkeys(
         name
-        for module in ("error", "least_squares", "estimator", "ordinary", "bayes", "forgetting", "instrumental", "registry")
+        for module in ("error", "least_squares", "estimator", "ordinary", "bayes", "forgetting", "instrumental", "registry", "subspace")
         for name in sys.modules[f"{__name__}.{module}"].__all__
     )
 )
