@@ -28,6 +28,9 @@ design
 key_length
     eq:opt_key generalised: the smallest safe key length under each cost model, and what a key
     is worth under each.
+empirical
+    An empirical sample identifying complexity (a fitted ``c / N^a`` with bootstrap intervals)
+    for estimators without a closed form, and the design with intervals for N*, lambda*, k*.
 attack_design
     A-optimal attack inputs (closed and open loop), ``gamma_opt`` and robust designs (needs
     cvxpy; imported on use).
@@ -45,6 +48,7 @@ from .complexity import *  # noqa: F403
 from .cost_models import *  # noqa: F403
 from .deciphering import *  # noqa: F403
 from .design import *  # noqa: F403
+from .empirical import *  # noqa: F403
 from .exact import *  # noqa: F403
 from .gramians import *  # noqa: F403
 from .key_length import *  # noqa: F403
@@ -66,6 +70,7 @@ __all__ = list(
             "deciphering",
             "design",
             "key_length",
+            "empirical",
             "attack_design",
         )
         for name in sys.modules[f"{__name__}.{module}"].__all__
