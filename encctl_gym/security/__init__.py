@@ -28,6 +28,9 @@ design
 key_length
     eq:opt_key generalised: the smallest safe key length under each cost model, and what a key
     is worth under each.
+defenses
+    The defences' closed forms: eq:sic with the defender's input noise, its Lyapunov price,
+    audit rates, the chi-squared detector's threshold, group rotation's precomputations.
 empirical
     An empirical sample identifying complexity (a fitted ``c / N^a`` with bootstrap intervals)
     for estimators without a closed form, and the design with intervals for N*, lambda*, k*.
@@ -47,6 +50,7 @@ from .bayes_complexity import *  # noqa: F403
 from .complexity import *  # noqa: F403
 from .cost_models import *  # noqa: F403
 from .deciphering import *  # noqa: F403
+from .defenses import *  # noqa: F403
 from .design import *  # noqa: F403
 from .empirical import *  # noqa: F403
 from .exact import *  # noqa: F403
@@ -70,6 +74,7 @@ __all__ = list(
             "deciphering",
             "design",
             "key_length",
+            "defenses",
             "empirical",
             "attack_design",
         )
