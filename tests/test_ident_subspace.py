@@ -149,3 +149,34 @@ def test_refusals_name_the_bad_value():
         moesp(u, y, order=4, block_rows=2)
     with pytest.raises(ParameterError, match="ARX"):
         arx(u[:, :5], y[:, :5], na=3, nb=3)
+
+
+def test_output_attacks_with_every_state_measured_match_least_squares_on_the_states():
+    """C = I without measurement noise: both errors are returned, the error falls with N, and
+    N4SID on the outputs does worse than least squares on the same states."""
+    from encctl_gym.sim.output import output_attack_errors
+    from encctl_gym.sim.plant import LinearPlant
+
+    plant = LinearPlant(np.array([[0.6, 0.2], [-0.1, 0.5]]), np.array([[1.0, 0.0], [0.3, 0.8]]), sigma_w2=0.1)
+    grid = np.array([50, 200, 800])
+    out = output_attack_errors(plant, np.eye(2), sample_sizes=grid, runs=6, sigma_u2=1.0, sigma_v2=0.0, seed=0, estimator="n4sid")
+    assert set(out) == {"markov", "state_ls", "state_ls_markov"}
+    assert np.all(np.median(out["markov"], axis=0)[::-1] < 1) and np.median(out["markov"][:, -1]) < np.median(out["markov"][:, 0])
+    # the subspace estimate needs more data than least squares on the states for the same error
+    assert np.median(out["markov"][:, -1]) > np.median(out["state_ls_markov"][:, -1])
+
+
+def test_output_attack_refusals():
+    from encctl_gym.sim.output import output_attack_errors
+    from encctl_gym.sim.plant import LinearPlant
+
+    plant = LinearPlant(0.5 * np.eye(2), np.eye(2), sigma_w2=0.1)  # A = a I: C = [1 0] shows one state
+    kw = dict(sample_sizes=[100, 200], runs=2, sigma_u2=1.0, seed=0)
+    with pytest.raises(ParameterError, match="exceeds the observable order 1"):
+        output_attack_errors(plant, [[1.0, 0.0]], sigma_v2=0.0, order=2, **kw)
+    with pytest.raises(ShapeError, match="C must have shape \\(p, 2\\)"):
+        output_attack_errors(plant, np.eye(3), sigma_v2=0.0, **kw)
+    with pytest.raises(ParameterError, match="sigma_v2"):
+        output_attack_errors(plant, np.eye(2), sigma_v2=-1.0, **kw)
+    with pytest.raises(ParameterError, match="unknown output estimator 'cva'"):
+        output_attack_errors(plant, np.eye(2), sigma_v2=0.0, estimator="cva", **kw)
