@@ -90,7 +90,7 @@ __all__ = [
 PAPER_EXAMPLE: dict[str, Any] = PAPER_DESIGN_EXAMPLE
 
 #: Values of :attr:`SecurityDesign.method`: the complexity that gave ``N*``.
-METHODS: tuple[str, ...] = ("asymptotic", "exact", "closed_loop", "open_loop", "gaussian")
+METHODS: tuple[str, ...] = ("asymptotic", "exact", "closed_loop", "open_loop", "gaussian", "input_noise")
 
 
 @dataclass(frozen=True)
@@ -102,7 +102,8 @@ class SecurityDesign:
     method : str
         ``"asymptotic"`` (eq:sic2, the paper's Theorem thm:opt_sec), ``"exact"`` (eq:sic),
         ``"closed_loop"``, ``"open_loop"`` or ``"gaussian"`` (robust designs of
-        :mod:`encctl_gym.security.attack_design`).
+        :mod:`encctl_gym.security.attack_design`), ``"input_noise"`` (the defender's input noise,
+        :func:`encctl_gym.security.defenses.noise_defense_design`).
     N_star : int
         Smallest sample size with ``gamma(N) < gamma_c``.
     lam_star : int
