@@ -81,8 +81,9 @@ def format_tables(noise: list[dict[str, float | int | str]], audits: list[dict[s
         "|---|---|---|---|---|---|---|---|",
     ]
     for r in noise:
+        level = "0 (none)" if r["noise"] == "0" else f"{r['noise']} = {float(r['sigma_d2']):g}"
         out.append(
-            f"| {r['system']} | {r['noise']} = {float(r['sigma_d2']):g} | {r['N_star']} | {r['lambda_star']} | {r['k_star']} | "
+            f"| {r['system']} | {level} | {r['N_star']} | {r['lambda_star']} | {r['k_star']} | "
             f"{float(r['trace_P']):.4g} | {float(r['trace_P_ratio']):.3g} | {float(r['cost_ratio']):.3g} |"
         )
     out += ["", "| system | N* | delta | audit rate p* = 1 - delta^(1/N*) |", "|---|---|---|---|"]
