@@ -5,9 +5,12 @@ on the same 100 runs of a 3-state, 2-input, 2-output plant; the script prints th
 difference of their Markov parameters (the same estimate to rounding) and the ratio of their
 times, measured in this one run (paired, alternating, best of three each).
 
-    python benchmarks/bench_subspace.py [--runs 100] [--samples 1000]
+    python benchmarks/bench_subspace.py [--runs 100] [--samples 1000] [--sippy]
 
-Needs nfoursid (pip install nfoursid).
+Needs nfoursid (pip install nfoursid). With ``--sippy`` (pip install sippy-unipi) it also prints
+the median Markov-parameter error of SIPPY's N4SID, MOESP and CVA (a different, weighted
+algorithm) against this package's N4SID and PO-MOESP on 10 runs of N = 2000 (order 3, 10 block
+rows), where both are not the same algorithm and only their accuracy can be compared.
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=100)
     parser.add_argument("--samples", type=int, default=1000)
+    parser.add_argument("--sippy", action="store_true", help="also compare accuracy with SIPPY's methods")
     args = parser.parse_args()
     import pandas as pd
     from nfoursid.nfoursid import NFourSID
@@ -83,6 +87,33 @@ def main() -> None:
         f"{args.runs} runs of N = {args.samples}: encctl_gym n4sid {min(t_ours):.3f} s, nfoursid {min(t_theirs):.3f} s, "
         f"ratio {min(t_theirs) / min(t_ours):.1f}x; largest relative Markov-parameter difference {diff:.1e}"
     )
+    if args.sippy:
+        compare_sippy()
+
+
+def compare_sippy() -> None:
+    """Median Markov error of SIPPY's methods and of this package's on the same 10 runs."""
+    import warnings
+
+    from sippy_unipi import system_identification
+
+    from encctl_gym.ident.subspace import markov_error, moesp, n4sid
+
+    true, u, y = simulate(10, 2000)
+    rows = {
+        "n4sid (this package)": markov_error(true, n4sid(u, y, order=3, block_rows=10)),
+        "moesp (this package, PO-MOESP)": markov_error(true, moesp(u, y, order=3, block_rows=10)),
+    }
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for method in ("N4SID", "MOESP", "CVA"):
+            errs = []
+            for r in range(u.shape[0]):
+                s = system_identification(y[r].T, u[r].T, method, SS_fixed_order=3, SS_f=10, SS_p=10)
+                errs.append(markov_error(true, (s.A, s.B, s.C, s.D)))
+            rows[f"{method} (SIPPY)"] = np.asarray(errs)
+    for name, e in rows.items():
+        print(f"  {name:32s} median Markov error {float(np.median(e)):.3g}")
 
 
 if __name__ == "__main__":
