@@ -38,6 +38,9 @@ def get_breaker(name: str | Breaker, **kwargs: Any) -> Breaker:
     """Build the breaker registered as ``name`` with keyword arguments ``kwargs`` (a
     :class:`~.base.Breaker` instance is returned as is, and takes no ``kwargs``).
 
+    A breaker that wraps another (:attr:`~.base.Breaker.WRAPS_OPTION`, the token chain's
+    ``inner``) may be given it by name: that one is built first, with ``max_bits`` and ``rng``.
+
     Raises
     ------
     ParameterError
@@ -61,6 +64,13 @@ def get_breaker(name: str | Breaker, **kwargs: Any) -> Breaker:
         raise ParameterError(
             f"breaker {cls.name!r} has no option {', '.join(format_value(k) for k in unknown)}; its options: {', '.join(options)}"
         )
+    wraps = cls.WRAPS_OPTION
+    if wraps is not None and isinstance(kwargs.get(wraps), str):
+        inner = kwargs[wraps]
+        if inner == cls.name:
+            raise ParameterError(f"the breaker {cls.name!r} cannot wrap itself")
+        inner_kwargs = {k: kwargs.pop(k) for k in ("max_bits",) if k in kwargs}
+        kwargs[wraps] = get_breaker(inner, **inner_kwargs, rng=kwargs.get("rng"))
     return cls(**kwargs)
 
 

@@ -9,6 +9,7 @@
   least squares, Bayesian least squares (Gaussian prior, ridge posterior mean), exponential
   forgetting, instrumental variables.
 * :mod:`.registry` -- estimators by name (``make_estimator("bayes")``).
+* :mod:`.grid` -- the error on a grid of ``N`` for least squares or any estimator by name.
 
 Pure numerical code (numpy): it imports only the package's base modules. The sample
 identifying complexities of :mod:`encctl_gym.security` bound the expected error of these
@@ -23,6 +24,7 @@ from .bayes import *  # noqa: F403
 from .error import *  # noqa: F403
 from .estimator import *  # noqa: F403
 from .forgetting import *  # noqa: F403
+from .grid import *  # noqa: F403
 from .instrumental import *  # noqa: F403
 from .least_squares import *  # noqa: F403
 from .ordinary import *  # noqa: F403
@@ -32,7 +34,17 @@ from .registry import *  # noqa: F403
 __all__ = list(
     dict.fromkeys(
         name
-        for module in ("error", "least_squares", "estimator", "ordinary", "bayes", "forgetting", "instrumental", "registry")
+        for module in (
+            "error",
+            "least_squares",
+            "estimator",
+            "ordinary",
+            "bayes",
+            "forgetting",
+            "instrumental",
+            "registry",
+            "grid",
+        )
         for name in sys.modules[f"{__name__}.{module}"].__all__
     )
 )

@@ -27,7 +27,7 @@ import numpy as np
 
 from encctl_gym.security.design import design_from_traces, minimum_key_length, optimal_security_parameter, sample_size_for_rate
 
-from .protocol import Curve, Result
+from .records import Curve, Result
 from .settings import Setting
 from .statistics import Z95, fit_rate, paired_ratio, samples_to_reach
 
