@@ -31,7 +31,7 @@ from encctl_gym.cryptanalysis import (
 )
 from encctl_gym.cryptanalysis import pari as pari_mod
 from encctl_gym.cryptanalysis.base import Deadline, format_seconds
-from encctl_gym.cryptanalysis.cli import key_sequence
+from encctl_gym.cryptanalysis.keys import key_sequence
 from encctl_gym.errors import (
     BreakerError,
     BreakerLimitError,

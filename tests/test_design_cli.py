@@ -11,7 +11,8 @@ import pytest
 from encctl_gym.cli import main
 from encctl_gym.errors import ParameterError, ResourceLimitError
 from encctl_gym.security.cost_models import GUILLEVIC_CORRECTION
-from encctl_gym.security.design_cli import MAX_STATE_DIMENSION, compute, load_system, parse_duration
+from encctl_gym.security.design_cli import load_system, parse_duration
+from encctl_gym.security.report import MAX_STATE_DIMENSION, design_report
 
 
 def _json(capsys: pytest.CaptureFixture, argv: list[str]) -> dict:
@@ -220,7 +221,7 @@ def test_large_plants_work_or_are_refused_with_a_reason(tmp_path: Path, capsys: 
     assert main(["design", str(path)]) == 0
     assert "skipped: the A-optimal design SDP for n + m = 120" in capsys.readouterr().out
     with pytest.raises(ResourceLimitError, match=f"n = {MAX_STATE_DIMENSION + 1} states"):
-        compute(0.5 * np.eye(MAX_STATE_DIMENSION + 1), np.eye(MAX_STATE_DIMENSION + 1, 1), gamma_c=1e-6, tau_c=1e8,
+        design_report(0.5 * np.eye(MAX_STATE_DIMENSION + 1), np.eye(MAX_STATE_DIMENSION + 1, 1), gamma_c=1e-6, tau_c=1e8,
                 upsilon=1e17, sigma_u2=1, sigma_w2=1)
 
 

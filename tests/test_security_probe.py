@@ -78,11 +78,11 @@ def test_bounded(name: str, tmp_path: Path, capsys: pytest.CaptureFixture) -> No
 def test_a_design_of_a_200_state_plant_completes(tmp_path: Path) -> None:
     # the plant the issue saw killed for memory after 95 s: the SDP rows are skipped with an
     # estimate, everything else is computed within the memory cap
-    from encctl_gym.security.design_cli import compute
+    from encctl_gym.security.report import design_report
 
     def call() -> None:
         n = 200
-        res = compute(0.5 * np.eye(n) + 0.1 * np.eye(n, k=1), np.eye(n), gamma_c=1e-6, tau_c=31536e4, upsilon=442e15,
+        res = design_report(0.5 * np.eye(n) + 0.1 * np.eye(n, k=1), np.eye(n), gamma_c=1e-6, tau_c=31536e4, upsilon=442e15,
                       sigma_u2=10, sigma_w2=0.1)
         assert set(res["skipped"]) == {"closed_loop", "open_loop"}
 

@@ -31,8 +31,10 @@ key_length
 attack_design
     A-optimal attack inputs (closed and open loop), ``gamma_opt`` and robust designs (needs
     cvxpy; imported on use).
+report
+    ``design_report``: everything the design command reports for a plant, as a dict.
 design_cli
-    The ``encctl-gym design`` subcommand.
+    The ``encctl-gym design`` subcommand (prints :func:`.report.design_report`).
 """
 
 from __future__ import annotations
