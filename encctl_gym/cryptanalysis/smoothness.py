@@ -19,7 +19,7 @@ import gmpy2
 import numpy as np
 
 from .._validation import check_int, check_nonnegative, format_value
-from ..crypto.group import _small_primes
+from ..crypto.group.sieve import _small_primes
 from ..errors import ParameterError, ResourceLimitError
 
 __all__ = ["primes_up_to", "check_bound", "FactorBase", "rational_reconstruction", "dickman_rho", "MAX_BOUND"]
