@@ -24,7 +24,7 @@ from encctl_gym.security.cost_models import (
     DECIPHERING_MODELS,
     GNFS_MIN_KEY_LENGTH,
     GUILLEVIC_CORRECTION,
-    DecipheringModel,
+    CostModel,
     GenericModel,
     PaperModel,
     PrecomputationModel,
@@ -186,12 +186,12 @@ def test_gnfs_range_is_where_the_formula_beats_rho() -> None:
         GenericModel().break_cost(15)
 
 
-# --------------------------------------------------------------------------- registry, protocol, errors
-def test_registry_and_protocol() -> None:
+# --------------------------------------------------------------------------- registry, base class, errors
+def test_registry_and_base_class() -> None:
     assert set(DECIPHERING_MODELS) == {"paper", "precomputation", "generic"}
     for name in DECIPHERING_MODELS:
         m = deciphering_model(name)
-        assert isinstance(m, DecipheringModel) and m.name == name
+        assert isinstance(m, CostModel) and m.name == name
         assert m.describe()["name"] == name
     with pytest.raises(ParameterError, match="'rho'") as info:
         deciphering_model("rho")
