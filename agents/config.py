@@ -48,6 +48,7 @@ from __future__ import annotations
 import copy
 import numbers
 from pathlib import Path
+from collections.abc import Mapping
 from typing import Any, Callable
 
 import yaml
@@ -179,7 +180,7 @@ def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _algorithms() -> dict[str, type]:
+def _algorithms() -> Mapping[str, type]:
     from .sb3 import ALGORITHMS
 
     return ALGORITHMS

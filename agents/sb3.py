@@ -28,6 +28,7 @@ from stable_baselines3.common.base_class import BaseAlgorithm
 
 from encctl_gym.envs.config import AttackParams, resolve_params
 from encctl_gym.errors import ConfigError, ParameterError
+from encctl_gym.registry import Registry
 
 from .ars import PairedARS
 from .base import Attacker, observation_indices
@@ -39,19 +40,13 @@ __all__ = ["SB3VecEnv", "SB3Attacker", "load_attacker", "ALGORITHMS", "algorithm
 #: The learning algorithms by name: ``train``, :func:`load_attacker` and the command line's
 #: choices all read this one table (a new algorithm is a row here and a default config in
 #: ``agents/configs/defaults/{name}.yaml``).
-ALGORITHMS: dict[str, type[BaseAlgorithm]] = {
-    "ppo": PPO,
-    "sac": SAC,
-    "recurrent_ppo": RecurrentPPO,
-    "ars": PairedARS,
-}
+_CLASSES: dict[str, type[BaseAlgorithm]] = {"ppo": PPO, "sac": SAC, "recurrent_ppo": RecurrentPPO, "ars": PairedARS}
+ALGORITHMS: Registry[type[BaseAlgorithm]] = Registry("algorithm", _CLASSES, error=ConfigError)
+
 
 def algorithm_class(algo: str) -> type[BaseAlgorithm]:
     """The stable-baselines3 (or sb3-contrib) class registered as ``algo`` in :data:`ALGORITHMS`."""
-    try:
-        return ALGORITHMS[algo]
-    except (KeyError, TypeError):
-        raise ConfigError(f"unknown algorithm {algo!r}; choose one of {', '.join(ALGORITHMS)}") from None
+    return ALGORITHMS.lookup(algo)
 
 
 class SB3Attacker(Attacker):
@@ -128,7 +123,7 @@ class SB3Attacker(Attacker):
         self._episode_start: np.ndarray | None = None
 
     @classmethod
-    def from_env(cls, env: Any, **kwargs: Any) -> "SB3Attacker":
+    def from_env(cls, env: Any, **kwargs: Any) -> SB3Attacker:
         from .base import params_of
 
         return cls(params=params_of(env), **kwargs)

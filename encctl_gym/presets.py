@@ -26,8 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._validation import format_value
-from .errors import ParameterError
+from .registry import Registry
 from .units import SECONDS_PER_YEAR
 
 __all__ = [
@@ -157,19 +156,18 @@ def _build() -> dict[str, SystemPreset]:
     return presets
 
 
-PRESETS: dict[str, SystemPreset] = _build()
+#: The presets by name (:class:`~encctl_gym.registry.Registry`).
+PRESETS: Registry[SystemPreset] = Registry("preset", _build())
 
 
 def preset_names() -> list[str]:
     """Names of the built-in presets."""
-    return list(PRESETS)
+    return PRESETS.names()
 
 
 def get_preset(name: str) -> SystemPreset:
     """Return the preset ``name``, raising :class:`ParameterError` for an unknown name (or a non-string)."""
-    if not isinstance(name, str) or name not in PRESETS:
-        raise ParameterError(f"unknown preset {format_value(name)}; choose one of {', '.join(PRESETS)}")
-    return PRESETS[name]
+    return PRESETS.lookup(name)
 
 
 def design_defaults() -> dict[str, float]:

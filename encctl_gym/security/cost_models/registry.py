@@ -4,26 +4,17 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..._validation import format_value
 from ...errors import ParameterError
+from ...registry import Registry
 from .base import CostModel
 from .models import GenericModel, PaperModel, PrecomputationModel
 
 __all__ = ["DECIPHERING_MODELS", "deciphering_model"]
 
 
-#: Registry: model name -> class.
-DECIPHERING_MODELS: dict[str, type[CostModel]] = {
-    "paper": PaperModel,
-    "precomputation": PrecomputationModel,
-    "generic": GenericModel,
-}
-
-_OPTIONS: dict[str, tuple[str, ...]] = {
-    "paper": ("gnfs_correction",),
-    "precomputation": ("gnfs_correction", "calibration"),
-    "generic": (),
-}
+#: Registry: model name -> class (:class:`~encctl_gym.registry.Registry`); a model's options are
+#: the parameters of its constructor.
+DECIPHERING_MODELS: Registry[type[CostModel]] = Registry("deciphering model", [PaperModel, PrecomputationModel, GenericModel])
 
 
 def deciphering_model(name: Any = "paper", **options: Any) -> CostModel:
@@ -45,10 +36,5 @@ def deciphering_model(name: Any = "paper", **options: Any) -> CostModel:
         if options:
             raise ParameterError(f"options {sorted(options)} cannot be applied to an already built {name.name} model")
         return name
-    if not isinstance(name, str) or name not in DECIPHERING_MODELS:
-        raise ParameterError(f"unknown deciphering model {format_value(name)}; choose one of {', '.join(DECIPHERING_MODELS)}")
-    bad = sorted(set(options) - set(_OPTIONS[name]))
-    if bad:
-        allowed = ", ".join(_OPTIONS[name]) or "none"
-        raise ParameterError(f"the {name} model takes no option(s) {bad} (its options: {allowed})")
-    return DECIPHERING_MODELS[name](**options)
+    model: CostModel = DECIPHERING_MODELS.build(name, **options)
+    return model
