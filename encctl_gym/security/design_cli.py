@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_int, check_nonnegative, check_positive, format_value, parse_number
+from .._validation import check_int, format_value, parse_number
 from ..errors import ConfigError, ParameterError
 from ..plant_file import load_plant_file, load_system
 from ..presets import DESIGN_FIELDS, design_defaults, get_preset, preset_names
@@ -49,6 +49,7 @@ from .attack_design import SDP_MAX_DIMENSION
 from .cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION, check_gnfs_correction
 from .records import load_records
 from .report import COMPLEXITIES, LABELS, design_report
+from .threat import ThreatModel
 
 __all__ = ["add_arguments", "run", "parse_duration", "load_system", "DEFAULTS", "parse_cost_models", "parse_gnfs_correction"]
 
@@ -286,7 +287,7 @@ def run(args: argparse.Namespace) -> int:
         sources = {key: ("file" if key in spec.from_file else "default") for key in DESIGN_FIELDS}
     else:
         raise ConfigError("give a SYSTEM_FILE (JSON, YAML or NPZ with A and B) or --preset NAME")
-    values: dict[str, float] = {}
+    values: dict[str, Any] = {}
     for key in DESIGN_FIELDS:
         raw = getattr(args, key)
         if raw is None:
@@ -294,9 +295,7 @@ def run(args: argparse.Namespace) -> int:
         else:
             values[key] = parse_duration(raw, "tau_c") if key == "tau_c" else parse_number(key, raw)
             sources[key] = "option"
-    for key in ("gamma_c", "upsilon", "sigma_u2", "sigma_w2", "tau_c"):
-        check_positive(key, values[key])
-    check_nonnegative("sigma_x2", values["sigma_x2"])
+    threat = ThreatModel(**values)  # checks every value once
     if args.system_file:
         groups: dict[str, list[str]] = {}
         for key in DESIGN_FIELDS:
@@ -320,8 +319,8 @@ def run(args: argparse.Namespace) -> int:
     records = None if args.calibration is None else load_records(args.calibration)
     sdp = None if args.sdp_max_dim is None else check_int("sdp_max_dim", parse_number("sdp_max_dim", args.sdp_max_dim), 2)
     res = design_report(
-        A,
-        B,
+        (A, B),
+        threat,
         solver=args.solver,
         sdp_max_dimension=sdp,
         cost_models=models,
@@ -329,7 +328,6 @@ def run(args: argparse.Namespace) -> int:
         complexity=args.complexity,
         key_length=key_length,
         calibration=records,
-        **values,
     )
     if args.json:
         res["title"] = title

@@ -15,8 +15,9 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_int, check_nonnegative, check_positive, check_schur_stable, check_system, format_value
+from .._validation import check_int, check_system, format_value
 from ..errors import ParameterError, ResourceLimitError
+from ..plant import Plant, as_plant
 from .attack_design import gaussian_attack_design, optimal_attack_design, robust_security_design
 from .complexity import input_upper_bound, noise_upper_bound, sic_asymptotic_from_traces, sic_from_traces
 from .cost_models import GUILLEVIC_CORRECTION, check_gnfs_correction, gnfs_log2_complexity
@@ -24,6 +25,7 @@ from .design import SecurityDesign, design_from_traces
 from .gramians import controllability_gramian, noise_gramian
 from .key_length import build_model, design_key_length, key_length_value
 from .records import RecordSet, default_records
+from .threat import ThreatModel
 
 __all__ = ["design_report", "COMPLEXITIES", "LABELS", "MAX_STATE_DIMENSION"]
 
@@ -63,30 +65,24 @@ def _check_size(n: int, m: int) -> None:
 
 def _cost_model_section(
     designs: dict[str, SecurityDesign],
+    threat: ThreatModel,
     *,
     models: Sequence[str],
     complexity: str,
     gnfs_correction: float,
     key_length: Any,
     records: RecordSet,
-    tau_c: float,
-    upsilon: float,
 ) -> dict[str, Any]:
     key = COMPLEXITIES[complexity]
     if key not in designs:
         raise ParameterError(f"complexity {complexity!r} was skipped for this plant (see skipped); choose another")
     N_star = designs[key].N_star
     out_designs = {}
+    threats = {name: threat.replace(cost_model=build_model(name, gnfs_correction, records)) for name in models}
     for name in models:
-        d = design_key_length(name, N_star, tau_c=tau_c, upsilon=upsilon, gnfs_correction=gnfs_correction, calibration=records)
-        out_designs[name] = d.to_dict()
+        out_designs[name] = design_key_length(N_star, threats[name]).to_dict()
     k_val = designs[key].k_star if key_length is None else check_int("key_length", key_length)
-    values = {
-        name: key_length_value(
-            name, k_val, N_star=N_star, tau_c=tau_c, upsilon=upsilon, gnfs_correction=gnfs_correction, calibration=records
-        ).to_dict()
-        for name in models
-    }
+    values = {name: key_length_value(k_val, threats[name], N_star=N_star).to_dict() for name in models}
     first = next(iter(out_designs.values()))
     return {
         "complexity": complexity,
@@ -110,15 +106,9 @@ def _records_section(records: RecordSet) -> dict[str, Any]:
 
 
 def design_report(
-    A: Any,
-    B: Any,
+    plant: Plant | tuple[Any, Any],
+    threat: ThreatModel,
     *,
-    gamma_c: float,
-    tau_c: float,
-    upsilon: float,
-    sigma_u2: float,
-    sigma_w2: float,
-    sigma_x2: float = 1.0,
     solver: str | None = None,
     sdp_max_dimension: int | None = None,
     cost_models: Sequence[str] | None = None,
@@ -131,10 +121,11 @@ def design_report(
 
     Parameters
     ----------
-    A, B : array_like
+    plant : Plant or (A, B)
         Plant (``A`` Schur stable, ``n <= 1000``).
-    gamma_c, tau_c, upsilon, sigma_u2, sigma_w2, sigma_x2 : float
-        Design parameters (see the module docstring).
+    threat : ThreatModel
+        ``sigma_u2``, ``sigma_w2``, ``sigma_x2``, ``gamma_c``, ``tau_c``, ``upsilon`` (its
+        adversary and cost model are not used: the cost-model section covers ``cost_models``).
     solver : str, optional
         cvxpy solver for the attack designs.
     sdp_max_dimension : int, optional
@@ -157,25 +148,25 @@ def design_report(
         per method with ``ratio_to_paper``), ``skipped`` (rows not computed, with the reason),
         and with ``cost_models`` also ``cost_models`` and ``records``.
     """
-    A, B = check_system(A, B)
-    n, m = B.shape
+    if isinstance(plant, tuple) and len(plant) == 2:  # the size bound comes before any eigenvalue
+        _check_size(*check_system(*plant)[1].shape)
+    p = as_plant(plant)
+    A, B, n, m = p.A, p.B, p.n, p.m
     _check_size(n, m)
-    rho = check_schur_stable(A)
-    gamma_c = check_positive("gamma_c", gamma_c)
-    tau_c = check_positive("tau_c", tau_c)
-    upsilon = check_positive("upsilon", upsilon)
-    su = check_positive("sigma_u2", sigma_u2)
-    sw = check_positive("sigma_w2", sigma_w2)
-    sx = check_nonnegative("sigma_x2", sigma_x2)
+    rho = p.spectral_radius
+    if not isinstance(threat, ThreatModel):
+        raise ParameterError(f"design_report: threat must be a ThreatModel, got {format_value(threat)}")
+    t = threat.require("sigma_u2", "sigma_w2", "gamma_c")
+    gamma_c, tau_c, upsilon = float(t.gamma_c), float(t.tau_c), float(t.upsilon)
+    su, sw, sx = float(t.sigma_u2), float(t.sigma_w2), float(t.sigma_x2)
     if not isinstance(complexity, str) or complexity not in COMPLEXITIES:
         raise ParameterError(f"unknown complexity {format_value(complexity)}; choose one of {', '.join(COMPLEXITIES)}")
     c = check_gnfs_correction(gnfs_correction)
     tr_u = float(np.trace(controllability_gramian(A, B)))
     tr_w = float(np.trace(noise_gramian(A)))
-    kw: dict[str, Any] = dict(gamma_c=gamma_c, tau_c=tau_c, upsilon=upsilon)
     designs: dict[str, SecurityDesign] = {
-        "paper_sic2": design_from_traces(tr_u, tr_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=sx, method="asymptotic", **kw),
-        "exact_sic": design_from_traces(tr_u, tr_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=sx, method="exact", **kw),
+        "paper_sic2": design_from_traces(tr_u, tr_w, m, n, t, method="asymptotic"),
+        "exact_sic": design_from_traces(tr_u, tr_w, m, n, t, method="exact"),
     }
     attacks: dict[str, Any] = {}
     skipped: dict[str, str] = {}
@@ -188,7 +179,7 @@ def design_report(
             skipped[kind] = str(exc)
     attacks["gaussian"] = gaussian_attack_design(A, B, sigma_u2=su, sigma_w2=sw)
     for kind, att in attacks.items():
-        designs[kind] = robust_security_design(A, B, sigma_u2=su, sigma_w2=sw, sigma_x2=sx, kind=kind, design=att, **kw)
+        designs[kind] = robust_security_design(p, t, kind=kind, design=att)
     designs = {k: designs[k] for k in LABELS if k in designs}
     N_ref = designs["paper_sic2"].N_star
     g_ref = float(sic_asymptotic_from_traces(N_ref, tr_u, tr_w, m, n, su / sw))
@@ -218,14 +209,7 @@ def design_report(
     if cost_models:
         records = calibration if calibration is not None else default_records()
         res["cost_models"] = _cost_model_section(
-            designs,
-            models=cost_models,
-            complexity=complexity,
-            gnfs_correction=c,
-            key_length=key_length,
-            records=records,
-            tau_c=tau_c,
-            upsilon=upsilon,
+            designs, t, models=cost_models, complexity=complexity, gnfs_correction=c, key_length=key_length, records=records
         )
         res["models"] = {name: _describe(name, c, records) for name in cost_models}
         res["records"] = _records_section(records)
