@@ -32,7 +32,7 @@ from typing import Any
 
 from .._validation import check_int, format_value
 from ..errors import ParameterError
-from .cost_models import CostModel, PaperModel, deciphering_model, paper_security_parameter
+from .cost_models import DECIPHERING_MODELS, CostModel, PaperModel, deciphering_model, paper_security_parameter
 from .deciphering import keys_to_break, max_affordable_samples
 from .exact import decimal_fraction, log2_fraction
 from .records import nist_key_length, nist_strength
@@ -147,15 +147,17 @@ class KeyValue:
 
 
 def build_model(model: Any, gnfs_correction: Any = 0.0, calibration: Any = None) -> CostModel:
-    """A cost model by name with the options that apply to it: the GNFS correction for the paper and
-    precomputation models, the calibration for the precomputation model (a built model is returned
-    as it is)."""
+    """A cost model by name with the options that apply to it: the GNFS correction and the
+    calibration go to the models whose constructors take them (the paper and precomputation
+    models; the calibration only when given), so no model is named here. A built model is
+    returned as it is."""
     if isinstance(model, CostModel):
         return model
+    takes = DECIPHERING_MODELS.options(model)
     options: dict[str, Any] = {}
-    if model in ("paper", "precomputation"):
+    if "gnfs_correction" in takes:
         options["gnfs_correction"] = gnfs_correction
-    if model == "precomputation" and calibration is not None:
+    if "calibration" in takes and calibration is not None:
         options["calibration"] = calibration
     return deciphering_model(model, **options)
 
