@@ -14,7 +14,7 @@ randomness*. :class:`PairedARS` uses that:
   difference ``R_i+ - R_i-`` then measures the perturbation, not the noise: on the design example
   (N = 256, 8 episodes) a change of the feedback gain by 0.05 moves the paired difference by
   0.088 with a standard deviation of 0.002 across seeds. Each iteration draws new seeds.
-* **Batched.** With the native vector environment (:class:`agents.sb3.SB3VecEnv`) all
+* **Batched.** With the native vector environment (:class:`agents.vec_env.SB3VecEnv`) all
   candidates and the current policy play at once, ``(2 n_delta + 1) n_eval_episodes`` copies
   stepped together, the candidates' networks evaluated in one vectorised call.
 * **Normalisation frozen within an iteration.** The observation statistics (``VecNormalize``)
@@ -49,6 +49,8 @@ from stable_baselines3.common.type_aliases import GymEnv, Schedule
 
 from encctl_gym.errors import ConfigError
 
+from .vec_env import SB3VecEnv
+
 __all__ = ["PairedARS", "STEP_RULES"]
 
 #: The step rules of :class:`PairedARS`.
@@ -56,9 +58,7 @@ STEP_RULES = ("adam", "ars")
 
 
 def _sb3_vec_env(env: Any) -> Any:
-    """The :class:`agents.sb3.SB3VecEnv` under a stack of VecEnv wrappers, or None."""
-    from .sb3 import SB3VecEnv
-
+    """The :class:`agents.vec_env.SB3VecEnv` under a stack of VecEnv wrappers, or None."""
     while env is not None:
         if isinstance(env, SB3VecEnv):
             return env
@@ -165,8 +165,6 @@ class PairedARS(ARS):
         return self
 
     def _paired(self, base: Any, copies: int) -> Any:
-        from .sb3 import SB3VecEnv
-
         env = self._paired_env
         if env is None or env.num_envs != copies:
             env = SB3VecEnv(base.config, copies, base.observation, base.reward_scaling, features=base.feature_names)

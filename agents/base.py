@@ -28,7 +28,7 @@ from encctl_gym.envs.config import AttackParams
 from encctl_gym.envs.layout import OBSERVATION_MODES, ObservationLayout
 from encctl_gym.errors import ParameterError
 
-__all__ = ["Attacker", "ObsLayout", "OBSERVATION_MODES", "observation_indices", "params_of"]
+__all__ = ["Attacker", "OBSERVATION_MODES", "observation_indices", "params_of"]
 
 
 def params_of(env: Any) -> AttackParams:
@@ -38,11 +38,6 @@ def params_of(env: Any) -> AttackParams:
         if isinstance(p, AttackParams):
             return p
     raise ParameterError(f"{type(env).__name__} carries no AttackParams (is it an EncryptedLTIAttack environment?)")
-
-
-#: The environment's observation layout (:class:`encctl_gym.envs.layout.ObservationLayout`),
-#: under the name this module gave it before it had one home.
-ObsLayout = ObservationLayout
 
 
 def observation_indices(params: AttackParams, mode: str) -> np.ndarray:

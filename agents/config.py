@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import copy
 import numbers
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -180,7 +180,7 @@ def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _algorithms() -> dict[str, type[Any]]:
+def _algorithms() -> Mapping[str, type[Any]]:
     from .sb3 import ALGORITHMS
 
     return ALGORITHMS

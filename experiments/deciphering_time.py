@@ -68,7 +68,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 import numpy as np
 
 from encctl_gym.cryptanalysis import get_breaker, pari_available
-from encctl_gym.cryptanalysis.cli import key_sequence
+from encctl_gym.cryptanalysis.keys import key_sequence
 from encctl_gym.cryptanalysis.sequence import break_sequence
 from encctl_gym.crypto import arith
 from encctl_gym.crypto.group import generate_safe_prime_group

@@ -36,9 +36,8 @@ def noise_rows() -> list[dict[str, float | int | str]]:
     for system in SYSTEMS:
         p = get_preset(system)
         Phi = -lqr_gain(p.A, p.B)
-        kw = dict(sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, gamma_c=p.gamma_c, tau_c=p.tau_c, upsilon=p.upsilon)
         for label, sd in (("0", 0.0), ("sigma_w2", p.sigma_w2), ("10 sigma_w2", 10 * p.sigma_w2), ("sigma_u2", p.sigma_u2)):
-            d = noise_defense_design(p.A, p.B, sigma_d2=sd, **kw)
+            d = noise_defense_design(p.plant(), p.threat(), sigma_d2=sd)
             price = noise_defense_price(p.A, p.B, Phi, sigma_w2=p.sigma_w2, sigma_d2=sd)
             rows.append(
                 {

@@ -34,7 +34,8 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 from encctl_gym.presets import PAPER_DESIGN_PARAMETERS, PAPER_REPORTED, get_preset
 from encctl_gym.security.cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION
 from encctl_gym.security.design import SecurityDesign, design_security_parameter, paper_design_example
-from encctl_gym.security.key_length import KeyLengthDesign, KeyValue, design_key_length, key_length_value
+from encctl_gym.security.key_length import KeyLengthDesign, KeyValue, build_model, design_key_length, key_length_value
+from encctl_gym.security.threat import ThreatModel
 from experiments.common import add_common_arguments, ensure_out_dir, entry_point
 
 __all__ = [
@@ -57,6 +58,11 @@ PAPER_VALUES = PAPER_REPORTED
 DYNAMIC_KEY_SAMPLES = (13159, 10**5, 10**6, 10**7, 10**8, 10**10)
 
 
+def _threat(cost_model: Any) -> ThreatModel:
+    """The design example's defense period and adversary under ``cost_model``."""
+    return ThreatModel(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"], cost_model=cost_model)
+
+
 def compute() -> list[tuple[str, SecurityDesign]]:
     """The design example by the security module, three ways.
 
@@ -67,10 +73,7 @@ def compute() -> list[tuple[str, SecurityDesign]]:
         and ``("plant paper-example, eq:sic2", ...)``.
     """
     p = get_preset("paper-example")
-    plant = design_security_parameter(
-        p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, sigma_x2=p.sigma_x2,
-        gamma_c=p.gamma_c, tau_c=p.tau_c, upsilon=p.upsilon,
-    )
+    plant = design_security_parameter(p.plant(), p.threat())
     return [
         ("traces, eq:sic2 (paper)", paper_design_example("asymptotic")),
         ("traces, eq:sic", paper_design_example("exact")),
@@ -82,13 +85,12 @@ def cost_model_designs(N_star: int | None = None) -> list[KeyLengthDesign]:
     """``k*`` of the design example under every model, without and with the 11.91-bit GNFS correction
     (the generic model has no GNFS term and appears once)."""
     N = paper_design_example().N_star if N_star is None else N_star
-    kw: dict[str, Any] = dict(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"])
     rows = []
     for correction in (0.0, GUILLEVIC_CORRECTION):
         for name in DECIPHERING_MODELS:
             if name == "generic" and correction:
                 continue
-            rows.append(design_key_length(name, N, gnfs_correction=correction, **kw))
+            rows.append(design_key_length(N, _threat(build_model(name, correction))))
     return rows
 
 
@@ -96,17 +98,15 @@ def key_values(key_length: int | None = None) -> list[KeyValue]:
     """What the paper's ``k*`` (or ``key_length``) is worth under every model (no correction)."""
     d = paper_design_example()
     k = d.k_star if key_length is None else key_length
-    kw: dict[str, Any] = dict(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"])
-    return [key_length_value(name, k, N_star=d.N_star, **kw) for name in DECIPHERING_MODELS]
+    return [key_length_value(k, _threat(name), N_star=d.N_star) for name in DECIPHERING_MODELS]
 
 
 def dynamic_key_bits(samples: Sequence[int] = DYNAMIC_KEY_SAMPLES) -> list[tuple[int, float, int, float]]:
     """For each sample size ``N``: ``log2 N`` (what the dynamic keys add under the paper's cost), the
     precomputation model's ``k*`` for ``N`` and the bits the dynamic keys add there."""
-    kw: dict[str, Any] = dict(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"])
     out = []
     for N in samples:
-        d = design_key_length("precomputation", N, **kw)
+        d = design_key_length(N, _threat("precomputation"))
         out.append((N, math.log2(N), d.k_star, d.dynamic_key_bits))
     return out
 

@@ -50,9 +50,7 @@ def run(runs: int, points: int, n_max: int | None, seed: int) -> list[dict[str, 
     for system in SYSTEMS:
         p = get_preset(system)
         plant = LinearPlant(p.A, p.B, sigma_w2=p.sigma_w2)
-        paper = design_security_parameter(
-            p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, gamma_c=p.gamma_c, tau_c=p.tau_c, upsilon=p.upsilon
-        )
+        paper = design_security_parameter(p.plant(), p.threat())
         top = n_max or 2 * paper.N_star
         grid = np.unique(np.geomspace(200, top, points).astype(int))
         ref = output_attack_errors(
@@ -60,8 +58,7 @@ def run(runs: int, points: int, n_max: int | None, seed: int) -> list[dict[str, 
         )
         ls_fit = fit_empirical_complexity(grid, ref["state_ls_markov"])
         target = float(ls_fit(paper.N_star))
-        budget: dict[str, Any] = {"tau_c": p.tau_c, "upsilon": p.upsilon}
-        base = empirical_design(ls_fit, gamma_c=target, **budget)
+        base = empirical_design(ls_fit, p.threat(), gamma_c=target)
         rows.append(
             _row(system, "states (least squares)", 0.0, "ls", grid, ref["state_ls_markov"], ls_fit, base, paper.N_star, target)
         )
@@ -74,7 +71,7 @@ def run(runs: int, points: int, n_max: int | None, seed: int) -> list[dict[str, 
                     fit = fit_empirical_complexity(grid, out["markov"])
                     d: Any
                     try:
-                        d = empirical_design(fit, gamma_c=target, **budget)
+                        d = empirical_design(fit, p.threat(), gamma_c=target)
                     except EncctlError as exc:  # a rate that does not decrease: reported, not designed
                         d = exc
                     rows.append(_row(system, label, sv, est, grid, out["markov"], fit, d, paper.N_star, target))

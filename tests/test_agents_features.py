@@ -82,5 +82,5 @@ def test_feature_names_are_checked():
             check_features(bad)
     cfg = load_config("ppo", "small", quick=True)
     cfg["features"] = ["nope"]
-    with pytest.raises(ConfigError, match="unknown feature 'nope' in features"):
+    with pytest.raises(ConfigError, match="features: unknown feature 'nope'; choose one of dither"):
         validate_config(cfg)

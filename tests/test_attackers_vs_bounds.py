@@ -4,10 +4,8 @@ registry, the security table, and a --quick run end to end checked against direc
 from __future__ import annotations
 
 import csv
-import importlib
 import json
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -236,14 +234,6 @@ def test_compare_bad_options_are_one_line_errors(tmp_path, capsys):
         assert cli.main(["compare", "--quick", "--no-progress", "--out", str(tmp_path), *argv]) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and needle in err[0], (argv, err)
-
-
-def test_the_old_module_path_still_imports():
-    sys.modules.pop("experiments.attackers_vs_bounds", None)
-    with pytest.warns(DeprecationWarning, match="experiments.compare"):
-        avb = importlib.import_module("experiments.attackers_vs_bounds")
-    assert avb.compute is cmp.compute and avb.fit_rate is cmp.fit_rate and avb.Setting is cmp.Setting
-    assert cli.SUBCOMMANDS["compare"][0] == "experiments.compare.cli"
 
 
 # ------------------------------------------------------------------ hardening

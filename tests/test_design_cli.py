@@ -11,7 +11,9 @@ import pytest
 from encctl_gym.cli import main
 from encctl_gym.errors import ParameterError, ResourceLimitError
 from encctl_gym.security.cost_models import GUILLEVIC_CORRECTION
-from encctl_gym.security.design_cli import MAX_STATE_DIMENSION, compute, load_system, parse_duration
+from encctl_gym.security.design_cli import load_system, parse_duration
+from encctl_gym.security.report import MAX_STATE_DIMENSION, design_report
+from encctl_gym.security.threat import ThreatModel
 
 
 def _json(capsys: pytest.CaptureFixture, argv: list[str]) -> dict:
@@ -141,14 +143,16 @@ def test_cost_model_table(capsys: pytest.CaptureFixture) -> None:
 
 
 def test_cost_model_json_agrees_with_the_library(capsys: pytest.CaptureFixture) -> None:
+    from encctl_gym.security.cost_models import PrecomputationModel
     from encctl_gym.security.key_length import design_key_length
+    from encctl_gym.security.threat import ThreatModel
 
     res = _json(capsys, ["design", "--preset", "paper-example", "--cost-model", "precomputation,paper",
                          "--gnfs-correction", "guillevic", "--json"])
     cm = res["cost_models"]
     assert list(cm["designs"]) == ["precomputation", "paper"]
     assert cm["gnfs_correction"] == GUILLEVIC_CORRECTION
-    lib = design_key_length("precomputation", 13159, tau_c=31536e4, upsilon=442e15, gnfs_correction=GUILLEVIC_CORRECTION)
+    lib = design_key_length(13159, ThreatModel(tau_c=31536e4, upsilon=442e15, cost_model=PrecomputationModel(GUILLEVIC_CORRECTION)))
     assert cm["designs"]["precomputation"]["k_star"] == lib.k_star
     assert cm["designs"]["paper"]["paper_k_star"] == 712 and cm["designs"]["paper"]["k_star"] > 712
     assert cm["key_value"]["key_length"] == 712
@@ -220,8 +224,8 @@ def test_large_plants_work_or_are_refused_with_a_reason(tmp_path: Path, capsys: 
     assert main(["design", str(path)]) == 0
     assert "skipped: the A-optimal design SDP for n + m = 120" in capsys.readouterr().out
     with pytest.raises(ResourceLimitError, match=f"n = {MAX_STATE_DIMENSION + 1} states"):
-        compute(0.5 * np.eye(MAX_STATE_DIMENSION + 1), np.eye(MAX_STATE_DIMENSION + 1, 1), gamma_c=1e-6, tau_c=1e8,
-                upsilon=1e17, sigma_u2=1, sigma_w2=1)
+        design_report((0.5 * np.eye(MAX_STATE_DIMENSION + 1), np.eye(MAX_STATE_DIMENSION + 1, 1)),
+                      ThreatModel(gamma_c=1e-6, tau_c=1e8, upsilon=1e17, sigma_u2=1, sigma_w2=1))
 
 
 @pytest.mark.parametrize(

@@ -67,7 +67,7 @@ def test_every_registered_estimator_follows_the_protocol() -> None:
     "spec, params, match",
     [
         ("ridge", {}, r"unknown estimator 'ridge'; choose one of ls, bayes, forgetting, iv"),
-        ("ls", {"lam": 1}, r"unknown parameter\(s\) \['lam'\] for estimator 'ls'"),
+        ("ls", {"lam": 1}, r"the estimator 'ls' has no option 'lam'; its options: method"),
         ({"lags": 2}, {}, "needs a 'name' key"),
         ({"name": "iv", "lags": 2}, {"lags": 3}, "given twice"),
         (3.0, {}, "must be a name"),

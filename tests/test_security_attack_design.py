@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -12,12 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from encctl_gym._validation import format_value
-from encctl_gym.errors import (
-    ParameterError,
-    ResourceLimitError,
-    SolverError,
-    UnstableSystemError,
-)
+from encctl_gym.errors import ParameterError, ResourceLimitError, SolverError, UnstableSystemError
+from encctl_gym.plant import Plant
 from encctl_gym.security.attack_design import (
     gamma_opt,
     gaussian_attack_design,
@@ -28,6 +25,7 @@ from encctl_gym.security.attack_design import (
 from encctl_gym.security.complexity import sic_asymptotic_from_traces
 from encctl_gym.security.design import paper_design_example, sample_size_for_rate
 from encctl_gym.security.gramians import noise_gramian
+from encctl_gym.security.threat import ThreatModel
 
 SCALAR_CASES = [(0.5, 1.0, 1.0, 1.0), (0.9, 0.2, 1.0, 1.0), (-0.8, 1.0, 0.1, 1.0), (0.3, 2.0, 5.0, 0.5), (0.0, 1.0, 2.0, 0.3)]
 
@@ -58,6 +56,11 @@ def _scalar_min(a: float, b: float, su: float, sw: float, open_loop: bool) -> fl
         options={"xatol": 1e-12, "fatol": 1e-14, "maxiter": 5000},
     )
     return float(min(vals[i], res.fun))
+
+
+def _robust(A: Any, B: Any, *, kind: str = "closed_loop", design: Any = None, **threat: Any) -> Any:
+    """robust_security_design on the value objects built from the plant and threat values."""
+    return robust_security_design(Plant(A, B), ThreatModel(**threat), kind=kind, design=design)
 
 
 @pytest.mark.parametrize("a,b,su,sw", SCALAR_CASES)
@@ -175,8 +178,8 @@ def test_monte_carlo_matches_gamma_opt() -> None:
 def test_robust_design_paper_example() -> None:
     A, B = np.sqrt(0.5) * np.eye(4), 0.5 * np.eye(4)
     kw = dict(sigma_u2=10, sigma_w2=0.1, gamma_c=1e-6, tau_c=31536e4, upsilon=442e15)
-    cl = robust_security_design(A, B, **kw)
-    ga = robust_security_design(A, B, kind="gaussian", **kw)
+    cl = _robust(A, B, **kw)
+    ga = _robust(A, B, kind="gaussian", **kw)
     paper = paper_design_example()
     d = optimal_attack_design(A, B, sigma_u2=10, sigma_w2=0.1)
     assert cl.N_star == sample_size_for_rate(d.rate, 1e-6)
@@ -200,9 +203,9 @@ def test_gamma_opt_and_errors() -> None:
     with pytest.raises(SolverError, match="NOSUCHSOLVER"):
         optimal_attack_design(A, B, sigma_u2=1, sigma_w2=1, solver="NOSUCHSOLVER")
     with pytest.raises(ParameterError, match="kind"):
-        robust_security_design(A, B, sigma_u2=1, sigma_w2=1, gamma_c=0.1, tau_c=1, upsilon=1, kind="psychic")
+        _robust(A, B, sigma_u2=1, sigma_w2=1, gamma_c=0.1, tau_c=1, upsilon=1, kind="psychic")
     with pytest.raises(ParameterError, match="gaussian"):
-        robust_security_design(A, B, sigma_u2=1, sigma_w2=1, gamma_c=0.1, tau_c=1, upsilon=1, design=gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1))
+        _robust(A, B, sigma_u2=1, sigma_w2=1, gamma_c=0.1, tau_c=1, upsilon=1, design=gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1))
 
 
 def test_scs_fallback_solver_agrees() -> None:
@@ -244,18 +247,18 @@ def test_robust_design_refuses_a_design_made_for_other_values() -> None:
     kw = dict(gamma_c=1e-3, tau_c=1e6, upsilon=1e12)
     for kind, feedback in (("closed_loop", True), ("open_loop", False)):
         made = optimal_attack_design(A, B, sigma_u2=1, sigma_w2=1, feedback=feedback)
-        assert robust_security_design(A, B, sigma_u2=1, sigma_w2=1, kind=kind, design=made, **kw).method == kind
+        assert _robust(A, B, sigma_u2=1, sigma_w2=1, kind=kind, design=made, **kw).method == kind
         with pytest.raises(ParameterError, match="sigma_u2 = 1.0, not sigma_u2 = 2.0"):
-            robust_security_design(A, B, sigma_u2=2, sigma_w2=1, kind=kind, design=made, **kw)
+            _robust(A, B, sigma_u2=2, sigma_w2=1, kind=kind, design=made, **kw)
         with pytest.raises(ParameterError, match="sigma_w2"):
-            robust_security_design(A, B, sigma_u2=1, sigma_w2=0.5, kind=kind, design=made, **kw)
+            _robust(A, B, sigma_u2=1, sigma_w2=0.5, kind=kind, design=made, **kw)
         with pytest.raises(ParameterError, match="does not fit this plant"):
-            robust_security_design(0.5 * A, B, sigma_u2=1, sigma_w2=1, kind=kind, design=made, **kw)
+            _robust(0.5 * A, B, sigma_u2=1, sigma_w2=1, kind=kind, design=made, **kw)
     g = gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1)
     with pytest.raises(ParameterError, match="does not fit this plant"):
-        robust_security_design(A, 2 * B, sigma_u2=1, sigma_w2=1, kind="gaussian", design=g, **kw)
+        _robust(A, 2 * B, sigma_u2=1, sigma_w2=1, kind="gaussian", design=g, **kw)
     with pytest.raises(ParameterError, match="AttackDesign"):
-        robust_security_design(A, B, sigma_u2=1, sigma_w2=1, kind="gaussian", design="gaussian", **kw)
+        _robust(A, B, sigma_u2=1, sigma_w2=1, kind="gaussian", design="gaussian", **kw)
 
 
 def test_large_sdp_refused_before_solving_with_an_estimate() -> None:

@@ -140,14 +140,17 @@ def test_refusals_name_the_bad_value(call, match):
 
 
 def test_the_noise_defense_design_without_noise_is_the_papers_design():
+    from encctl_gym.plant import Plant
     from encctl_gym.presets import get_preset
     from encctl_gym.security.defenses import noise_defense_design
     from encctl_gym.security.design import design_security_parameter
+    from encctl_gym.security.threat import ThreatModel
 
     p = get_preset("paper-example")
-    kw = dict(sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, gamma_c=p.gamma_c, tau_c=p.tau_c, upsilon=p.upsilon)
-    ref = design_security_parameter(p.A, p.B, **kw)
-    d0 = noise_defense_design(p.A, p.B, sigma_d2=0.0, **kw)
+    plant = Plant(p.A, p.B)
+    threat = ThreatModel(sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, gamma_c=p.gamma_c, tau_c=p.tau_c, upsilon=p.upsilon)
+    ref = design_security_parameter(plant, threat)
+    d0 = noise_defense_design(plant, threat, sigma_d2=0.0)
     assert (d0.N_star, d0.lam_star, d0.k_star) == (ref.N_star, ref.lam_star, ref.k_star) == (13159, 74, 712)
-    d1 = noise_defense_design(p.A, p.B, sigma_d2=p.sigma_w2, **kw)
+    d1 = noise_defense_design(plant, threat, sigma_d2=p.sigma_w2)
     assert d1.N_star > d0.N_star and d1.lam_star <= d0.lam_star and d1.k_star <= d0.k_star

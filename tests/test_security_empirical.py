@@ -12,10 +12,11 @@ import pytest
 from encctl_gym.errors import ParameterError, ShapeError
 from encctl_gym.security.complexity import sample_identifying_complexity
 from encctl_gym.security.empirical import empirical_design, fit_empirical_complexity
+from encctl_gym.security.threat import ThreatModel
 from encctl_gym.sim.montecarlo import gaussian_attack_errors
 from encctl_gym.sim.plant import LinearPlant
 
-BUDGET = {"tau_c": 31536e4, "upsilon": 442e15}
+THREAT = ThreatModel(tau_c=31536e4, upsilon=442e15)
 
 
 def test_a_known_rate_is_recovered_with_its_interval():
@@ -29,11 +30,11 @@ def test_a_known_rate_is_recovered_with_its_interval():
     assert fit.a_interval[1] - fit.a_interval[0] < 0.1
     gamma_c = 1e-4
     exact = math.floor((c0 / gamma_c) ** (1 / a0)) + 1
-    d = empirical_design(fit, gamma_c=gamma_c, **BUDGET)
+    d = empirical_design(fit, THREAT, gamma_c=gamma_c)
     assert d.N_star_interval[0] <= exact <= d.N_star_interval[1]
     assert d.k_star_interval[0] <= d.k_star <= d.k_star_interval[1]
     assert not d.extrapolated and d.N_star_interval[1] <= N[-1]
-    beyond = empirical_design(fit, gamma_c=1e-6, **BUDGET)  # N* near 1.4e5, the grid ends at 5000
+    beyond = empirical_design(fit, THREAT, gamma_c=1e-6)  # N* near 1.4e5, the grid ends at 5000
     assert beyond.extrapolated and beyond.N_star > N[-1]
 
 
@@ -52,7 +53,7 @@ def test_iid_gaussian_regressors_follow_the_inverse_wishart_mean():
     assert fit.a_interval[0] < 1.0 < fit.a_interval[1]
     gamma_c = 1e-3
     exact_N_star = math.floor((n / 2 + m) / ((n + m) * gamma_c) + n + m + 2) + 1
-    d = empirical_design(fit, gamma_c=gamma_c, **BUDGET)
+    d = empirical_design(fit, THREAT, gamma_c=gamma_c)
     assert d.N_star_interval[0] <= exact_N_star <= d.N_star_interval[1]
     gamma = sample_identifying_complexity(N, plant.A, plant.B, sigma_u2=1.0, sigma_w2=1.0, sigma_x2=2.0)
     assert np.all(gamma < exact)
@@ -71,4 +72,4 @@ def test_refusals():
         fit_empirical_complexity(N, good, level=1.5)
     flat = fit_empirical_complexity(N, good * np.array([1.0, 1.0, 1.0]), bootstrap=100)
     with pytest.raises(ParameterError, match="not positive|non-positive"):
-        empirical_design(flat, gamma_c=1e-3, **BUDGET)
+        empirical_design(flat, THREAT, gamma_c=1e-3)

@@ -1,4 +1,4 @@
-"""Tests of encctl_gym.sim.parallel and sim.montecarlo: seeded tasks on joblib and Dask."""
+"""Tests of encctl_gym.parallel and sim.montecarlo: seeded tasks on joblib and Dask."""
 
 from __future__ import annotations
 
@@ -89,7 +89,7 @@ def test_missing_dask_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
 
 def test_unreachable_scheduler_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
     pytest.importorskip("distributed")
-    import encctl_gym.sim.parallel as parallel
+    import encctl_gym.parallel as parallel
 
     monkeypatch.setattr(parallel, "CONNECT_TIMEOUT", "1s")
     with pytest.raises(ConfigError, match="cannot connect"):

@@ -9,6 +9,7 @@
   least squares, Bayesian least squares (Gaussian prior, ridge posterior mean), exponential
   forgetting, instrumental variables.
 * :mod:`.registry` -- estimators by name (``make_estimator("bayes")``).
+* :mod:`.grid` -- the error on a grid of ``N`` for least squares or any estimator by name.
 * :mod:`.subspace` -- identification from outputs ``y = C x + D u + v``: N4SID, PO-MOESP and
   ARX on batches of runs, and the basis-free Markov-parameter error.
 
@@ -25,6 +26,7 @@ from .bayes import *  # noqa: F403
 from .error import *  # noqa: F403
 from .estimator import *  # noqa: F403
 from .forgetting import *  # noqa: F403
+from .grid import *  # noqa: F403
 from .instrumental import *  # noqa: F403
 from .least_squares import *  # noqa: F403
 from .ordinary import *  # noqa: F403
@@ -35,7 +37,18 @@ from .subspace import *  # noqa: F403
 __all__ = list(
     dict.fromkeys(
         name
-        for module in ("error", "least_squares", "estimator", "ordinary", "bayes", "forgetting", "instrumental", "registry", "subspace")
+        for module in (
+            "error",
+            "least_squares",
+            "estimator",
+            "ordinary",
+            "bayes",
+            "forgetting",
+            "instrumental",
+            "registry",
+            "grid",
+            "subspace",
+        )
         for name in sys.modules[f"{__name__}.{module}"].__all__
     )
 )

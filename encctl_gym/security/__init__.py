@@ -19,7 +19,10 @@ records
 cost_models
     Deciphering-cost models ``paper`` (def:sdt, eq:opt_key), ``precomputation`` (index calculus:
     one precomputation per group, then a cheap descent per key) and ``generic`` (Pollard rho),
-    one protocol and one registry; the GNFS formula with its optional o(1) correction.
+    one base class and one registry; the GNFS formula with its optional o(1) correction.
+threat
+    ``ThreatModel``: variances, gamma_c, tau_c, Upsilon, adversary and cost model, checked once;
+    the design functions take one.
 deciphering
     Sample deciphering time (Definition def:sdt) for the modified, token and static schemes,
     under a security parameter or any cost model; the largest affordable sample size.
@@ -37,8 +40,10 @@ empirical
 attack_design
     A-optimal attack inputs (closed and open loop), ``gamma_opt`` and robust designs (needs
     cvxpy; imported on use).
+report
+    ``design_report``: everything the design command reports for a plant, as a dict.
 design_cli
-    The ``encctl-gym design`` subcommand.
+    The ``encctl-gym design`` subcommand (prints :func:`.report.design_report`).
 """
 
 from __future__ import annotations
@@ -58,6 +63,7 @@ from .gramians import *  # noqa: F403
 from .key_length import *  # noqa: F403
 from .records import *  # noqa: F403
 from .sample_size import *  # noqa: F403
+from .threat import *  # noqa: F403
 
 #: The public names of the modules above, in their order (each module's ``__all__``).
 __all__ = list(
@@ -71,6 +77,7 @@ __all__ = list(
             "sample_size",
             "records",
             "cost_models",
+            "threat",
             "deciphering",
             "design",
             "key_length",

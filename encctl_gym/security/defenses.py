@@ -37,10 +37,12 @@ import numpy as np
 
 from .._validation import as_finite_array, check_int, check_nonnegative, check_positive, check_schur_stable, check_system
 from ..errors import ParameterError, ShapeError
+from ..plant import as_plant
 from .complexity import _out, check_sample_size
 from .design import SecurityDesign, design_for_sample_size
 from .gramians import controllability_gramian, noise_gramian, solve_gramian
 from .sample_size import minimum_sample_size
+from .threat import ThreatModel
 
 __all__ = [
     "chi2_detection_probability",
@@ -130,12 +132,19 @@ def sic_with_input_noise_asymptotic(
     return _out((m + n) * (tr_sigma / n) / ((Nf - 1.0) * (su * (tr_u + m) + sd * tr_u + sigma_w2 * tr_w)), scalar)
 
 
-def noise_defense_design(
-    A: Any, B: Any, *, sigma_u2: float, sigma_w2: float, sigma_d2: float, gamma_c: float, tau_c: float, upsilon: float
-) -> SecurityDesign:
+def noise_defense_design(plant: Any, threat: ThreatModel, *, sigma_d2: float) -> SecurityDesign:
     """Theorem thm:opt_sec and eq:opt_key under the defender's input noise: ``N*`` from
     :func:`sic_with_input_noise_asymptotic` (the large-sample form, as the paper designs with
     eq:sic2), then ``lambda*`` and ``k*``. At ``sigma_d2 = 0`` it is the paper's design.
+
+    Parameters
+    ----------
+    plant : Plant or (A, B)
+        The plant of eq:system.
+    threat : ThreatModel
+        With ``sigma_u2``, ``sigma_w2`` and ``gamma_c``.
+    sigma_d2 : float
+        Variance of the defender's input noise (>= 0).
 
     Returns
     -------
@@ -143,28 +152,17 @@ def noise_defense_design(
         With ``method = "input_noise"``; ``tr_psi_w`` is the trace of the Gramian of the whole
         noise ``Sigma`` (``sigma_d2 tr Psi_u / sigma_w2 + tr Psi_w``, in units of ``sigma_w2``).
     """
-    tr_u, tr_w, _, n, m = _noise_terms(A, B, sigma_w2, sigma_d2)
+    p = as_plant(plant)
+    threat = threat.require("sigma_u2", "sigma_w2", "gamma_c")
+    sw = float(threat.sigma_w2)
+    sd = check_nonnegative("sigma_d2", sigma_d2)
+    tr_u, tr_w, _, n, m = _noise_terms(p.A, p.B, sw, sd)
 
     def gamma(N: int) -> float:
-        return float(sic_with_input_noise_asymptotic(N, A, B, sigma_u2=sigma_u2, sigma_w2=sigma_w2, sigma_d2=sigma_d2))
+        return float(sic_with_input_noise_asymptotic(N, p.A, p.B, sigma_u2=threat.sigma_u2, sigma_w2=sw, sigma_d2=sd))
 
-    N_star = minimum_sample_size(gamma, gamma_c)
-    sd = check_nonnegative("sigma_d2", sigma_d2)
-    return design_for_sample_size(
-        "input_noise",
-        N_star,
-        gamma,
-        m=m,
-        n=n,
-        sigma_u2=sigma_u2,
-        sigma_w2=sigma_w2,
-        sigma_x2=1.0,
-        tr_psi_u=tr_u,
-        tr_psi_w=tr_w + sd * tr_u / sigma_w2,
-        gamma_c=gamma_c,
-        tau_c=tau_c,
-        upsilon=upsilon,
-    )
+    N_star = minimum_sample_size(gamma, threat.gamma_c)
+    return design_for_sample_size("input_noise", N_star, gamma, threat, m=m, n=n, tr_psi_u=tr_u, tr_psi_w=tr_w + sd * tr_u / sw)
 
 
 def closed_loop_state_covariance(A: Any, B: Any, Phi: Any, *, sigma_w2: float, sigma_d2: float) -> np.ndarray:

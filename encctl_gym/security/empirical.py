@@ -32,6 +32,7 @@ from .._validation import as_finite_array, check_int, check_positive
 from ..errors import ParameterError, ShapeError
 from .design import optimal_security_parameter
 from .key_length import design_key_length
+from .threat import ThreatModel
 
 __all__ = ["EmpiricalComplexity", "EmpiricalDesign", "empirical_design", "fit_empirical_complexity"]
 
@@ -180,7 +181,7 @@ def _n_star(a: float, c: float, gamma_c: float) -> int:
 
 
 def empirical_design(
-    fit: EmpiricalComplexity, *, gamma_c: float, tau_c: float, upsilon: float, model: str = "paper", level: float | None = None
+    fit: EmpiricalComplexity, threat: ThreatModel, *, gamma_c: float | None = None, level: float | None = None
 ) -> EmpiricalDesign:
     """The design of Theorem thm:opt_sec and eq:opt_key from an empirical complexity (step 2).
 
@@ -194,10 +195,12 @@ def empirical_design(
     ----------
     fit : EmpiricalComplexity
         From :func:`fit_empirical_complexity`.
-    gamma_c, tau_c, upsilon : float
-        Acceptable error, defense period (s) and adversary FLOPS (Definitions def:security, def:sdt).
-    model : str
-        Deciphering-cost model of eq:opt_key (``"paper"``, ``"precomputation"``, ``"generic"``).
+    threat : ThreatModel
+        Defense period, adversary FLOPS and deciphering-cost model (eq:opt_key), and the
+        acceptable error ``gamma_c`` in the fitted error's own measure.
+    gamma_c : float, optional
+        Overrides ``threat.gamma_c`` (an error measure other than Definition def:error needs its
+        own threshold).
     level : float, optional
         Confidence level of the intervals.
 
@@ -205,7 +208,8 @@ def empirical_design(
     -------
     EmpiricalDesign
     """
-    gamma_c = check_positive("gamma_c", gamma_c)
+    gamma_c = check_positive("gamma_c", threat.require("gamma_c").gamma_c if gamma_c is None else gamma_c)
+    tau_c, upsilon = threat.tau_c, threat.upsilon
     level = fit.level if level is None else check_positive("level", level)
     N_star = _n_star(fit.a, fit.c, gamma_c)
     boot = np.array([_n_star(a, c, gamma_c) for a, c in zip(fit.boot_a, fit.boot_c) if a > 0])
@@ -215,8 +219,8 @@ def empirical_design(
     n_lo, n_hi = (int(v) for v in np.quantile(boot, q, method="nearest"))
     lam = optimal_security_parameter(N_star, tau_c=tau_c, upsilon=upsilon)
     lam_ends = sorted(optimal_security_parameter(v, tau_c=tau_c, upsilon=upsilon) for v in (n_lo, n_hi))
-    k = design_key_length(model, N_star, tau_c=tau_c, upsilon=upsilon).k_star
-    k_ends = sorted(design_key_length(model, v, tau_c=tau_c, upsilon=upsilon).k_star for v in (n_lo, n_hi))
+    k = design_key_length(N_star, threat).k_star
+    k_ends = sorted(design_key_length(v, threat).k_star for v in (n_lo, n_hi))
     return EmpiricalDesign(
         N_star=N_star,
         N_star_interval=(n_lo, n_hi),
@@ -224,6 +228,6 @@ def empirical_design(
         lambda_star_interval=(lam_ends[0], lam_ends[1]),
         k_star=k,
         k_star_interval=(k_ends[0], k_ends[1]),
-        model=str(model),
+        model=str(getattr(threat.cost_model, "name", threat.cost_model)),
         extrapolated=bool(max(N_star, n_hi) > fit.N[-1]),
     )

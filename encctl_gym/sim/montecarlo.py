@@ -2,7 +2,7 @@
 
 One task = one system: ``runs`` trajectories of length ``N_max`` under i.i.d. Gaussian attack
 inputs (Theorem thm:sic), and the error ``epsilon(N)`` of Definition def:error on a whole grid
-of sample sizes from each trajectory (:func:`~encctl_gym.ident.least_squares.identification_errors`),
+of sample sizes from each trajectory (:func:`~encctl_gym.ident.grid.identification_errors`),
 by least squares (eq:estimate) or any estimator of :mod:`encctl_gym.ident.registry`.
 A sweep spreads systems over workers with :func:`~encctl_gym.parallel.run_tasks`, one
 child seed per system.
@@ -19,7 +19,8 @@ import numpy as np
 from .._validation import check_int, check_nonnegative, format_value
 from ..errors import ParameterError
 from ..ident.estimator import check_grid
-from ..ident.least_squares import check_sample_sizes, identification_errors
+from ..ident.grid import identification_errors
+from ..ident.least_squares import check_sample_sizes
 from ..ident.registry import make_estimator
 from ..parallel import SeedLike, run_tasks
 from ..resources import check_memory
@@ -109,7 +110,7 @@ def gaussian_attack_errors(
     estimator : str, mapping or Estimator, optional
         Anything :func:`~encctl_gym.ident.registry.make_estimator` takes; ``None`` (default) is
         least squares with exactly the numbers of eq:estimate's grid
-        (:func:`~encctl_gym.ident.least_squares.identification_errors`). The same seed gives
+        (:func:`~encctl_gym.ident.grid.identification_errors`). The same seed gives
         the same trajectories whatever the estimator, so estimators compare on common data.
 
     Returns

@@ -16,7 +16,8 @@ import numpy as np
 
 from .._validation import as_finite_array, check_int, check_nonnegative
 from ..errors import ParameterError, ShapeError
-from ..ident.least_squares import identification_errors, prefix_estimates
+from ..ident.grid import identification_errors
+from ..ident.least_squares import prefix_estimates
 from ..ident.subspace import arx, markov_error, moesp, n4sid
 from .plant import LinearPlant, simulate_gaussian_attack
 

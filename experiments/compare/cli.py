@@ -29,7 +29,8 @@ from encctl_gym.errors import ConfigError
 
 from .attackers import ATTACKERS
 from .plots import plot
-from .protocol import Result, compute
+from .protocol import compute
+from .records import Result
 from .report import summary_markdown
 from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, parse_delays
 from .tables import write_csvs

@@ -1,6 +1,6 @@
 """Figures of a comparison: error against N per system, and the energy pacing within one attack.
 
-Every number drawn comes from a :class:`~experiments.compare.protocol.Result`.
+Every number drawn comes from a :class:`~experiments.compare.records.Result`.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import numpy as np
 
 from encctl_gym.plotting import legend_below, save_figure
 
-from .protocol import Curve, Result
+from .records import Curve, Result
 from .settings import Setting
 from .statistics import Z95
 

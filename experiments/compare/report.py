@@ -2,7 +2,7 @@
 in words, and ``summary.md``.
 
 Nothing here is fixed text about the outcome: every statement is computed from a
-:class:`~experiments.compare.protocol.Result`.
+:class:`~experiments.compare.records.Result`.
 """
 
 from __future__ import annotations
@@ -14,7 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from .protocol import GAUSSIAN_NAME, Result
+from .protocol import GAUSSIAN_NAME
+from .records import Result
 from .statistics import paired_ratio
 
 __all__ = ["comparison_table", "design_efficiencies", "findings", "summary_markdown"]

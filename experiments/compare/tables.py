@@ -26,8 +26,9 @@ from typing import Any
 import numpy as np
 
 from encctl_gym.security.design import design_from_traces, minimum_key_length, optimal_security_parameter, sample_size_for_rate
+from encctl_gym.security.threat import ThreatModel
 
-from .protocol import Curve, Result
+from .records import Curve, Result
 from .settings import Setting
 from .statistics import Z95, fit_rate, paired_ratio, samples_to_reach
 
@@ -90,10 +91,9 @@ def security_row(setting: Setting, curve: Curve, *, gaussian: Curve | None = Non
 def bound_rows(setting: Setting) -> list[dict[str, Any]]:
     """The reference rows: the paper's design (eq:sic2, thm:opt_sec), the exact Gaussian rate and gamma_opt."""
     p = setting.base
-    paper = design_from_traces(
-        p.tr_psi_u, p.tr_psi_w, p.m, p.n, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, sigma_x2=p.sigma_x2,
-        gamma_c=p.gamma_c, tau_c=p.tau_c, upsilon=p.upsilon,
-    )
+    threat = ThreatModel(sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, sigma_x2=p.sigma_x2, gamma_c=p.gamma_c, tau_c=p.tau_c,
+                         upsilon=p.upsilon)
+    paper = design_from_traces(p.tr_psi_u, p.tr_psi_w, p.m, p.n, threat)
     rows = [{"system": setting.system, "delay": setting.delay, "attacker": "paper gamma (eq:sic2)", "N_to_gamma_c": paper.N_star,
              "N_how": "thm:opt_sec", "lambda_needed": paper.lam_star, "k_needed": paper.k_star,
              "rate_c": (p.m + p.n) * p.sigma_w2 / (p.sigma_u2 * (p.tr_psi_u + p.m) + p.sigma_w2 * p.tr_psi_w)}]

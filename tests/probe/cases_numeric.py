@@ -41,7 +41,7 @@ def _cryptanalysis() -> list[Case]:
             out.append(case(C, f"{cls.split(':')[1]}({opt}={label(v)}).precompute(32-bit group) bounded", "hang",
                             lambda _, c=cls, o=opt, v=v: api(f"{CA}.{c}")(**{o: v}).precompute(resolve_group(GROUP32)),
                             expect="either", timeout=30))
-    out += bad_args(C, f"{CA}.token_chain:TokenChain", {}, {"inner": explicit(["bogus", "token-chain", 3, None])}, drawn=0)
+    out += bad_args(C, f"{CA}.token_chain:TokenChain", {}, {"inner": explicit(["bogus", "token-chain", 3])}, drawn=0)
 
     def precompute(kw: dict[str, Any]) -> Any:
         b = api(f"{CA}.registry:get_breaker")(kw.pop("breaker", "bsgs"))
@@ -171,7 +171,7 @@ def _ident() -> list[Case]:
                             {p: explicit([np.zeros(5), np.array([NAN, 0.0]), np.array([1j, 0.0]), "ab", None])},
                             name="RecursiveLeastSquares.update", drawn=0)
     A2, B2 = np.array([[0.5, 0.1], [0.0, 0.3]]), np.array([[1.0], [0.5]])
-    ie = "encctl_gym.ident.least_squares:identification_errors"
+    ie = "encctl_gym.ident.grid:identification_errors"
     valid = {"x": x, "u": u, "A": A2, "B": B2, "sample_sizes": [10, 20, 40]}
     out += bad_args(I, ie, valid, {"sample_sizes": explicit([[0, 10], [2, 10], [10, 50], [10.5], "abc", None, [], [[10, 20]], [NAN], [HUGE], [True, 10]]),
                                    "method": explicit(["bogus", 3, None]), "estimator": explicit(["bogus", 3, {"name": "bogus"}]),

@@ -19,6 +19,28 @@ A_ = "security"
 A2 = np.array([[0.5, 0.1], [0.0, 0.3]])
 B2 = np.array([[1.0], [0.5]])
 SEC = "encctl_gym.security"
+
+
+#: The fields of a ThreatModel: the design functions take them in one value object.
+_THREAT_FIELDS = ("tau_c", "upsilon", "sigma_u2", "sigma_w2", "sigma_x2", "gamma_c", "adversary", "cost_model")
+
+
+def _on_values(path: str, *, plant: bool = False) -> Any:
+    """A target that builds the value objects (a Plant from ``A``, ``B``; a ThreatModel from its
+    fields; a cost model from ``model``, ``gnfs_correction``, ``calibration``) from the keywords
+    and calls ``path`` with them, so every value is probed where it is checked."""
+
+    def run(kw: dict[str, Any]) -> Any:
+        kw = dict(kw)
+        threat = {k: kw.pop(k) for k in _THREAT_FIELDS if k in kw}
+        if "model" in kw:
+            build = api(f"{SEC}.key_length:build_model")
+            threat["cost_model"] = build(kw.pop("model"), kw.pop("gnfs_correction", 0.0), kw.pop("calibration", None))
+        if plant:
+            kw["plant"] = api("encctl_gym.plant:Plant")(kw.pop("A"), kw.pop("B"))
+        return api(path)(threat=api(f"{SEC}.threat:ThreatModel")(**threat), **kw)
+
+    return run
 UNSTABLE = explicit([np.array([[1.5, 0.0], [0.0, 0.3]]), np.array([[1.0, 0.0], [0.0, 0.3]])], "silent")
 N_BAD = explicit([0, 1, -5, 2.5, NAN, INF, "100", None, True, HUGER, np.array([10.0, NAN]), np.array([10, "a"], dtype=object), 2 + 0j])
 
@@ -106,13 +128,13 @@ def _design() -> list[Case]:
                      "gamma_c": explicit([0.0, -1.0, NAN, "a"]), "gamma_infimum": explicit([-1.0, NAN, "a"])}, drawn=0)
     traces = {"tr_psi_u": 2.0, "tr_psi_w": 1.0, "m": 1, "n": 2, "sigma_u2": 10.0, "sigma_w2": 0.1, "gamma_c": 1e-6,
               "tau_c": 3.1536e8, "upsilon": 442e15}
-    out += bad_args(A_, f"{des}:design_from_traces", traces,
+    out += bad_args(A_, _on_values(f"{des}:design_from_traces"), traces,
                     {"gamma_c": BAD["pos"], "tau_c": tau_bad, "upsilon": "pos", "method": "name",
-                     "sigma_u2": explicit([0.0, -1.0, NAN, HUGE]), "m": explicit([0, -1, 2.5, "1", True])})
-    out += bad_args(A_, f"{des}:design_security_parameter",
+                     "sigma_u2": explicit([0.0, -1.0, NAN, HUGE]), "m": explicit([0, -1, 2.5, "1", True])}, name="design_from_traces")
+    out += bad_args(A_, _on_values(f"{des}:design_security_parameter", plant=True),
                     {"A": A2, "B": B2, "sigma_u2": 10.0, "sigma_w2": 0.1, "gamma_c": 1e-6, "tau_c": 3.1536e8, "upsilon": 442e15},
                     {"A": BAD["matrix"][:6] + UNSTABLE, "sigma_w2": "pos", "sigma_x2": "nonneg", "method": explicit(["bogus", 3, None])},
-                    drawn=0)
+                    name="design_security_parameter", drawn=0)
     out += bad_args(A_, f"{des}:paper_design_example", {}, {"method": "name"}, drawn=1)
     ss = f"{SEC}.sample_size"
     out += bad_args(A_, f"{ss}:optimal_sample_size", {"tr_psi_u": 2.0, "tr_psi_w": 1.0, "m": 1, "n": 2, "r_sigma": 100.0, "gamma_c": 1e-6},
@@ -153,13 +175,15 @@ def _cost_models() -> list[Case]:
     out += bad_args(A_, lambda kw: api(f"{cm}:deciphering_model")(kw.pop("model")).break_cost(**kw), {"model": "generic", "key_length": 712},
                     {"key_length": explicit([0, -1, 2.5, "a", 10**308])}, name="GenericModel.break_cost", drawn=0)
     kl = f"{SEC}.key_length"
-    out += bad_args(A_, f"{kl}:design_key_length", {"model": "paper", "N_star": 13159, "tau_c": 3.1536e8, "upsilon": 442e15},
+    out += bad_args(A_, _on_values(f"{kl}:design_key_length"), {"model": "paper", "N_star": 13159, "tau_c": 3.1536e8, "upsilon": 442e15},
                     {"model": "name", "N_star": explicit([0, -1, 2.5, NAN, "a", HUGE]), "tau_c": BAD["pos"] + explicit([1e-300]),
-                     "upsilon": explicit([0.0, -1.0, NAN, HUGE, 1e300]), "gnfs_correction": explicit([NAN, "bogus"])}, drawn=1)
-    out += bad_args(A_, f"{kl}:design_key_length", {"model": "generic", "N_star": 2, "tau_c": 1e300, "upsilon": 1e300},
+                     "upsilon": explicit([0.0, -1.0, NAN, HUGE, 1e300]), "gnfs_correction": explicit([NAN, "bogus"]),
+                     "adversary": explicit(["bogus", None, 3])}, name="design_key_length", drawn=1)
+    out += bad_args(A_, _on_values(f"{kl}:design_key_length"), {"model": "generic", "N_star": 2, "tau_c": 1e300, "upsilon": 1e300},
                     {"tau_c": explicit([1e300], "hang")}, name="design_key_length(generic, 1e600)", drawn=0, timeout=30)
-    out += bad_args(A_, f"{kl}:key_length_value", {"model": "paper", "key_length": 712, "N_star": 13159, "tau_c": 3.1536e8, "upsilon": 442e15},
-                    {"key_length": explicit([0, -1, 2.5, "a", None, 10**308, HUGE]), "N_star": explicit([0, -1, 2.5])}, drawn=0)
+    out += bad_args(A_, _on_values(f"{kl}:key_length_value"), {"model": "paper", "key_length": 712, "N_star": 13159, "tau_c": 3.1536e8,
+                    "upsilon": 442e15}, {"key_length": explicit([0, -1, 2.5, "a", None, 10**308, HUGE]), "N_star": explicit([0, -1, 2.5])},
+                    name="key_length_value", drawn=0)
     out += bad_args(A_, f"{kl}:defense_budget", {"tau_c": 3.1536e8, "upsilon": 442e15},
                     {"tau_c": explicit([0.0, -1.0, NAN, "a", HUGE]), "upsilon": explicit([0.0, NAN, HUGE])}, drawn=0)
     return out
@@ -190,12 +214,13 @@ def _attack_design() -> list[Case]:
     out += bad_args(A_, f"{ad}:gamma_opt", {"N": 100, **valid},
                     {"N": explicit([0, 1, -5, 2.5, NAN, "a", None]), "feedback": explicit(["no", 0, None, NAN])}, drawn=0)
     robust = {**valid, "gamma_c": 1e-6, "tau_c": 3.1536e8, "upsilon": 442e15}
-    out += bad_args(A_, f"{ad}:robust_security_design", robust,
-                    {"kind": "name", "gamma_c": explicit([0.0, -1.0, NAN]), "tau_c": explicit([1e-300, -1.0, NAN])}, drawn=0)
+    out += bad_args(A_, _on_values(f"{ad}:robust_security_design", plant=True), robust,
+                    {"kind": "name", "gamma_c": explicit([0.0, -1.0, NAN]), "tau_c": explicit([1e-300, -1.0, NAN])},
+                    name="robust_security_design", drawn=0)
 
     def robust_other_design(kw: dict[str, Any]) -> Any:
         design = api(f"{ad}:optimal_attack_design")(A2, B2, sigma_u2=5.0, sigma_w2=0.1)
-        return api(f"{ad}:robust_security_design")(design=design, **{**robust, **kw})
+        return _on_values(f"{ad}:robust_security_design", plant=True)({"design": design, **robust, **kw})
 
     out += bad_args(A_, robust_other_design, {}, {"sigma_u2": explicit([1.0, 2.0])}, name="robust_security_design(design of sigma_u2=5)", drawn=0)
     out += bad_args(A_, f"{ad}:sdp_estimate", {"dimension": 10}, {"dimension": explicit([0, -1, 2.5, "a", None, HUGE])}, drawn=0)
