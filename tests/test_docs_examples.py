@@ -88,3 +88,14 @@ def test_block_parser_finds_languages_marks_and_unclosed_fences() -> None:
     assert python_blocks(text) == [(3, "x = 1\n", False), (9, "y = x\n", True)]
     with pytest.raises(ValueError, match="line 2"):
         python_blocks("a\n```python\nx = 1\n")
+
+
+def test_readme_links_point_to_files_of_the_repository() -> None:
+    """The README is outside the site (mkdocs checks the links of docs/ only): its relative links
+    and images must name files that exist."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    targets = re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", text)
+    relative = [t for t in targets if "://" not in t]
+    assert relative, "the README links no page of docs/"
+    missing = [t for t in relative if not (ROOT / t).is_file()]
+    assert not missing, missing
