@@ -46,6 +46,8 @@ class OrdinaryLeastSquares(MomentEstimator):
     method : {"auto", "gram", "qr"}
         Solver of the grid estimates (:func:`~encctl_gym.ident.least_squares.prefix_estimates`).
 
+    Notes
+    -----
     Costs: :meth:`fit` one batched pseudo-inverse; :meth:`prefix_estimates` one pass over the
     data plus one batched ``d x d`` solve per (run, N); online, ``O(K (2n + m)^2)`` per update
     and one Cholesky solve per copy per estimate (``O(K d^3)``, ``d = n + m``).
