@@ -58,14 +58,16 @@ class ThreatModel:
         :data:`~encctl_gym.security.cost_models.DECIPHERING_MODELS` (with its default options)
         or a built model (with its own GNFS correction and calibration).
 
-    ``sigma_u2``, ``sigma_w2`` and ``gamma_c`` are optional because a key-length design for a
-    given ``N*`` does not use them; a design of the sample size refuses a threat model without
-    them (:meth:`require`).
-
     Raises
     ------
     ParameterError
         Naming the first bad value.
+
+    Notes
+    -----
+    ``sigma_u2``, ``sigma_w2`` and ``gamma_c`` are optional because a key-length design for a
+    given ``N*`` does not use them; a design of the sample size refuses a threat model without
+    them (:meth:`require`).
 
     Examples
     --------
