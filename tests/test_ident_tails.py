@@ -111,3 +111,39 @@ def test_engine_summaries_use_the_rule() -> None:
     assert ss[2].mean == pytest.approx(float(e[:, 2].mean()))
     with pytest.raises(ParameterError, match="sample_sizes"):
         error_summaries(e, [5, 7], n=2, m=2)
+
+
+def test_compare_row_reports_the_median_where_the_mean_does_not_exist() -> None:
+    from agents.evaluate import Rollout
+    from experiments.compare.protocol import Curve
+    from experiments.compare.report import _error_cell
+    from experiments.compare.settings import make_setting
+    from experiments.compare.tables import security_row
+
+    s = make_setting("small", 0, None, length=40)
+    rng = np.random.default_rng(2)
+    final = rng.pareto(0.5, 50) * 1e-3 + 1e-3
+    grid = np.array([4, 5])
+    means = np.array([1.0, final.mean()])
+    c = Curve("gaussian", False, grid, means, 0.1 * means, 50, final, np.ones(50), 0.0)
+    row = security_row(s, c)  # horizon N = 5 = n + m + 1: tail exponent 1/2
+    assert row["mean_status"] == "does not exist" and row["median_at_horizon"] == pytest.approx(float(np.median(final)))
+    cell = _error_cell(row)
+    assert cell.startswith("median ") and "mean does not exist" in cell
+    ok = security_row(
+        s,
+        Curve(
+            "gaussian",
+            False,
+            np.array([10, 40]),
+            np.array([1e-2, 2e-3]),
+            np.array([1e-3, 1e-4]),
+            50,
+            rng.exponential(2e-3, 50),
+            np.ones(50),
+            0.0,
+        ),
+    )
+    assert ok["mean_status"] == "exists" and _error_cell(ok).startswith(f"{ok['mean_error_at_horizon']:.3g} [")
+    r = Rollout("gaussian", np.array([5]), final[:, None], final[:, None], final, np.ones(50), np.ones(50), np.ones(1), 0.0)
+    assert r.summary_final(2, 2).status == "does not exist" and r.summary_final().status == "unreliable"
