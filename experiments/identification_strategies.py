@@ -473,10 +473,18 @@ def plot(result: Result, out: Path) -> list[Path]:
                 mean, se = c.mean, c.se
                 ok = np.isfinite(mean)
                 top = c.estimator == "ls"  # the paper's estimator on top of the others
-                ax.plot(c.N[ok], mean[ok], color=color[c.estimator], lw=2.0 if top else 1.2, marker="o", ms=2,
+                # where the mean does not exist or is unreliable: the median (open marker), no band
+                sms = c.summaries
+                bare = np.array([sm is not None and not sm.mean_ok for sm in sms])
+                med = np.array([sm.median if sm is not None else np.nan for sm in sms])
+                y = np.where(bare, med, mean)
+                ax.plot(c.N[ok], y[ok], color=color[c.estimator], lw=2.0 if top else 1.2, marker="o", ms=2,
                         label=c.estimator, zorder=3 if top else 2, ls="--" if top else "-")
+                if bare.any():
+                    ax.plot(c.N[bare], med[bare], ls="none", marker="o", ms=5, mfc="none", color=color[c.estimator], zorder=4)
+                band = ok & ~bare
                 lo = np.maximum(mean - 1.96 * se, 0.05 * mean)
-                ax.fill_between(c.N[ok], lo[ok], (mean + 1.96 * se)[ok], color=color[c.estimator], alpha=0.2, lw=0)
+                ax.fill_between(c.N[band], lo[band], (mean + 1.96 * se)[band], color=color[c.estimator], alpha=0.2, lw=0)
             ax.plot(Nl, s.params.gamma(Nl), "k--", lw=1.0, label="gamma(N), eq:sic")
             ax.plot(Nl, s.design.gamma(Nl), "k:", lw=1.4, label="gamma_opt(N)")
             ax.axhline(s.base.gamma_c, color="0.5", lw=0.7, ls="-.", label="gamma_c")
@@ -488,13 +496,14 @@ def plot(result: Result, out: Path) -> list[Path]:
                 ax.set_ylabel(f"{system}\nE[eps(N)]", fontsize=9)
             if i == len(systems) - 1:
                 ax.set_xlabel("attack length N", fontsize=9)
-            lo_y = float(np.nanmin([np.nanmin(c.mean) for c in cs] + [float(np.min(s.design.gamma(Nl)))]))
-            hi_y = float(np.nanmax([np.nanmax(c.mean[np.isfinite(c.mean)]) if np.isfinite(c.mean).any() else lo_y for c in cs]))
+            shown = [np.array([(sm.mean if sm.mean_ok else sm.median) if sm is not None else np.nan for sm in c.summaries]) for c in cs]
+            lo_y = float(np.nanmin([np.nanmin(v) for v in shown] + [float(np.min(s.design.gamma(Nl)))]))
+            hi_y = float(np.nanmax([np.nanmax(v[np.isfinite(v)]) if np.isfinite(v).any() else lo_y for v in shown]))
             ax.set_ylim(0.5 * lo_y, 2.0 * max(hi_y, lo_y))
     axes[0, 0].legend(fontsize=6, loc="lower left")
     E = result.curves[systems[0]][0].errors.shape[0]
-    fig.suptitle(f"Identification strategies: mean error (95 % band, {E} attacks per N at energy m sigma_u2 N) "
-                 "of each estimator on the same delivered data", fontsize=10)
+    fig.suptitle(f"Identification strategies: mean error (95 % band; open circles: the median where the mean does not exist "
+                 f"or is unreliable), {E} attacks per N at energy m sigma_u2 N, each estimator on the same delivered data", fontsize=9)
     fig.tight_layout()
     path = out / "identification_strategies.png"
     fig.savefig(path, dpi=100)
