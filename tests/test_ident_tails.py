@@ -147,3 +147,16 @@ def test_compare_row_reports_the_median_where_the_mean_does_not_exist() -> None:
     assert ok["mean_status"] == "exists" and _error_cell(ok).startswith(f"{ok['mean_error_at_horizon']:.3g} [")
     r = Rollout("gaussian", np.array([5]), final[:, None], final[:, None], final, np.ones(50), np.ones(50), np.ones(1), 0.0)
     assert r.summary_final(2, 2).status == "does not exist" and r.summary_final().status == "unreliable"
+
+
+def test_bad_samples_are_refused_with_their_name() -> None:
+    with pytest.raises(ParameterError, match="errors must be a numeric array"):
+        summarize_errors("abc")
+    with pytest.raises(ParameterError, match="1-d"):
+        summarize_errors([[1.0, 2.0], [3.0, 4.0]])
+    with pytest.raises(ParameterError, match="tail_exponent"):
+        summarize_errors([1.0, 2.0], tail_exponent=[1.0, 2.0])
+    with pytest.raises(ParameterError, match="samples must be a numeric array"):
+        hill_tail_exponent("abc")
+    with pytest.raises(ParameterError, match=r"sample_sizes\[0\]"):
+        error_summaries(np.ones((3, 1)), [5.5], n=2, m=2)

@@ -63,7 +63,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import as_finite_array, check_int, check_positive
+from .._validation import as_finite_array, check_int, check_positive, format_value
 from ..errors import ParameterError
 from .registry import make_estimator
 
@@ -82,6 +82,17 @@ MIN_HILL_SAMPLES = 40
 #: Quantiles an :class:`ErrorSummary` reports.
 QUANTILES = (0.1, 0.25, 0.5, 0.75, 0.9)
 _Z95 = 1.959963984540054
+
+
+def _sample(name: str, value: Any) -> np.ndarray:
+    """A 1-d float sample (NaN allowed: runs without an estimate)."""
+    try:
+        x = np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"{name} must be a numeric array, got {format_value(value)}") from None
+    if x.ndim > 1:
+        raise ParameterError(f"{name} must be 1-d, got shape {x.shape}")
+    return x.ravel()
 
 
 def _estimator_kind(estimator: Any, n: int, m: int) -> tuple[str, Any]:
@@ -207,7 +218,7 @@ def hill_tail_exponent(samples: Any, k: int | None = None) -> HillEstimate:
     ParameterError
         Fewer than two finite samples, a non-positive or infinite value, or ``k`` out of range.
     """
-    x = np.asarray(samples, dtype=float).ravel()
+    x = _sample("samples", samples)
     x = x[~np.isnan(x)]
     if x.size < 2:
         raise ParameterError(f"a tail exponent needs at least 2 finite samples, got {x.size}")
@@ -311,12 +322,16 @@ def summarize_errors(errors: Any, *, tail_exponent: float | None = None) -> Erro
     ParameterError
         No finite error, or a negative or infinite one.
     """
-    x = as_finite_array("errors", np.asarray(errors, dtype=float)[~np.isnan(np.asarray(errors, dtype=float))])
+    raw = _sample("errors", errors)
+    x = as_finite_array("errors", raw[~np.isnan(raw)])
     if x.size == 0:
         raise ParameterError("no error to summarize")
     if np.any(x < 0):
         raise ParameterError("errors must be >= 0")
-    alpha = None if tail_exponent is None else float(tail_exponent)
+    t = None if tail_exponent is None else _sample("tail_exponent", tail_exponent)
+    if t is not None and t.size != 1:
+        raise ParameterError(f"tail_exponent must be one number, got {format_value(tail_exponent)}")
+    alpha = None if t is None else float(t[0])
     if alpha is not None and not alpha > 0:
         raise ParameterError(f"tail_exponent must be > 0, got {tail_exponent!r}")
     mean = float(x.mean())

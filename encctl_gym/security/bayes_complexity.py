@@ -79,8 +79,9 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import as_finite_array, check_int, check_positive, check_system
+from .._validation import as_finite_array, check_int, check_positive, check_system, format_value
 from ..errors import ParameterError, ShapeError
+from ..resources import check_memory
 from .complexity import sic_from_traces
 from .gramians import controllability_gramian, noise_gramian
 
@@ -376,7 +377,7 @@ def bayes_risk_iid_gaussian(
     (float, float)
         The value and its standard error (0 when exact).
     """
-    N = check_int("N", N, minimum=2)
+    N = check_int("N", N, minimum=2, maximum=2**53)
     n = check_int("n", n, minimum=1)
     sw = check_positive("sigma_w2", sigma_w2)
     S = as_finite_array("covariance", covariance)
@@ -396,6 +397,7 @@ def bayes_risk_iid_gaussian(
             return math.inf, 0.0
         return sw * float(np.trace(np.linalg.inv(S))) / (d * (T - d - 1)), 0.0
     draws = check_int("draws", draws, minimum=2)
+    check_memory(f"draws = {format_value(draws)}", 8 * draws, advice="ask for fewer draws")
     rng = np.random.default_rng(check_int("seed", seed, minimum=0))
     vals = np.empty(draws)
     step = 4096

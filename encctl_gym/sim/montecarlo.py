@@ -223,12 +223,13 @@ def error_summaries(errors: Any, sample_sizes: Any, *, n: int, m: int, estimator
     -------
     list of ErrorSummary
     """
-    errors = np.asarray(errors, dtype=float)
-    grid = np.asarray(sample_sizes).ravel()
-    if errors.ndim != 2 or errors.shape[1] != grid.size:
+    try:
+        errors = np.asarray(errors, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"errors must be a numeric array, got {format_value(errors)}") from None
+    grid = [check_int(f"sample_sizes[{k}]", v, minimum=2) for k, v in enumerate(np.asarray(sample_sizes, dtype=object).ravel())]
+    if errors.ndim != 2 or errors.shape[1] != len(grid):
         raise ParameterError(
-            f"errors must have shape (runs, {grid.size}) for sample_sizes of length {grid.size}, got {errors.shape}"
+            f"errors must have shape (runs, {len(grid)}) for sample_sizes of length {len(grid)}, got {errors.shape}"
         )
-    return [
-        summarize_errors(errors[:, k], tail_exponent=error_tail_exponent(n, m, int(N), estimator)) for k, N in enumerate(grid)
-    ]
+    return [summarize_errors(errors[:, k], tail_exponent=error_tail_exponent(n, m, N, estimator)) for k, N in enumerate(grid)]
