@@ -12,6 +12,8 @@
 * :mod:`.grid` -- the error on a grid of ``N`` for least squares or any estimator by name.
 * :mod:`.subspace` -- identification from outputs ``y = C x + D u + v``: N4SID, PO-MOESP and
   ARX on batches of runs, and the basis-free Markov-parameter error.
+* :mod:`.tails` -- when the error's mean and variance exist (the tail rule), the Hill
+  estimator, and summaries that report medians and flag a mean that does not exist.
 
 Pure numerical code (numpy): it imports only the package's base modules. The sample
 identifying complexities of :mod:`encctl_gym.security` bound the expected error of these
@@ -32,6 +34,7 @@ from .least_squares import *  # noqa: F403
 from .ordinary import *  # noqa: F403
 from .registry import *  # noqa: F403
 from .subspace import *  # noqa: F403
+from .tails import *  # noqa: F403
 
 #: The public names of the modules above, in their order (each module's ``__all__``).
 __all__ = list(
@@ -48,6 +51,7 @@ __all__ = list(
             "registry",
             "grid",
             "subspace",
+            "tails",
         )
         for name in sys.modules[f"{__name__}.{module}"].__all__
     )

@@ -27,10 +27,17 @@ def _ratio(r: dict[str, Any], which: str) -> str:
     return f"{r[f'ratio_to_{which}']:.3f} [{r[f'ratio_to_{which}_low']:.3f}, {r[f'ratio_to_{which}_high']:.3f}]"
 
 
+def _error_cell(r: dict[str, Any]) -> str:
+    if r.get("mean_status", "exists") == "exists":
+        return f"{r['mean_error_at_horizon']:.3g} [{r['ci95_low_at_horizon']:.3g}, {r['ci95_high_at_horizon']:.3g}]"
+    return f"median {r['median_at_horizon']:.3g} [10-90 %: {r['q10_at_horizon']:.3g}, {r['q90_at_horizon']:.3g}]; {r['mean_flag']}"
+
+
 def comparison_table(result: Result) -> str:
     """The markdown table of every attacker and setting, then the reference rows.
 
-    Columns: average power; mean final error at the horizon with its 95 % interval; the horizon
+    Columns: average power; mean final error at the horizon with its 95 % interval (where the
+    mean does not exist or is unreliable, the median with the 10-90 % quantiles and why); the horizon
     (``*``: set by the evaluation, not by the system's tau_c); the error over ``gamma_opt(N)``; the paired ratios to the
     Gaussian attacker and to the oracle on the same episodes (ratio of geometric means, 95 %
     interval); the fitted rate over the Gaussian design's; the samples needed to reach
@@ -44,7 +51,7 @@ def comparison_table(result: Result) -> str:
     for r in result.security:
         lines.append(
             f"| {r['system']} | {r['delay']} | {r['attacker']}{' (oracle)' if r['oracle'] else ''} | {r['average_power']:.3g} | "
-            f"{r['mean_error_at_horizon']:.3g} [{r['ci95_low_at_horizon']:.3g}, {r['ci95_high_at_horizon']:.3g}] | "
+            f"{_error_cell(r)} | "
             f"{r['horizon']}{'*' if r['capped'] else ''} | {r['error_over_gamma_opt']:.3f} | {_ratio(r, 'gaussian')} | "
             f"{_ratio(r, 'oracle')} | {r['rate_over_gaussian_design']:.3f} | {r['N_to_gamma_c']} ({r['N_how'][:5]}.) | "
             f"{r['lambda_needed']} | {r['k_needed']} |"

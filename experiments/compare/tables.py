@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from encctl_gym.ident.tails import error_tail_exponent, summarize_errors
 from encctl_gym.security.design import design_from_traces, minimum_key_length, optimal_security_parameter, sample_size_for_rate
 from encctl_gym.security.threat import ThreatModel
 
@@ -42,13 +43,16 @@ SECURITY_COLUMNS = ("system", "delay", "attacker", "oracle", "episodes", "horizo
                     "gamma_opt_at_horizon", "error_over_gamma_opt", "ratio_to_gaussian", "ratio_to_gaussian_low",
                     "ratio_to_gaussian_high", "ratio_to_oracle", "ratio_to_oracle_low", "ratio_to_oracle_high",
                     "average_power", "sigma_u2", "rate_c", "rate_over_gaussian_design", "gamma_c", "N_to_gamma_c", "N_how",
-                    "lambda_needed", "k_needed")
+                    "lambda_needed", "k_needed", "median_at_horizon", "q10_at_horizon", "q90_at_horizon", "mean_status",
+                    "mean_flag")
 
 
 def security_row(setting: Setting, curve: Curve, *, gaussian: Curve | None = None, oracle: Curve | None = None) -> dict[str, Any]:
     """One attacker's row: error at the horizon with its 95 % interval, the paired ratios to the
-    Gaussian attacker and to the oracle on the same episodes (with 95 % intervals), and the
-    security consequence (module docstring)."""
+    Gaussian attacker and to the oracle on the same episodes (with 95 % intervals), the security
+    consequence (module docstring), and the median and 10-90 % quantiles at the horizon with the
+    status of the mean (:func:`encctl_gym.ident.tails.summarize_errors`: the least-squares tail
+    rule, which assumes inputs with a density, and the Hill check)."""
     p, b = setting.params, setting.base
     N_c, how = samples_to_reach(curve.N, curve.mean, b.gamma_c)
     lam = optimal_security_parameter(N_c, tau_c=b.tau_c, upsilon=b.upsilon)
@@ -56,6 +60,7 @@ def security_row(setting: Setting, curve: Curve, *, gaussian: Curve | None = Non
     mean = float(curve.final.mean())
     se = float(curve.final.std(ddof=1) / math.sqrt(curve.final.size)) if curve.final.size > 1 else float("nan")
     rate = fit_rate(curve.N, curve.mean)
+    tails = summarize_errors(curve.final, tail_exponent=error_tail_exponent(p.n, p.m, Nh) if Nh > p.n + p.m else None)
     row = {
         "system": setting.system,
         "delay": setting.delay,
@@ -80,6 +85,11 @@ def security_row(setting: Setting, curve: Curve, *, gaussian: Curve | None = Non
         "N_how": how,
         "lambda_needed": lam,
         "k_needed": minimum_key_length(lam),
+        "median_at_horizon": tails.median,
+        "q10_at_horizon": tails.quantiles[0.1],
+        "q90_at_horizon": tails.quantiles[0.9],
+        "mean_status": tails.status,
+        "mean_flag": tails.flag(),
     }
     for label, ref in (("gaussian", gaussian), ("oracle", oracle)):
         if ref is not None and ref is not curve and ref.final.size == curve.final.size and ref.final.size > 1:
