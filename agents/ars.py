@@ -114,10 +114,22 @@ class PairedARS(ARS):
         self._paired_env: Any = None
         self._continue = True
         super().__init__(
-            policy, env, n_delta=n_delta, n_top=n_top, learning_rate=learning_rate, delta_std=delta_std,
-            zero_policy=zero_policy, alive_bonus_offset=alive_bonus_offset, n_eval_episodes=n_eval_episodes,
-            policy_kwargs=policy_kwargs, stats_window_size=stats_window_size, tensorboard_log=tensorboard_log,
-            seed=seed, verbose=verbose, device=device, _init_setup_model=_init_setup_model,
+            policy,
+            env,
+            n_delta=n_delta,
+            n_top=n_top,
+            learning_rate=learning_rate,
+            delta_std=delta_std,
+            zero_policy=zero_policy,
+            alive_bonus_offset=alive_bonus_offset,
+            n_eval_episodes=n_eval_episodes,
+            policy_kwargs=policy_kwargs,
+            stats_window_size=stats_window_size,
+            tensorboard_log=tensorboard_log,
+            seed=seed,
+            verbose=verbose,
+            device=device,
+            _init_setup_model=_init_setup_model,
         )
 
     def _excluded_save_params(self) -> list[str]:
@@ -150,8 +162,15 @@ class PairedARS(ARS):
         return returns
 
     def learn(  # type: ignore[override]  # sb3-contrib's ARS.learn adds async_eval before progress_bar
-        self, total_timesteps: int, callback: Any = None, log_interval: int = 1, tb_log_name: str = "ARS",
-              reset_num_timesteps: bool = True, async_eval: Any = None, progress_bar: bool = False) -> PairedARS:
+        self,
+        total_timesteps: int,
+        callback: Any = None,
+        log_interval: int = 1,
+        tb_log_name: str = "ARS",
+        reset_num_timesteps: bool = True,
+        async_eval: Any = None,
+        progress_bar: bool = False,
+    ) -> PairedARS:
         """As :meth:`sb3_contrib.ARS.learn`, and a callback returning False stops training."""
         total_steps, callback = self._setup_learn(total_timesteps, callback, reset_num_timesteps, tb_log_name, progress_bar)
         callback.on_training_start(locals(), globals())
@@ -198,7 +217,7 @@ class PairedARS(ARS):
         while True:
             o = vn.normalize_obs(obs) if vn is not None else obs
             if vn is not None:
-                centre_obs.append(obs[P * E:])
+                centre_obs.append(obs[P * E :])
             with th.no_grad():
                 a = batched(params, th.as_tensor(np.asarray(o, np.float32)).reshape(P + 1, E, -1)).reshape((P + 1) * E, -1)
             obs, reward, dones, _ = env.step(a.cpu().numpy())
@@ -208,7 +227,7 @@ class PairedARS(ARS):
                 break
         if vn is not None and vn.training:
             vn.obs_rms.update(np.concatenate(centre_obs, axis=0))
-        centre = total[P * E:]
+        centre = total[P * E :]
         self._mimic_monitor_wrapper(centre, np.full(E, steps))
         self.logger.record("rollout/centre_return", float(centre.mean()))
         returns = th.as_tensor(total[: P * E].reshape(P, E).mean(axis=1), dtype=th.float32)
@@ -230,7 +249,9 @@ class PairedARS(ARS):
                 policy.load_from_vector(candidate_weights[i].cpu())  # type: ignore[arg-type]  # SB3 accepts a tensor
                 assert self.env is not None
                 self.env.seed(seed)
-                rew, lens = evaluate_policy(policy, self.env, n_eval_episodes=self.n_eval_episodes, return_episode_rewards=True, warn=False)
+                rew, lens = evaluate_policy(
+                    policy, self.env, n_eval_episodes=self.n_eval_episodes, return_episode_rewards=True, warn=False
+                )
                 returns[i] = float(np.mean(rew))
                 played += int(np.sum(lens))
                 self._mimic_monitor_wrapper(np.asarray(rew), np.asarray(lens))
@@ -250,7 +271,7 @@ class PairedARS(ARS):
         candidates = th.cat([self.weights + delta_std * deltas, self.weights - delta_std * deltas])
         with th.no_grad():
             R = self.evaluate_candidates(candidates, callback, async_eval)
-        grad = ((R[: self.n_delta] - R[self.n_delta:]).to(deltas) @ deltas) / (2.0 * delta_std * self.n_delta)
+        grad = ((R[: self.n_delta] - R[self.n_delta :]).to(deltas) @ deltas) / (2.0 * delta_std * self.n_delta)
         if self._adam is None:
             self._adam = {"m": th.zeros_like(grad), "v": th.zeros_like(grad), "t": 0}
         st, (b1, b2) = self._adam, self.adam_betas

@@ -102,7 +102,9 @@ class Attacker(ABC):
         if single:
             o = o[None]
         if o.ndim != 2 or o.shape[1] != self.layout.dim:
-            raise ParameterError(f"observation must have shape ({self.layout.dim},) or (K, {self.layout.dim}), got {np.shape(obs)}")
+            raise ParameterError(
+                f"observation must have shape ({self.layout.dim},) or (K, {self.layout.dim}), got {np.shape(obs)}"
+            )
         if self._batch is None:
             self._batch = o.shape[0]
             self._start(self._batch)

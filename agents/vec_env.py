@@ -47,8 +47,9 @@ class SB3VecEnv(VecEnv):
     cost more than the step itself).
     """
 
-    def __init__(self, config: dict[str, Any], num_envs: int, observation: str = "full", reward_scaling: str = "none",
-                 features: Any = ()) -> None:
+    def __init__(
+        self, config: dict[str, Any], num_envs: int, observation: str = "full", reward_scaling: str = "none", features: Any = ()
+    ) -> None:
         from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
 
         self.config = dict(config)
@@ -63,7 +64,9 @@ class SB3VecEnv(VecEnv):
         self.feature_names = list(self.features.names)
         low, high = self.params.observation_bounds()
         f_low, f_high = self.features.bounds()
-        obs_space = spaces.Box(np.concatenate([low[self.obs_idx], f_low]), np.concatenate([high[self.obs_idx], f_high]), dtype=np.float32)
+        obs_space = spaces.Box(
+            np.concatenate([low[self.obs_idx], f_low]), np.concatenate([high[self.obs_idx], f_high]), dtype=np.float32
+        )
         self.num_envs = num_envs
         self.render_mode = None
         self._actions = np.zeros((num_envs, self.params.m), dtype=np.float32)
@@ -92,7 +95,7 @@ class SB3VecEnv(VecEnv):
         """
         obs, _ = self.venv.reset(seed=[int(s) for s in seeds])
         self.features.reset(self.num_envs, seeds=seeds)
-        self._feature_rng = np.random.default_rng(np.random.SeedSequence([int(s) for s in seeds[:1]] + [0x7a]))
+        self._feature_rng = np.random.default_rng(np.random.SeedSequence([int(s) for s in seeds[:1]] + [0x7A]))
         self._reset_seeds()
         self._reset_options()
         return self._obs(obs)

@@ -23,21 +23,10 @@ from encctl_gym.errors import ParameterError
 from encctl_gym.plotting import save_figure
 from encctl_gym.sim.montecarlo import log_grid
 
-__all__ = [
-    "GridConfig",
-    "FULL",
-    "QUICK",
-    "Table",
-    "add_common_arguments",
-    "grid_config",
-    "figure_seed",
-    "ensure_out_dir",
-]
+__all__ = ["GridConfig", "FULL", "QUICK", "Table", "add_common_arguments", "grid_config", "figure_seed", "ensure_out_dir"]
 
 #: CSV columns, in order.
-COLUMNS = (
-    "figure", "panel", "sigma_w2", "sigma_u2", "r_sigma", "psi_u", "N", "run", "error", "gamma", "bound",
-)
+COLUMNS = ("figure", "panel", "sigma_w2", "sigma_u2", "r_sigma", "psi_u", "N", "run", "error", "gamma", "bound")
 
 
 @dataclass(frozen=True)
@@ -107,19 +96,21 @@ class Table:
         run = np.repeat(np.arange(runs), K)
         rows = runs * K
         bound_col = np.full(K, np.nan) if bound is None else np.asarray(bound, dtype=float)
-        return cls({
-            "figure": np.full(rows, figure, dtype=object),
-            "panel": np.full(rows, panel, dtype=object),
-            "sigma_w2": np.full(rows, sigma_w2),
-            "sigma_u2": np.full(rows, sigma_u2),
-            "r_sigma": np.full(rows, sigma_u2 / sigma_w2),
-            "psi_u": np.full(rows, psi_u),
-            "N": N.astype(np.int64),
-            "run": run.astype(np.int64),
-            "error": errors.reshape(-1),
-            "gamma": np.tile(np.asarray(gamma, dtype=float), runs),
-            "bound": np.tile(bound_col, runs),
-        })
+        return cls(
+            {
+                "figure": np.full(rows, figure, dtype=object),
+                "panel": np.full(rows, panel, dtype=object),
+                "sigma_w2": np.full(rows, sigma_w2),
+                "sigma_u2": np.full(rows, sigma_u2),
+                "r_sigma": np.full(rows, sigma_u2 / sigma_w2),
+                "psi_u": np.full(rows, psi_u),
+                "N": N.astype(np.int64),
+                "run": run.astype(np.int64),
+                "error": errors.reshape(-1),
+                "gamma": np.tile(np.asarray(gamma, dtype=float), runs),
+                "bound": np.tile(bound_col, runs),
+            }
+        )
 
     def __len__(self) -> int:
         return len(self.columns["N"]) if self.columns else 0
@@ -242,7 +233,9 @@ def add_common_arguments(parser: argparse.ArgumentParser) -> None:
         "--n-jobs", type=_checked(_n_jobs, "n_jobs"), default=-1, help="worker processes (-1: all cores; 1: serial)"
     )
     parser.add_argument(
-        "--scheduler", type=_checked(_scheduler, "scheduler"), default=None,
+        "--scheduler",
+        type=_checked(_scheduler, "scheduler"),
+        default=None,
         help="Dask scheduler: 'local' (start a LocalCluster) or an address like tcp://host:8786 "
         "(default: joblib processes on this machine; needs encctl-gym[dask])",
     )
@@ -262,8 +255,16 @@ def ensure_out_dir(out: str | os.PathLike[str]) -> Path:
 def plot_panel(ax: Any, s: dict[str, Any], title: str, *, bound: bool = False) -> None:
     """One log-log panel: gray dots per run, mean (solid), gamma (dashed), bound (dotted)."""
     N, err = s["N"], s["errors"]
-    ax.loglog(np.broadcast_to(N, err.shape).ravel(), err.ravel(), ".", color="0.6", ms=2, alpha=0.5,
-              rasterized=True, label="error (each run)")
+    ax.loglog(
+        np.broadcast_to(N, err.shape).ravel(),
+        err.ravel(),
+        ".",
+        color="0.6",
+        ms=2,
+        alpha=0.5,
+        rasterized=True,
+        label="error (each run)",
+    )
     ax.loglog(N, s["mean"], "-", color="tab:blue", lw=1.6, label="mean error")
     ax.loglog(N, s["gamma"], "--", color="tab:orange", lw=1.6, label=r"$\gamma(N)$ (eq:sic2)")
     if bound:
@@ -282,8 +283,16 @@ def preset_spec(name: str) -> Any:
 
 
 def figure_table(
-    figure: str, number: int, panels: Sequence[tuple[str, Any]], config: GridConfig, *, seed: int, n_jobs: int,
-    scheduler: Any, progress: bool, bound: bool = False,
+    figure: str,
+    number: int,
+    panels: Sequence[tuple[str, Any]],
+    config: GridConfig,
+    *,
+    seed: int,
+    n_jobs: int,
+    scheduler: Any,
+    progress: bool,
+    bound: bool = False,
 ) -> Table:
     """The data of one of the paper's figures: for each ``(letter, spec)`` of ``panels``,
     ``config.runs`` Gaussian attacks identified on the grid of N (Definition def:error), with
@@ -297,10 +306,18 @@ def figure_table(
 
     grid = config.grid(4, 4)
     errors_all = sweep_gaussian_attack(
-        [spec for _, spec in panels], sample_sizes=grid, runs=config.runs, seed=figure_seed(seed, number),
-        n_jobs=n_jobs, scheduler=scheduler, progress=progress, desc=f"Figure {number}",
+        [spec for _, spec in panels],
+        sample_sizes=grid,
+        runs=config.runs,
+        seed=figure_seed(seed, number),
+        n_jobs=n_jobs,
+        scheduler=scheduler,
+        progress=progress,
+        desc=f"Figure {number}",
     )
-    return Table.concat([panel_table(figure, letter, spec, grid, errors, bound=bound) for (letter, spec), errors in zip(panels, errors_all)])
+    return Table.concat(
+        [panel_table(figure, letter, spec, grid, errors, bound=bound) for (letter, spec), errors in zip(panels, errors_all)]
+    )
 
 
 def panel_table(figure: str, panel: str, spec: Any, grid: np.ndarray, errors: np.ndarray, *, bound: bool = False) -> Table:
@@ -316,14 +333,29 @@ def panel_table(figure: str, panel: str, spec: Any, grid: np.ndarray, errors: np
     psi_u = float(np.trace(controllability_gramian(spec.A, spec.B))) / n
     extra = {"bound": np.asarray(input_upper_bound(grid, m, n, r_sigma))} if bound else {}
     return Table.from_errors(
-        figure=figure, panel=panel, grid=grid, errors=errors, gamma=np.asarray(gamma),
-        sigma_w2=spec.sigma_w2, sigma_u2=spec.sigma_u2, psi_u=psi_u, **extra,
+        figure=figure,
+        panel=panel,
+        grid=grid,
+        errors=errors,
+        gamma=np.asarray(gamma),
+        sigma_w2=spec.sigma_w2,
+        sigma_u2=spec.sigma_u2,
+        psi_u=psi_u,
+        **extra,
     )
 
 
 def panel_figure(
-    table: Table, panels: Sequence[str], shape: tuple[int, int], figsize: tuple[float, float], title: Callable[[dict[str, Any]], str],
-    suptitle: str, path: str | Path, *, bound: bool = False, rect: tuple[float, float, float, float] = (0, 0.05, 1, 0.95),
+    table: Table,
+    panels: Sequence[str],
+    shape: tuple[int, int],
+    figsize: tuple[float, float],
+    title: Callable[[dict[str, Any]], str],
+    suptitle: str,
+    path: str | Path,
+    *,
+    bound: bool = False,
+    rect: tuple[float, float, float, float] = (0, 0.05, 1, 0.95),
 ) -> Path:
     """A grid of :func:`plot_panel` panels, one per label of ``panels`` (``title(summary)`` each),
     with a shared legend below and ``suptitle`` above, saved as a PNG at ``path``."""
@@ -354,8 +386,9 @@ def run_figure(args: argparse.Namespace, compute: Callable[..., Table], plot: Ca
     """Compute a figure's table, save ``<stem>.csv`` and ``<stem>.png`` under ``args.out``, print the paths."""
     out = ensure_out_dir(args.out)
     t0 = time.perf_counter()
-    table = compute(grid_config(args.quick), seed=args.seed, n_jobs=args.n_jobs,
-                    scheduler=args.scheduler, progress=not args.no_progress)
+    table = compute(
+        grid_config(args.quick), seed=args.seed, n_jobs=args.n_jobs, scheduler=args.scheduler, progress=not args.no_progress
+    )
     elapsed = time.perf_counter() - t0
     csv_path = table.to_csv(out / f"{stem}.csv")
     png_path = plot(table, out / f"{stem}.png")
@@ -366,8 +399,7 @@ def run_figure(args: argparse.Namespace, compute: Callable[..., Table], plot: Ca
 
 
 def entry_point(
-    name: str, doc: str | None, add_arguments: Callable[[argparse.ArgumentParser], None],
-    run: Callable[[argparse.Namespace], int],
+    name: str, doc: str | None, add_arguments: Callable[[argparse.ArgumentParser], None], run: Callable[[argparse.Namespace], int]
 ) -> Callable[..., int]:
     """The ``main(argv=None) -> int`` of the experiment script ``experiments/<name>.py``
     (:func:`script_main` over its options and its run)."""

@@ -115,18 +115,15 @@ def format_table(rows: Sequence[tuple[str, SecurityDesign]]) -> str:
     """A plain-text table of ``N*``, ``lambda*``, ``k*`` next to the paper's values."""
     head = f"{'computation':32s} {'N*':>7s} {'lambda*':>8s} {'k*':>6s} {'gamma(N*)':>11s} {'log2 Omega(k*)':>15s}"
     lines = [head, "-" * len(head)]
-    lines.append(
-        f"{'paper':32s} {PAPER_VALUES['N_star']:7d} {PAPER_VALUES['lam_star']:8d} {PAPER_VALUES['k_star']:6d}"
-    )
+    lines.append(f"{'paper':32s} {PAPER_VALUES['N_star']:7d} {PAPER_VALUES['lam_star']:8d} {PAPER_VALUES['k_star']:6d}")
     for label, d in rows:
-        lines.append(
-            f"{label:32s} {d.N_star:7d} {d.lam_star:8d} {d.k_star:6d} {d.gamma_at_N_star:11.4e} {d.bit_security:15.2f}"
-        )
+        lines.append(f"{label:32s} {d.N_star:7d} {d.lam_star:8d} {d.k_star:6d} {d.gamma_at_N_star:11.4e} {d.bit_security:15.2f}")
     return "\n".join(lines)
 
 
-def format_cost_models(designs: Sequence[KeyLengthDesign], values: Sequence[KeyValue],
-                       dynamic: Sequence[tuple[int, float, int, float]]) -> str:
+def format_cost_models(
+    designs: Sequence[KeyLengthDesign], values: Sequence[KeyValue], dynamic: Sequence[tuple[int, float, int, float]]
+) -> str:
     """The three cost-model tables as text."""
     lines = [
         f"budget Upsilon tau_c = 2^{designs[0].budget_bits:.3f} operations",
@@ -140,12 +137,16 @@ def format_cost_models(designs: Sequence[KeyLengthDesign], values: Sequence[KeyV
             f"{d.first_key_bits:9.3f} {d.next_key_bits:9.3f} {d.dynamic_key_bits:9.3f} {nist:>7s}"
         )
     k = values[0].key_length
-    lines += ["", f"a {k}-bit key (no correction): {'model':16s} {'first key':>9s} {'next key':>9s} "
-                  f"{'log2 N in tau_c':>15s} {'secure':>6s}"]
+    lines += [
+        "",
+        f"a {k}-bit key (no correction): {'model':16s} {'first key':>9s} {'next key':>9s} "
+        f"{'log2 N in tau_c':>15s} {'secure':>6s}",
+    ]
     for v in values:
         n = "-inf" if v.log2_affordable_samples == -math.inf else f"{v.log2_affordable_samples:.3f}"
-        lines.append(f"{'':30s}{v.model:16s} {v.first_key_bits:9.3f} {v.next_key_bits:9.3f} {n:>15s} "
-                     f"{'yes' if v.secure else 'no':>6s}")
+        lines.append(
+            f"{'':30s}{v.model:16s} {v.first_key_bits:9.3f} {v.next_key_bits:9.3f} {n:>15s} {'yes' if v.secure else 'no':>6s}"
+        )
     lines += ["", f"{'N':>12s} {'log2 N':>7s} {'precomputation k*':>18s} {'dyn. keys there':>16s}"]
     for N, log_n, k_star, dyn in dynamic:
         lines.append(f"{N:12d} {log_n:7.3f} {k_star:18d} {dyn:16.3f}")
@@ -167,8 +168,20 @@ def run(args: argparse.Namespace) -> int:
     path = out / "design_example.csv"
     with path.open("w", newline="") as fh:
         w = csv.writer(fh)
-        fields: list[Any] = ["computation", "N_star", "lam_star", "k_star", "gamma_at_N_star", "bit_security",
-                             "tr_psi_u", "tr_psi_w", "r_sigma", "gamma_c", "tau_c", "upsilon"]
+        fields: list[Any] = [
+            "computation",
+            "N_star",
+            "lam_star",
+            "k_star",
+            "gamma_at_N_star",
+            "bit_security",
+            "tr_psi_u",
+            "tr_psi_w",
+            "r_sigma",
+            "gamma_c",
+            "tau_c",
+            "upsilon",
+        ]
         w.writerow(fields)
         w.writerow(["paper", PAPER_VALUES["N_star"], PAPER_VALUES["lam_star"], PAPER_VALUES["k_star"]] + [""] * 8)
         for label, d in rows:

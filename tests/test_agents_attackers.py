@@ -30,9 +30,7 @@ BASELINES = (GaussianAttacker, PRBSAttacker, ColoredGaussianAttacker)
 
 
 def all_attackers(params):
-    return [cls(params) for cls in BASELINES] + [
-        OptimalDesignAttacker(params, feedback=params.decipher_delay is not None)
-    ]
+    return [cls(params) for cls in BASELINES] + [OptimalDesignAttacker(params, feedback=params.decipher_delay is not None)]
 
 
 @pytest.mark.parametrize("delay", [0, 2, "end"])
@@ -246,4 +244,4 @@ def test_design_efficiency_of_the_gaussian_attack_and_the_oracle():
     # 16 x 2047 regressors: the realised designs come within a few per cent of their closed forms
     assert design_efficiency(g.covariance, opt) == pytest.approx(best.fun / tr_inv(0.0), abs=0.02)
     assert design_efficiency(o.covariance, opt) == pytest.approx(1.0, abs=0.02)
-    assert np.allclose(np.diag(g.covariance)[p.n:], p.sigma_u2, rtol=0.05)
+    assert np.allclose(np.diag(g.covariance)[p.n :], p.sigma_u2, rtol=0.05)

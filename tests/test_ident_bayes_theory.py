@@ -41,8 +41,10 @@ def test_error_given_gram_is_exact_for_a_fixed_design() -> None:
     V = np.concatenate([np.broadcast_to(D.T, (R, T, d)), np.swapaxes(Y, 1, 2)], axis=2)
     M = np.swapaxes(V, 1, 2) @ V
     m0 = np.full((n, d), 0.2)
-    for est in (BayesianLeastSquares(prior_mean=m0, prior_variance=0.4, noise_variance=sw2),
-                BayesianLeastSquares(prior_mean=m0, prior_variance=np.array([0.1, 1.0, 5.0, 0.5]), noise_variance=sw2)):
+    for est in (
+        BayesianLeastSquares(prior_mean=m0, prior_variance=0.4, noise_variance=sw2),
+        BayesianLeastSquares(prior_mean=m0, prior_variance=np.array([0.1, 1.0, 5.0, 0.5]), noise_variance=sw2),
+    ):
         err = estimate_errors(est.solve(M, T, n, m), A, B)
         _mc_close(err, bayesian_error_given_gram(A, B, G, prior_mean=m0, precision=est.precision(n, m), sigma_w2=sw2))
     err_ls = estimate_errors(OrdinaryLeastSquares().solve(M, T, n, m), A, B)
@@ -59,7 +61,9 @@ def test_error_given_gram_in_the_closed_loop_of_eq_system() -> None:
     sim = simulate_gaussian_attack(LinearPlant(A, B, sigma_w2=SMALL.sigma_w2), N=N, runs=R, sigma_u2=SMALL.sigma_u2, seed=1)
     err = estimate_errors(est.fit(sim.states, sim.inputs), A, B)
     Dt = np.concatenate([sim.states[:, :-1], sim.inputs[:, : N - 1]], axis=-1)
-    F = bayesian_error_given_gram(A, B, np.swapaxes(Dt, 1, 2) @ Dt, prior_mean=0.0, precision=est.precision(n, m), sigma_w2=SMALL.sigma_w2)
+    F = bayesian_error_given_gram(
+        A, B, np.swapaxes(Dt, 1, 2) @ Dt, prior_mean=0.0, precision=est.precision(n, m), sigma_w2=SMALL.sigma_w2
+    )
     assert abs(err.mean() / F.mean() - 1.0) < 0.03
 
 
@@ -111,7 +115,9 @@ def test_gamma_B_is_eq_sic_with_the_prior_as_extra_samples() -> None:
     np.testing.assert_allclose(gB, sic_from_traces(N + 3, tr_u, tr_w, m, n, 1.0, 0.1), rtol=1e-12)
     # one trace per row: the mean of the rows' complexities
     per_row = bayesian_sic_from_traces(10, tr_u, tr_w, m, n, 1.0, 0.1, tr_precision=[0.0, tr_lam])
-    assert per_row == pytest.approx(0.5 * (sic_from_traces(10, tr_u, tr_w, m, n, 1.0, 0.1) + sic_from_traces(13, tr_u, tr_w, m, n, 1.0, 0.1)))
+    assert per_row == pytest.approx(
+        0.5 * (sic_from_traces(10, tr_u, tr_w, m, n, 1.0, 0.1) + sic_from_traces(13, tr_u, tr_w, m, n, 1.0, 0.1))
+    )
     lam = BayesianLeastSquares(prior_variance=2.0, noise_variance=0.1).precision(n, m)
     by_plant = bayesian_sample_identifying_complexity(10, A, B, sigma_u2=1.0, sigma_w2=0.1, precision=lam)
     assert by_plant == pytest.approx(bayesian_sic_from_traces(10, tr_u, tr_w, m, n, 1.0, 0.1, tr_precision=d * 0.1 / 2.0))
@@ -166,7 +172,9 @@ def test_gamma_B_is_a_lower_bound_of_the_bayes_error_on_the_design_example(N: in
     lam = est.precision(nn, mm)
     tr_u = np.mean([np.trace(controllability_gramian(t[:, :nn], t[:, nn:])) for t in theta[:500]])
     tr_w = np.mean([np.trace(noise_gramian(t[:, :nn])) for t in theta[:500]])
-    gB = bayesian_sic_from_traces(N, tr_u, tr_w, mm, nn, PAPER.sigma_u2, PAPER.sigma_w2, PAPER.sigma_x2, tr_precision=np.trace(lam[0]))
+    gB = bayesian_sic_from_traces(
+        N, tr_u, tr_w, mm, nn, PAPER.sigma_u2, PAPER.sigma_w2, PAPER.sigma_x2, tr_precision=np.trace(lam[0])
+    )
     se = err.std(ddof=1) / np.sqrt(R)
     assert err.mean() - 4.0 * se > gB, (err.mean(), se, gB)
 

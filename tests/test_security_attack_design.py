@@ -52,7 +52,9 @@ def _scalar_min(a: float, b: float, su: float, sw: float, open_loop: bool) -> fl
     vals = value(q, c)
     i = np.unravel_index(np.argmin(vals), vals.shape)
     res = scipy.optimize.minimize(
-        lambda z: float(value(np.asarray(z[0]), np.asarray(z[1]))), [q[i], c[i]], method="Nelder-Mead",
+        lambda z: float(value(np.asarray(z[0]), np.asarray(z[1]))),
+        [q[i], c[i]],
+        method="Nelder-Mead",
         options={"xatol": 1e-12, "fatol": 1e-14, "maxiter": 5000},
     )
     return float(min(vals[i], res.fun))
@@ -96,8 +98,12 @@ def _stable_system(seed: int, n: int, m: int, rho: float) -> tuple[np.ndarray, n
 
 @settings(max_examples=12, deadline=None, derandomize=True)
 @given(
-    st.integers(0, 10**6), st.integers(1, 3), st.integers(1, 2), st.floats(0.05, 0.95),
-    st.floats(0.05, 20.0), st.floats(0.05, 20.0),
+    st.integers(0, 10**6),
+    st.integers(1, 3),
+    st.integers(1, 2),
+    st.floats(0.05, 0.95),
+    st.floats(0.05, 20.0),
+    st.floats(0.05, 20.0),
 )
 def test_ordering_constraints_and_policy(seed: int, n: int, m: int, rho: float, su: float, sw: float) -> None:
     A, B = _stable_system(seed, n, m, rho)
@@ -140,6 +146,7 @@ def test_ordering_constraints_and_policy(seed: int, n: int, m: int, rho: float, 
 def test_paper_example_values() -> None:
     A, B = np.sqrt(0.5) * np.eye(4), 0.5 * np.eye(4)
     cl = optimal_attack_design(A, B, sigma_u2=10, sigma_w2=0.1)
+
     # decoupled channels: each is the scalar problem a = sqrt(1/2), b = 1/2, q = 10:
     # p = sqrt(2) c + 5.2, minimise (p + 10) / (10 p - c^2) over c.
     def f(c):
@@ -205,7 +212,16 @@ def test_gamma_opt_and_errors() -> None:
     with pytest.raises(ParameterError, match="kind"):
         _robust(A, B, sigma_u2=1, sigma_w2=1, gamma_c=0.1, tau_c=1, upsilon=1, kind="psychic")
     with pytest.raises(ParameterError, match="gaussian"):
-        _robust(A, B, sigma_u2=1, sigma_w2=1, gamma_c=0.1, tau_c=1, upsilon=1, design=gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1))
+        _robust(
+            A,
+            B,
+            sigma_u2=1,
+            sigma_w2=1,
+            gamma_c=0.1,
+            tau_c=1,
+            upsilon=1,
+            design=gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1),
+        )
 
 
 def test_scs_fallback_solver_agrees() -> None:
@@ -276,8 +292,10 @@ def test_large_sdp_refused_before_solving_with_an_estimate() -> None:
     assert gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1).Sigma.shape == (60, 60)
 
 
-@pytest.mark.parametrize("bad,match", [(10**400, "<= 9007199254740992, got <integer of 1329 bits"), (2**53 + 1, "<= 9007199254740992"),
-                                       (1, ">= 2"), ("a", "'a'")])
+@pytest.mark.parametrize(
+    "bad,match",
+    [(10**400, "<= 9007199254740992, got <integer of 1329 bits"), (2**53 + 1, "<= 9007199254740992"), (1, ">= 2"), ("a", "'a'")],
+)
 def test_sdp_estimate_is_bounded(bad: object, match: str) -> None:
     with pytest.raises(ParameterError, match=f"^dimension must be .*{match}"):
         sdp_estimate(bad)  # type: ignore[arg-type]

@@ -106,8 +106,11 @@ def test_generic_k_star_by_hand() -> None:
 
 @settings(max_examples=25, deadline=None)
 @given(
-    st.sampled_from(list(DECIPHERING_MODELS)), st.integers(2, 10**7),
-    st.floats(1e3, 1e12), st.floats(1e9, 1e20), st.sampled_from([0.0, 5.0, GUILLEVIC_CORRECTION]),
+    st.sampled_from(list(DECIPHERING_MODELS)),
+    st.integers(2, 10**7),
+    st.floats(1e3, 1e12),
+    st.floats(1e9, 1e20),
+    st.sampled_from([0.0, 5.0, GUILLEVIC_CORRECTION]),
 )
 def test_k_star_is_the_smallest_secure_key(model: str, N_star: int, tau_c: float, upsilon: float, c: float) -> None:
     """Definition def:security itself: secure at k*, and (but for the paper model's integer lam) not at k* - 1."""
@@ -148,8 +151,9 @@ def test_nist_lookups() -> None:
     assert nist_strength(712) is None and nist_strength(1024) == 80 and nist_strength(3000) == 112
 
 
-
-@pytest.mark.parametrize("bad,match", [(math.nan, "finite"), (-1.0, ">= 0"), ("a", "'a'"), (None, "None"), (10**400, "1329 bits"), (2 + 1j, "2")])
+@pytest.mark.parametrize(
+    "bad,match", [(math.nan, "finite"), (-1.0, ">= 0"), ("a", "'a'"), (None, "None"), (10**400, "1329 bits"), (2 + 1j, "2")]
+)
 def test_nist_key_length_checks_its_strength(bad: object, match: str) -> None:
     with pytest.raises(ParameterError, match=f"^bits .*{match}"):
         nist_key_length(bad)  # type: ignore[arg-type]
@@ -315,7 +319,9 @@ def test_what_a_712_bit_key_is_worth() -> None:
     assert generic.secure and generic.affordable_samples == 0 and generic.first_key_bits > 355
 
 
-@pytest.mark.parametrize("year,match", [(-1, ">= 0"), (10**400, "<= 9999, got <integer of 1329 bits"), (2015.5, "2015.5"), ("2015", "'2015'")])
+@pytest.mark.parametrize(
+    "year,match", [(-1, ">= 0"), (10**400, "<= 9999, got <integer of 1329 bits"), (2015.5, "2015.5"), ("2015", "'2015'")]
+)
 def test_record_years_are_bounded(tmp_path: Path, year: object, match: str) -> None:
     def mutate(d: dict) -> None:
         d["records"][0]["year"] = year

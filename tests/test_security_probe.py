@@ -6,8 +6,9 @@ kill or another exception. The whole probe is ``tests/test_probe.py``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import pytest
@@ -40,6 +41,7 @@ def _cases(tmp: Path) -> dict[str, Callable[[], Any]]:
             if rc != 2:
                 raise AssertionError(f"exit code {rc}")
             raise ParameterError("exit code 2")  # reported as a package error
+
         return call
 
     n = 200
@@ -52,7 +54,9 @@ def _cases(tmp: Path) -> dict[str, Callable[[], Any]]:
         "key_length = 1e308": lambda: bit_security_of_key_length(int(1e308)),
         "minimum_key_length(1e12)": lambda: minimum_key_length(1e12),
         "pow2(1e9)": lambda: pow2(1e9),
-        "generic design for Upsilon tau_c = 1e600": lambda: design_key_length(2, ThreatModel(tau_c=1e300, upsilon=1e300, cost_model="generic")),
+        "generic design for Upsilon tau_c = 1e600": lambda: design_key_length(
+            2, ThreatModel(tau_c=1e300, upsilon=1e300, cost_model="generic")
+        ),
         "SDP for n + m = 400": lambda: optimal_attack_design(0.5 * np.eye(200), np.eye(200), sigma_u2=1, sigma_w2=1),
         "YAML alias bomb of 10^9 nodes": lambda: load_plant_file(bomb),
         "duration of a million digits": lambda: parse_duration("9" * 10**6),
@@ -62,9 +66,17 @@ def _cases(tmp: Path) -> dict[str, Callable[[], Any]]:
 
 
 CASES = [
-    "max_affordable_samples(1.0, 10**12, 1.0)", "lambda = 2.0**53", "exact time at lambda 1e12", "key_length = 1e308",
-    "minimum_key_length(1e12)", "pow2(1e9)", "generic design for Upsilon tau_c = 1e600", "SDP for n + m = 400",
-    "YAML alias bomb of 10^9 nodes", "duration of a million digits", "design CLI on the alias bomb",
+    "max_affordable_samples(1.0, 10**12, 1.0)",
+    "lambda = 2.0**53",
+    "exact time at lambda 1e12",
+    "key_length = 1e308",
+    "minimum_key_length(1e12)",
+    "pow2(1e9)",
+    "generic design for Upsilon tau_c = 1e600",
+    "SDP for n + m = 400",
+    "YAML alias bomb of 10^9 nodes",
+    "duration of a million digits",
+    "design CLI on the alias bomb",
     "design CLI at tau_c = 1e-300",
 ]
 

@@ -30,7 +30,9 @@ def _ratio(r: dict[str, Any], which: str) -> str:
 def _error_cell(r: dict[str, Any]) -> str:
     if r.get("mean_status", "exists") == "exists":
         return f"{r['mean_error_at_horizon']:.3g} [{r['ci95_low_at_horizon']:.3g}, {r['ci95_high_at_horizon']:.3g}]"
-    return f"median {r['median_at_horizon']:.3g} [10-90 %: {r['q10_at_horizon']:.3g}, {r['q90_at_horizon']:.3g}]; {r['mean_flag']}"
+    return (
+        f"median {r['median_at_horizon']:.3g} [10-90 %: {r['q10_at_horizon']:.3g}, {r['q90_at_horizon']:.3g}]; {r['mean_flag']}"
+    )
 
 
 def comparison_table(result: Result) -> str:
@@ -57,8 +59,10 @@ def comparison_table(result: Result) -> str:
             f"{r['lambda_needed']} | {r['k_needed']} |"
         )
     for r in result.bounds:
-        lines.append(f"| {r['system']} | {r['delay']} | *{r['attacker']}* | | | | | | | {r['rate_over_gaussian_design']:.3f} | "
-                     f"{r['N_to_gamma_c']} | {r['lambda_needed']} | {r['k_needed']} |")
+        lines.append(
+            f"| {r['system']} | {r['delay']} | *{r['attacker']}* | | | | | | | {r['rate_over_gaussian_design']:.3f} | "
+            f"{r['N_to_gamma_c']} | {r['lambda_needed']} | {r['k_needed']} |"
+        )
     return "\n".join(lines)
 
 
@@ -70,10 +74,16 @@ def design_efficiencies(result: Result) -> str:
 
     out = []
     for s in result.settings:
-        parts = [f"{c.attacker} {design_efficiency(c.covariance, s.design):.4f}" for c in result.curves[s.key] if c.covariance is not None]
+        parts = [
+            f"{c.attacker} {design_efficiency(c.covariance, s.design):.4f}"
+            for c in result.curves[s.key]
+            if c.covariance is not None
+        ]
         if parts:
-            out.append(f"{s.system}, delay {s.delay}, N = {s.params.horizon}: design efficiency tr(Sigma_opt^-1) / tr(Sigma^-1) "
-                       f"({s.design.kind} optimum): " + ", ".join(parts) + ".")
+            out.append(
+                f"{s.system}, delay {s.delay}, N = {s.params.horizon}: design efficiency tr(Sigma_opt^-1) / tr(Sigma^-1) "
+                f"({s.design.kind} optimum): " + ", ".join(parts) + "."
+            )
     return "\n".join(out)
 
 
@@ -107,12 +117,16 @@ def findings(result: Result) -> str:
                 continue  # the energy is recorded from N = 2 (n + m) + 1 on; no extrapolation
             tenth = float(np.interp(0.1 * s.params.horizon, c.along_N, c.along_energy))
             if abs(tenth - 0.1) > 0.1:
-                out.append(f"{c.attacker} ({s.system}, delay {s.delay}) paces its energy unevenly: {100 * tenth:.0f}% of the "
-                           "attack's budget in its first 10% of samples.")
+                out.append(
+                    f"{c.attacker} ({s.system}, delay {s.delay}) paces its energy unevenly: {100 * tenth:.0f}% of the "
+                    "attack's budget in its first 10% of samples."
+                )
     return " ".join(out)
 
 
-def summary_markdown(result: Result, *, command: str, plots: Sequence[Path], title: str = "Attackers against the bounds (`encctl-gym compare`)") -> str:
+def summary_markdown(
+    result: Result, *, command: str, plots: Sequence[Path], title: str = "Attackers against the bounds (`encctl-gym compare`)"
+) -> str:
     """The table and the finding in words, with the command that reproduces them; images are
     linked by file name (the PNGs sit beside ``summary.md``)."""
     lines = [f"## {title}", ""]
@@ -123,17 +137,23 @@ def summary_markdown(result: Result, *, command: str, plots: Sequence[Path], tit
     lines.append("")
     lines.append(comparison_table(result))
     lines.append("")
-    lines.append(f"Environment seeds {result.seed}, {result.seed + 1}, ... for every attacker (paired). "
-                 "N marked * is set by the evaluation (a cap or an exact length), not by the system's tau_c budget. " + findings(result))
+    lines.append(
+        f"Environment seeds {result.seed}, {result.seed + 1}, ... for every attacker (paired). "
+        "N marked * is set by the evaluation (a cap or an exact length), not by the system's tau_c budget. " + findings(result)
+    )
     eff = design_efficiencies(result)
     if eff:
         lines.append("")
         lines.append(eff.replace("\n", "\n\n"))
     if result.elgamal:
-        same = sum(abs(r["error_elgamal"] - r["error_ideal_same_seed"]) <= 1e-9 * r["error_ideal_same_seed"] for r in result.elgamal)
+        same = sum(
+            abs(r["error_elgamal"] - r["error_ideal_same_seed"]) <= 1e-9 * r["error_ideal_same_seed"] for r in result.elgamal
+        )
         lines.append("")
         attackers = len({(r["system"], r["delay"], r["attacker"]) for r in result.elgamal})
-        lines.append(f"Through real ElGamal ciphertexts ({result.elgamal[0]['key_length']}-bit key, N = {result.elgamal[0]['N']}): "
-                     f"{len(result.elgamal)} episodes over {attackers} attacker settings; {same} of them give the same final "
-                     "error as the ideal backend on the same seeds (elgamal.csv).")
+        lines.append(
+            f"Through real ElGamal ciphertexts ({result.elgamal[0]['key_length']}-bit key, N = {result.elgamal[0]['N']}): "
+            f"{len(result.elgamal)} episodes over {attackers} attacker settings; {same} of them give the same final "
+            "error as the ideal backend on the same seeds (elgamal.csv)."
+        )
     return "\n".join(lines) + "\n"
