@@ -51,6 +51,7 @@ from .config import AttackParams
 from .helper import HelperThread
 from .layout import ObservationLayout, info_dict
 from .rewards import REWARDS
+from .steps import EpisodeArrays, KernelConstants, StepStrategy, choose_step
 
 __all__ = ["EpisodeCore", "EpisodeSchedule", "attack_design_for", "episode_bytes", "check_episode_memory"]
 
@@ -232,27 +233,23 @@ class EpisodeCore:
         # the same tables as Python floats, for the per-step info scalars
         self._gamma_list, self._time_list = self.gamma_table.tolist(), self.time_table.tolist()
         self._gamma_opt_list = self.gamma_opt_table.tolist()
-        # per-copy data: collected (deciphered) states and applied inputs
-        # time-major: the data of all copies for one period are contiguous
-        self.X = np.zeros((N, K, n))  # collected (deciphered) states x_0 .. x_{N-1}
-        self.U = np.zeros((N, K, m))  # applied inputs u_0 .. u_{N-1}
+        # the per-copy arrays the kernels write, by name (steps.EpisodeArrays): collected
+        # (deciphered) states X and applied inputs U, time-major (the data of all copies for one
+        # period are contiguous); the recursive least squares [P | Theta_hat^T] in Q, P by its
+        # upper triangle, copies innermost: entry (a, b) of every copy is row a (d + n) + b
+        s = self.state = EpisodeArrays.allocate(K, n, m, N, p.input_history)
+        self.X, self.U, self.Q, self.eps = s.X, s.U, s.Q, s.eps
+        s.eps[:] = self._eps0
         # regressor Gram matrix G of the delivered data and cross term C = sum z x_next^T, kept
         # as [G | C] with the copies innermost (see _kernels); G and C are views of it, (K, d, .)
         self._GC = np.zeros((self.d * (self.d + n), K))
         gc = self._GC.reshape(self.d, self.d + n, K).transpose(2, 0, 1)
         self.G, self.C = gc[:, :, : self.d], gc[:, :, self.d :]
         self._gram_scratch = np.zeros((self.d + n, K))  # add_gram's, apart from the step's (the helper runs it)
-        # recursive least squares [P | Theta_hat^T], P by its upper triangle; copies innermost:
-        # entry (a, b) of every copy is row a (d + n) + b (see _kernels)
-        self.Q = np.zeros((self.d * (self.d + n), K))
         self.ready = np.zeros(K, dtype=bool)  # recursion started (well-conditioned Gram matrix)
         self._gram_upto = 1  # G and C hold the columns j < _gram_upto (the fused step lets them lag)
         self._since_refresh = 0
-        self.x = np.zeros((K, n))
-        self.hist = np.zeros((K, p.input_history * m))
         self._dims = kern.dims(n, m, p.input_history * m)  # the sizes, as the kernels take them
-        self.energy = np.zeros(K)
-        self.eps = np.full(K, self._eps0)
         self.reward = REWARDS[p.reward](p, K)
         # the attacker's estimator: least squares runs in the compiled kernels; any other is
         # updated column by column (encctl_gym.ident)
@@ -267,31 +264,16 @@ class EpisodeCore:
         self._act = np.zeros((K, m))  # the actions of the current step, float64
         self._obs_shape = (K, self.layout.dim)
         self._obs_at = self.layout.offsets
-        self._reward_out = np.zeros(K)
-        self._step_fused = kern.step_fused_parallel if parallel else kern.step_fused
-        self._budget = p.energy_budget
         self._all_ready = False
-        # what the compiled kernels take (see _kernels): built once, the arrays are never rebound
-        self._consts = (self._A, self._B, np.ascontiguousarray(self._theta_true.T), float(self._c), p.u_max, self._budget)
-        self._arrays = (
-            self.x,
-            self.energy,
-            self.X,
-            self.U,
-            self.hist,
-            self.Q,
-            self.eps,
-            self._reward_out,
-            np.zeros((K, m)),
-            np.zeros((K, m), dtype=np.int64),
-            np.zeros((K, n), dtype=np.int64),
-            np.zeros((2 * self.d + n + 2, K)),
+        self.consts = KernelConstants(
+            self._A, self._B, np.ascontiguousarray(self._theta_true.T), float(self._c), p.u_max, p.energy_budget
         )
-        self._a = self._arrays[8]  # the energy-limited input of the current step (a_buf)
-        # the ideal backend's steady-state step is one compiled call, on the loop's arithmetic
+        # what the compiled kernels take (see _kernels): built once, the arrays are never rebound
+        self._consts, self._arrays = self.consts.kernel_tuple(), s.kernel_tuple()
+        # how a step runs, chosen once: the ideal backend's steady state is one compiled call
         q = loop.quantization
-        self._quant = tuple(q) if q is not None else None
-        self._fused = self._quant is not None and self.reward.fused and self.estimator is None
+        fused = q is not None and self.reward.fused and self.estimator is None
+        self.stepper: StepStrategy = choose_step(self, q, fused, parallel)
         C = sch.chunk
         self._noise_draws = np.zeros((K, C, n))  # each copy's chunk, as its generator draws it
         self._noise = np.zeros((C, K, n))  # period-major, like X: one period's noise is contiguous
@@ -408,13 +390,13 @@ class EpisodeCore:
         self._obs_out = None
         for i, g in enumerate(rngs):
             draw = g.standard_normal(self.n) * self._sx
-            self.x[i] = draw if x0_arr is None else x0_arr[i]
+            self.state.x[i] = draw if x0_arr is None else x0_arr[i]
         self._noise_pos = self.schedule.chunk
         self._noise_ahead = False
         self._chunks = 0
         self.loop.start_episode()
         for _ in range(self.p.warmup_steps):  # normal operation under the encrypted controller (eq:ec)
-            kern.plant_step(self._dims, self.x, self.loop.control(self.x), self._draw_noise(), self._A, self._B)
+            kern.plant_step(self._dims, self.state.x, self.loop.control(self.state.x), self._draw_noise(), self._A, self._B)
         self.X[:] = 0.0
         self.U[:] = 0.0
         self._GC[:] = 0.0
@@ -422,8 +404,8 @@ class EpisodeCore:
         self._gram_upto = 1
         self._all_ready = False
         self._since_refresh = 0
-        self.hist[:] = 0.0
-        self.energy[:] = 0.0
+        self.state.hist[:] = 0.0
+        self.state.energy[:] = 0.0
         self.eps[:] = self._eps0
         if self.estimator is not None:
             self.estimator.start(self.K, self.n, self.m)
@@ -459,7 +441,7 @@ class EpisodeCore:
         sample whose break ends past ``tau_c`` came too late: it is not counted, and the episode
         has :attr:`expired`.
         """
-        self.X[self.collected] = self.loop.collect_state(self.x)
+        self.X[self.collected] = self.loop.collect_state(self.state.x)
         if self._measured:
             spent = self.loop.deciphering_seconds
             if spent > self.p.tau_c:
@@ -493,7 +475,7 @@ class EpisodeCore:
 
     def _overflow(self) -> None:
         raise EncodingOverflowError(
-            f"state {self.x.tolist()} leaves the encoder's declared range |x| <= {self.p.x_bound} (x_bound)"
+            f"state {self.state.x.tolist()} leaves the encoder's declared range |x| <= {self.p.x_bound} (x_bound)"
         )
 
     def _target(self, collected: int) -> int:
@@ -518,7 +500,7 @@ class EpisodeCore:
             self._sync_gram(first)
             kern.add_columns(self._dims, self.X, self.U, first, target, self._GC, self.Q, self.ready)
             self._gram_upto = target
-            kern.estimation_error(self._dims, self.Q, self._consts[2], self._consts[3], self.ready, self.eps)
+            kern.estimation_error(self._dims, self.Q, self.consts.theta_true_T, self.consts.c, self.ready, self.eps)
             self._since_refresh += target - first
             self.delivered = target
             self.history.append((target, float(self.eps[0])))
@@ -541,8 +523,8 @@ class EpisodeCore:
             if stale.any():
                 rows = np.nonzero(stale)[0]
                 theta_hat_T = self._refresh(rows)
-                self.eps[rows] = ((theta_hat_T - self._consts[2]) ** 2).sum(axis=(1, 2)) / self._c
-            kern.estimation_error(self._dims, self.Q, self._consts[2], self._consts[3], self.ready & ~stale, self.eps)
+                self.eps[rows] = ((theta_hat_T - self.consts.theta_true_T) ** 2).sum(axis=(1, 2)) / self._c
+            kern.estimation_error(self._dims, self.Q, self.consts.theta_true_T, self.consts.c, self.ready & ~stale, self.eps)
             self._all_ready = bool(self.ready.all())
         self.history.append((self.delivered, float(self.eps[0])))
         return True
@@ -625,73 +607,20 @@ class EpisodeCore:
             raise ParameterError("step() called before reset(); call reset() first")
         if self.done:
             raise ParameterError("step() called after the episode ended; call reset() first")
-        p = self.p
         act = self.check_actions(action)
         w = self._draw_noise()
-        ended = self.collected >= p.horizon or self.expired
-        if self._fused and self._all_ready and not ended:
-            # steady state of the ideal backend: period, delivery, recursive LS, error, reward,
-            # observation and info in one compiled call
-            first = max(self.delivered, 1)
-            target = self._target(self.collected + 1)
-            if self._since_refresh + target - first < self.schedule.refresh:
-                new = target > self.delivered
-                obs = np.empty(self._obs_shape, dtype=np.float32)
-                N, collected = (target if new else self.delivered), self.collected + 1
-                status = self._step_fused(
-                    self._dims,
-                    self._consts,
-                    self._arrays,
-                    self._quant,
-                    act,
-                    w,
-                    self.collected - 1,
-                    self.collected,
-                    first,
-                    target,
-                    obs,
-                    self._obs_at,
-                    N - 1,
-                    float(new),
-                    float(self._time_frac[collected]),
-                )
-                if status == kern.STATE_OVERFLOW:
-                    self._overflow()
-                self.collected += 1
-                self.new = new
-                if new:
-                    self._since_refresh += target - first
-                    self.delivered = target
-                    self.history.append((target, float(self.eps[0])))
-                    if self.helper is not None and target - self._gram_upto >= self.schedule.gram_batch:
-                        self._gram_behind(target)
-                self._obs_out = obs
-                return self._reward_out.copy(), False, False
-        self._obs_out = None
-        if self._quant is not None:  # ideal backend: the period in one compiled call
-            status = kern.step_ideal(
-                self._dims, self._consts, self._arrays, self._quant, act, w, self.collected - 1, -1 if ended else self.collected
-            )
-            if status == kern.STATE_OVERFLOW:
-                self._overflow()
-            if not ended:
-                self.collected += 1
-        else:
-            kern.energy_budget(self._dims, act, p.u_max, self.energy, self._budget, self._a)
-            u = self.loop.inject(self._a)
-            self.U[self.collected - 1] = u
-            kern.plant_step(self._dims, self.x, u, w, self._A, self._B)
-            if p.input_history:
-                kern.shift_history(self._dims, self.hist, act)
-            self.loop.tick()
-            if not ended:
-                self._collect()
-                ended = self.expired  # the measured clock passed tau_c: the attack is over now
+        ended = self.collected >= self.p.horizon or self.expired
+        return self.stepper.step(act, w, ended)
+
+    def finish_step(self, ended: bool) -> tuple[np.ndarray, bool, bool]:
+        """What follows the period of a step on every path: the delivery (all paid samples if
+        the attack has ``ended``), the estimate and the reward. Returns (rewards (K,),
+        terminated, truncated)."""
         self.reward.begin(self)
         self.new = self._deliver(final=ended)
         reward = self.reward.end(self)
         self.done = ended
-        out_of_time = p.budget_limited or self.expired
+        out_of_time = self.p.budget_limited or self.expired
         return reward, ended and out_of_time, ended and not out_of_time
 
     # ----------------------------------------------------------------- observation and info
@@ -710,10 +639,10 @@ class EpisodeCore:
                 self.U,
                 self.delivered - 1,
                 float(self.new),
-                self.hist,
+                self.state.hist,
                 float(self._time_frac[self.collected]),
-                self.energy,
-                self._budget,
+                self.state.energy,
+                self.consts.budget,
             )
         return obs
 
@@ -731,7 +660,7 @@ class EpisodeCore:
 
     def info_arrays(self) -> dict[str, np.ndarray]:
         """Info of every copy as new arrays of shape (K,) (:func:`~encctl_gym.envs.layout.info_dict`)."""
-        return info_dict(self.eps.copy(), self.energy.copy(), self._shared_info(), self.has_gamma_opt, self.K)
+        return info_dict(self.eps.copy(), self.state.energy.copy(), self._shared_info(), self.has_gamma_opt, self.K)
 
     def info(self) -> dict[str, Any]:
         """Info of copy 0 as Python scalars (single environment).
@@ -739,4 +668,4 @@ class EpisodeCore:
         ``epsilon`` is the error (Definition def:error) of the attacker's current estimate: the
         least squares estimate once ``n + m`` columns are delivered, ``[A B] = 0`` before.
         """
-        return info_dict(float(self.eps[0]), float(self.energy[0]), self._shared_info(), self.has_gamma_opt)
+        return info_dict(float(self.eps[0]), float(self.state.energy[0]), self._shared_info(), self.has_gamma_opt)
