@@ -13,6 +13,9 @@ import encctl_gym  # noqa: F401  (registers the environment)
 from encctl_gym.envs import ENV_ID
 from encctl_gym.envs.episode import EpisodeSchedule
 from encctl_gym.envs.steps import CompiledIdealStep, FusedStep, GenericStep
+from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
+from encctl_gym.errors import ParameterError
+from encctl_gym.loop import DefenderAction, FixedDefender, loop_group
 
 BASE = {"preset": "paper-example", "gamma_opt": False}
 
@@ -89,3 +92,155 @@ def test_every_step_strategy_gives_the_same_numbers(overrides):
 def test_the_elgamal_backend_runs_the_generic_step():
     env = gym.make(ENV_ID, config={**BASE, "max_samples": 12, "crypto": "elgamal", "key_length": 64})
     assert type(env.unwrapped.episode.stepper) is GenericStep
+
+
+# ----------------------------------------------------------------------------- defenders
+class NoisyActuator:
+    """A toy defence written here, outside the package: the plant side adds Gaussian noise of
+    standard deviation ``scale`` to its actuator input, drawn from the defender's own streams,
+    and records what it added."""
+
+    name = "noisy-actuator"
+
+    def __init__(self, scale: float) -> None:
+        self.scale = scale
+        self.added: list[np.ndarray] = []
+
+    def group(self, params):
+        return loop_group(params.key_length)
+
+    def reset(self, K, n, m, rngs):
+        self.rngs, self.m, self.added = rngs, m, []
+
+    def act(self, view):
+        v = np.stack([g.standard_normal(self.m) for g in self.rngs]) * self.scale
+        self.added.append(v)
+        return DefenderAction(input_noise=v)
+
+
+class InputWatchdog:
+    """A toy detector: the plant side stops the attack once a decoded input exceeds ``limit``."""
+
+    name = "watchdog"
+
+    def __init__(self, limit: float) -> None:
+        self.limit = limit
+        self.steps_seen: list[int] = []
+
+    def group(self, params):
+        return loop_group(params.key_length)
+
+    def reset(self, K, n, m, rngs):
+        self.steps_seen = []
+
+    def act(self, view):
+        self.steps_seen.append(view.step)
+        return DefenderAction(end=bool(np.abs(view.last_input).max() > self.limit))
+
+
+SMALL = {**BASE, "max_samples": 60}
+
+
+def test_a_defence_from_outside_the_package_adds_its_noise_to_the_applied_input():
+    """The plant's state moves by exactly B v more than without the defence; the attacker's own
+    record of its inputs is what it forged, unchanged."""
+    x0, noise = np.full(4, 0.3), np.random.default_rng(1).normal(size=(60, 4))
+    fixed = gym.make(ENV_ID, config=SMALL)
+    defence = NoisyActuator(0.5)
+    noisy = gym.make(ENV_ID, config={**SMALL, "defender": defence})
+    for env in (fixed, noisy):
+        env.reset(seed=0, options={"x0": x0, "noise": noise})
+    a = np.full(fixed.action_space.shape, 0.25, dtype=np.float32)
+    fixed.step(a)
+    noisy.step(a)
+    B = fixed.unwrapped.params.B
+    shift = noisy.unwrapped.episode.state.x - fixed.unwrapped.episode.state.x
+    assert len(defence.added) == 1 and np.allclose(shift[0], B @ defence.added[0][0], rtol=0, atol=1e-12)
+    assert np.abs(shift).max() > 0.01
+    assert np.array_equal(noisy.unwrapped.episode.U[0], fixed.unwrapped.episode.U[0])
+    for _ in range(40):  # and on through the fused steady state: the defence keeps acting
+        fixed.step(a)
+        noisy.step(a)
+    assert len(defence.added) == 41
+    assert not np.array_equal(noisy.unwrapped.episode.X[:41], fixed.unwrapped.episode.X[:41])
+
+
+def test_a_defender_that_draws_but_adds_nothing_leaves_the_trajectory_bit_for_bit():
+    """Its draws come from streams of its own: the plant's draws are those of the fixed defender."""
+    want = rollout(gym.make(ENV_ID, config=SMALL), 60)
+    got = rollout(gym.make(ENV_ID, config={**SMALL, "defender": NoisyActuator(0.0)}), 60)
+    for g, w in zip(got, want, strict=True):
+        assert np.array_equal(g[0], w[0]) and all(a == b for a, b in zip(g[1:], w[1:]))
+
+
+def test_the_default_defender_is_the_fixed_one_and_changes_nothing():
+    want = rollout(gym.make(ENV_ID, config=SMALL), 60)
+    for spec in ("fixed", FixedDefender()):
+        env = gym.make(ENV_ID, config={**SMALL, "defender": spec})
+        assert isinstance(env.unwrapped.episode.defender, FixedDefender)
+        for g, w in zip(rollout(env, 60), want, strict=True):
+            assert np.array_equal(g[0], w[0]) and all(a == b for a, b in zip(g[1:], w[1:]))
+
+
+def test_a_detector_from_outside_the_package_ends_the_episode():
+    watchdog = InputWatchdog(limit=0.5)
+    env = gym.make(ENV_ID, config={**SMALL, "defender": watchdog})
+    env.reset(seed=0)
+    u_max = env.unwrapped.params.u_max
+    small = np.full(env.action_space.shape, 0.1 / u_max, dtype=np.float32)
+    for _ in range(5):
+        assert env.step(small)[2:4] == (False, False)
+    env.step(np.full(env.action_space.shape, 0.9, dtype=np.float32))  # decoded input ~0.9 u_max > 0.5
+    _, _, terminated, truncated, info = env.step(small)  # the plant side sees it now and stops
+    assert terminated and not truncated and watchdog.steps_seen == list(range(7))
+    assert info["samples_delivered"] == info["samples_collected"] == 7
+    with pytest.raises(ParameterError, match="after the episode ended"):
+        env.step(small)
+
+
+def test_a_defender_runs_in_the_vector_env_with_a_stream_per_copy():
+    defence = NoisyActuator(0.2)
+    venv = EncryptedLTIAttackVectorEnv(num_envs=3, config={**SMALL, "defender": defence})
+    venv.reset(seed=4)
+    venv.step(np.zeros((3, 4), dtype=np.float32))
+    v = defence.added[0]
+    assert v.shape == (3, 4) and len({tuple(row) for row in v}) == 3
+    venv.close()
+
+
+def test_the_defender_picks_the_loop_group():
+    class BiggerGroup(FixedDefender):
+        def group(self, params):
+            return loop_group(128)
+
+    env = gym.make(ENV_ID, config={**BASE, "max_samples": 12, "crypto": "elgamal", "key_length": 64, "defender": BiggerGroup()})
+    assert env.unwrapped.loop.group.bits == 128
+
+
+@pytest.mark.parametrize(
+    "spec, text",
+    [("nobody", "unknown defender 'nobody'"), (object(), "defender must be a name"), (FixedDefender, "defender must")],
+)
+def test_a_bad_defender_is_refused_at_construction(spec, text):
+    with pytest.raises(ParameterError, match=text):
+        gym.make(ENV_ID, config={**SMALL, "defender": spec})
+
+
+@pytest.mark.parametrize(
+    "decision, text",
+    [
+        ("noise", "must return None or a DefenderAction"),
+        (DefenderAction(input_noise=np.zeros(3)), r"shape \(4,\)"),
+        (DefenderAction(input_noise=[np.nan] * 4), "finite"),
+        (DefenderAction(end=1), "end must be a bool"),
+    ],
+)
+def test_a_bad_defender_decision_is_refused_naming_it(decision, text):
+    class Bad(FixedDefender):
+        def act(self, view):
+            return decision
+
+    env = gym.make(ENV_ID, config={**SMALL, "defender": Bad()})
+    env.reset(seed=0)
+    with pytest.raises(ParameterError, match=text):
+        env.step(np.zeros(env.action_space.shape, dtype=np.float32))

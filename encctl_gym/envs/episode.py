@@ -45,6 +45,7 @@ from ..errors import EncodingOverflowError, ParameterError, ShapeError
 from ..ident.ordinary import OrdinaryLeastSquares
 from ..ident.registry import make_estimator
 from ..loop import LoopBackend
+from ..loop.defender import DefenderPolicy, DefenderStreams, PlantView, check_defender_action, make_defender
 from ..resources import check_memory
 from . import _kernels as kern
 from .config import AttackParams
@@ -178,6 +179,9 @@ class EpisodeCore:
     memory_limit : int, optional
         Refuse, before allocating anything, an episode whose :func:`episode_bytes` exceed this
         many bytes (default :data:`encctl_gym.resources.MEMORY_LIMIT`).
+    defender : DefenderPolicy, optional
+        The plant side's policy (:mod:`encctl_gym.loop.defender`), called before every attack
+        step; default: the one ``params.defender`` names (the fixed defender unless configured).
 
     Public state (for training, evaluation and tests; privileged where it involves the true
     plant or undelivered data): :attr:`done`, :attr:`collected`, :attr:`delivered`,
@@ -200,6 +204,7 @@ class EpisodeCore:
         helper: HelperThread | None = None,
         schedule: EpisodeSchedule | None = None,
         memory_limit: int | None = None,
+        defender: DefenderPolicy | None = None,
     ) -> None:
         p = self.p = params
         self.loop = loop
@@ -274,6 +279,10 @@ class EpisodeCore:
         q = loop.quantization
         fused = q is not None and self.reward.fused and self.estimator is None
         self.stepper: StepStrategy = choose_step(self, q, fused, parallel)
+        # the other party: the plant side's decisions, each step, on what the plant knows
+        self.defender = make_defender(p.defender) if defender is None else make_defender(defender)
+        self.plant_view = PlantView(s.x, s.U)
+        self.stopped = False  # the defender ended the attack
         C = sch.chunk
         self._noise_draws = np.zeros((K, C, n))  # each copy's chunk, as its generator draws it
         self._noise = np.zeros((C, K, n))  # period-major, like X: one period's noise is contiguous
@@ -412,8 +421,10 @@ class EpisodeCore:
         self.reward.reset(self)
         self.collected = self.delivered = 0
         self.expired = False
+        self.stopped = False
         self.done = False
         self.history = []
+        self.defender.reset(self.K, self.n, self.m, DefenderStreams(rngs))
         self._collect()
         self.new = self._deliver(final=False)
         return self.observation()
@@ -610,6 +621,15 @@ class EpisodeCore:
         act = self.check_actions(action)
         w = self._draw_noise()
         ended = self.collected >= self.p.horizon or self.expired
+        view = self.plant_view
+        view.step = self.collected - 1
+        decision = self.defender.act(view)
+        if decision is not None:
+            noise, stop = check_defender_action(decision, self.K, self.m)
+            if noise is not None:  # u + v applied, u recorded: to the attacker, process noise B v
+                w = w + noise @ self.consts.B.T
+            if stop:
+                self.stopped = ended = True
         return self.stepper.step(act, w, ended)
 
     def finish_step(self, ended: bool) -> tuple[np.ndarray, bool, bool]:
@@ -620,7 +640,7 @@ class EpisodeCore:
         self.new = self._deliver(final=ended)
         reward = self.reward.end(self)
         self.done = ended
-        out_of_time = self.p.budget_limited or self.expired
+        out_of_time = self.p.budget_limited or self.expired or self.stopped
         return reward, ended and out_of_time, ended and not out_of_time
 
     # ----------------------------------------------------------------- observation and info
