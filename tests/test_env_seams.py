@@ -15,6 +15,8 @@ from encctl_gym.envs.episode import EpisodeSchedule
 from encctl_gym.envs.steps import CompiledIdealStep, FusedStep, GenericStep
 from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
 from encctl_gym.errors import ParameterError
+from encctl_gym.ident import make_estimator
+from encctl_gym.ident.compiled import RecursiveLeastSquaresKernels
 from encctl_gym.loop import DefenderAction, FixedDefender, loop_group
 
 BASE = {"preset": "paper-example", "gamma_opt": False}
@@ -244,3 +246,72 @@ def test_a_bad_defender_decision_is_refused_naming_it(decision, text):
     env.reset(seed=0)
     with pytest.raises(ParameterError, match=text):
         env.step(np.zeros(env.action_space.shape, dtype=np.float32))
+
+
+# ----------------------------------------------------------------------------- estimator kernels
+class DelegatingLeastSquares:
+    """An estimator written here, outside the package and not a subclass of any of its classes:
+    least squares by delegation, with the compiled online form least squares provides."""
+
+    name = "delegating-ls"
+
+    def __init__(self) -> None:
+        self._ls = make_estimator("ls")
+
+    def __getattr__(self, attr):
+        return getattr(self._ls, attr)
+
+    def min_sample_size(self, n, m):
+        return self._ls.min_sample_size(n, m)
+
+    def fit(self, x, u):
+        return self._ls.fit(x, u)
+
+    def prefix_estimates(self, x, u, sample_sizes):
+        return self._ls.prefix_estimates(x, u, sample_sizes)
+
+    def start(self, K, n, m):
+        self._ls.start(K, n, m)
+
+    def update(self, z, y):
+        self._ls.update(z, y)
+
+    def estimate(self):
+        return self._ls.estimate()
+
+    def error(self, A, B):
+        return self._ls.error(A, B)
+
+    @property
+    def count(self):
+        return self._ls.count
+
+    @property
+    def ready(self):
+        return self._ls.ready
+
+    def check_dimensions(self, n, m):
+        self._ls.check_dimensions(n, m)
+
+    def online_kernels(self, K, A, B, Q, refresh, cond_limit):
+        return RecursiveLeastSquaresKernels(K, A, B, Q, refresh, cond_limit)
+
+
+class ColumnByColumnLeastSquares(DelegatingLeastSquares):
+    """The same estimator without kernels: the episode updates it column by column."""
+
+    online_kernels = None  # type: ignore[assignment]
+
+
+def test_an_estimator_that_provides_kernels_gets_the_fused_step_and_one_without_the_generic_update():
+    config = {**BASE, "max_samples": 80}
+    want = rollout(gym.make(ENV_ID, config=config), 80)
+    fast = gym.make(ENV_ID, config={**config, "estimator": DelegatingLeastSquares()})
+    slow = gym.make(ENV_ID, config={**config, "estimator": ColumnByColumnLeastSquares()})
+    assert type(fast.unwrapped.episode.stepper) is FusedStep and fast.unwrapped.episode.estimator is None
+    assert type(slow.unwrapped.episode.stepper) is CompiledIdealStep and slow.unwrapped.episode.kernels is None
+    for g, w in zip(rollout(fast, 80), want, strict=True):  # the kernels are least squares': the same numbers
+        assert np.array_equal(g[0], w[0]) and all(a == b for a, b in zip(g[1:], w[1:]))
+    got = rollout(slow, 80)  # the column-by-column estimate is least squares too, by another solve
+    assert all(np.array_equal(g[0], w[0]) for g, w in zip(got, want, strict=True))
+    assert got[-1][4]["epsilon"] == pytest.approx(want[-1][4]["epsilon"], rel=1e-8)

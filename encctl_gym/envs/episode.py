@@ -42,7 +42,7 @@ import numpy as np
 
 from .._validation import as_finite_array, check_int, check_positive, format_value
 from ..errors import EncodingOverflowError, ParameterError, ShapeError
-from ..ident.ordinary import OrdinaryLeastSquares
+from ..ident.compiled import OnlineKernels, ProvidesKernels
 from ..ident.registry import make_estimator
 from ..loop import LoopBackend
 from ..loop.defender import DefenderPolicy, DefenderStreams, PlantView, check_defender_action, make_defender
@@ -127,25 +127,6 @@ def check_episode_memory(
         memory_limit,
         "use fewer copies, a shorter attack (max_samples) or a shorter input_history",
     )
-
-
-def _condition(Gs: np.ndarray) -> np.ndarray:
-    """2-norm condition numbers of symmetric positive semidefinite matrices (..., d, d), from
-    their eigenvalues (``inf`` where singular)."""
-    lam = np.linalg.eigvalsh(Gs)
-    lo, hi = lam[..., 0], lam[..., -1]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(lo > 0.0, hi / np.where(lo > 0.0, lo, 1.0), np.inf)
-
-
-def _pinv_psd(G: np.ndarray) -> np.ndarray:
-    """Moore-Penrose pseudo-inverses of symmetric positive semidefinite matrices (..., d, d),
-    from their eigendecompositions; eigenvalues below ``d * eps * max`` count as zero (NumPy's
-    default cut-off for ``pinv``)."""
-    lam, V = np.linalg.eigh(G)
-    keep = lam > G.shape[-1] * np.finfo(float).eps * lam[..., -1:]
-    inv = np.where(keep, 1.0 / np.where(keep, lam, 1.0), 0.0)
-    return (V * inv[..., None, :]) @ np.swapaxes(V, -1, -2)
 
 
 def attack_design_for(p: AttackParams) -> Any:
@@ -251,15 +232,18 @@ class EpisodeCore:
         gc = self._GC.reshape(self.d, self.d + n, K).transpose(2, 0, 1)
         self.G, self.C = gc[:, :, : self.d], gc[:, :, self.d :]
         self._gram_scratch = np.zeros((self.d + n, K))  # add_gram's, apart from the step's (the helper runs it)
-        self.ready = np.zeros(K, dtype=bool)  # recursion started (well-conditioned Gram matrix)
         self._gram_upto = 1  # G and C hold the columns j < _gram_upto (the fused step lets them lag)
-        self._since_refresh = 0
         self._dims = kern.dims(n, m, p.input_history * m)  # the sizes, as the kernels take them
         self.reward = REWARDS[p.reward](p, K)
-        # the attacker's estimator: least squares runs in the compiled kernels; any other is
-        # updated column by column (encctl_gym.ident)
+        # the attacker's estimator: one that provides kernels (least squares) runs compiled on the
+        # episode's arrays; any other is updated column by column (encctl_gym.ident)
         est = make_estimator(p.estimator)
-        self.estimator = None if isinstance(est, OrdinaryLeastSquares) else est
+        self.kernels: OnlineKernels | None = (
+            est.online_kernels(K, self._A, self._B, s.Q, sch.refresh, sch.cond_limit)
+            if isinstance(est, ProvidesKernels)
+            else None
+        )
+        self.estimator = est if self.kernels is None else None
         self.collected = 0  # samples collected and paid for
         self.expired = False  # the measured deciphering time passed tau_c (deciphering_clock="measured")
         self.delivered = 0  # samples delivered to the agent
@@ -269,7 +253,6 @@ class EpisodeCore:
         self._act = np.zeros((K, m))  # the actions of the current step, float64
         self._obs_shape = (K, self.layout.dim)
         self._obs_at = self.layout.offsets
-        self._all_ready = False
         self.consts = KernelConstants(
             self._A, self._B, np.ascontiguousarray(self._theta_true.T), float(self._c), p.u_max, p.energy_budget
         )
@@ -277,7 +260,7 @@ class EpisodeCore:
         self._consts, self._arrays = self.consts.kernel_tuple(), s.kernel_tuple()
         # how a step runs, chosen once: the ideal backend's steady state is one compiled call
         q = loop.quantization
-        fused = q is not None and self.reward.fused and self.estimator is None
+        fused = q is not None and self.reward.fused and self.kernels is not None and self.kernels.fused
         self.stepper: StepStrategy = choose_step(self, q, fused, parallel)
         # the other party: the plant side's decisions, each step, on what the plant knows
         self.defender = make_defender(p.defender) if defender is None else make_defender(defender)
@@ -409,10 +392,9 @@ class EpisodeCore:
         self.X[:] = 0.0
         self.U[:] = 0.0
         self._GC[:] = 0.0
-        self.ready[:] = False
         self._gram_upto = 1
-        self._all_ready = False
-        self._since_refresh = 0
+        if self.kernels is not None:
+            self.kernels.reset()
         self.state.hist[:] = 0.0
         self.state.energy[:] = 0.0
         self.eps[:] = self._eps0
@@ -502,41 +484,35 @@ class EpisodeCore:
         if target <= self.delivered:
             return False
         first = max(self.delivered, 1)
+        kernels = self.kernels
         if (
-            self._all_ready
+            kernels is not None
+            and kernels.all_ready
             and not final
             and not self.reward.needs_gram
-            and self._since_refresh + target - first < self.schedule.refresh
-        ):  # steady state: columns, recursive least squares and error in one compiled call
+            and kernels.since_refresh + target - first < kernels.refresh
+        ):  # steady state: columns, the compiled estimate and its error
             self._sync_gram(first)
-            kern.add_columns(self._dims, self.X, self.U, first, target, self._GC, self.Q, self.ready)
+            kernels.add_columns(self._dims, self.X, self.U, first, target, self._GC)
             self._gram_upto = target
-            kern.estimation_error(self._dims, self.Q, self.consts.theta_true_T, self.consts.c, self.ready, self.eps)
-            self._since_refresh += target - first
+            kernels.steady_error(self._dims, self.eps)
+            kernels.since_refresh += target - first
             self.delivered = target
             self.history.append((target, float(self.eps[0])))
             return True
         self._sync_gram(first)
         if target > first:
-            kern.add_columns(self._dims, self.X, self.U, first, target, self._GC, self.Q, self.ready)
+            if kernels is not None:
+                kernels.add_columns(self._dims, self.X, self.U, first, target, self._GC)
+            else:  # the Gram matrices alone (the rewards read them), as the columns would add them
+                kern.add_gram(self._dims, self.X, self.U, first, target, self._GC, self._gram_scratch)
             self._gram_upto = target
         self.delivered = target
         if self.estimator is not None:
             self._estimate(first, target)
         self.reward.on_delivery(self)
-        if self.estimator is None and self.delivered - 1 >= self.d:
-            self._since_refresh += target - first
-            if final or self._since_refresh >= self.schedule.refresh:  # exact solve: bounds drift; final = eq:estimate
-                stale = np.ones(self.K, dtype=bool)
-                self._since_refresh = 0
-            else:
-                stale = ~self.ready
-            if stale.any():
-                rows = np.nonzero(stale)[0]
-                theta_hat_T = self._refresh(rows)
-                self.eps[rows] = ((theta_hat_T - self.consts.theta_true_T) ** 2).sum(axis=(1, 2)) / self._c
-            kern.estimation_error(self._dims, self.Q, self.consts.theta_true_T, self.consts.c, self.ready & ~stale, self.eps)
-            self._all_ready = bool(self.ready.all())
+        if kernels is not None:
+            kernels.settle(self._dims, self.G, self.C, target - first, self.delivered, final, self.eps)
         self.history.append((self.delivered, float(self.eps[0])))
         return True
 
@@ -552,42 +528,6 @@ class EpisodeCore:
             err = est.error(self.p.A, self.p.B)
             ok = np.isfinite(err)
             self.eps[ok] = err[ok]
-
-    def _refresh(self, rows: np.ndarray) -> np.ndarray:
-        """Exact least squares (eq:estimate) for the copies ``rows`` from the running Gram matrices.
-
-        A copy whose Jacobi-scaled Gram matrix is well conditioned (condition number below
-        ``schedule.cond_limit``) solves ``G [P | Theta_hat^T] = [I | C]`` and (re)starts its
-        recursion from the solution; any other copy gets the minimum-norm least-squares solution
-        ``pinv(G) C`` of eq:estimate and stays non-recursive. A started recursion is re-anchored
-        without a new check: G only grows, by positive semidefinite terms, so its smallest
-        eigenvalue never falls. Called for copies that are not yet recursive, and for every copy
-        each ``schedule.refresh`` columns to bound rounding drift. Returns Theta_hat^T of those
-        copies, shape (len(rows), n + m, n).
-        """
-        d = self.d
-        G, C = self.G[rows], self.C[rows]
-        ok = self.ready[rows]  # a copy: the ones already recursive stay so
-        if not ok.all():
-            fresh = ~ok
-            g = G[fresh]
-            s = 1.0 / np.sqrt(np.maximum(np.einsum("kii->ki", g), 1e-300))
-            ok[fresh] = _condition(g * s[:, :, None] * s[:, None, :]) < self.schedule.cond_limit
-        sol = np.zeros((len(rows), d, d + self.n))
-        if ok.any():
-            g, c = G[ok], C[ok]
-            s = 1.0 / np.sqrt(np.einsum("kii->ki", g))  # Jacobi scaling
-            rhs = np.concatenate((np.broadcast_to(np.eye(d), g.shape) * s[:, :, None], c * s[:, :, None]), axis=2)
-            try:
-                sol[ok] = np.linalg.solve(g * s[:, :, None] * s[:, None, :], rhs) * s[:, :, None]
-            except np.linalg.LinAlgError:  # cannot happen to a well-conditioned matrix; never crash on it
-                ok[:] = False
-        if not ok.all():
-            bad = ~ok
-            sol[bad, :, d:] = _pinv_psd(G[bad]) @ C[bad]
-        self.Q[:, rows[ok]] = sol[ok].reshape(-1, d * (d + self.n)).T
-        self.ready[rows] = ok
-        return sol[:, :, d:]
 
     def check_actions(self, action: Any) -> np.ndarray:
         """Validate actions: shape (K, m) (or (m,) for K = 1), finite, inside [-1, 1]. Returns

@@ -215,11 +215,13 @@ class FusedStep(CompiledIdealStep):
 
     def step(self, act: np.ndarray, w: np.ndarray, ended: bool) -> tuple[np.ndarray, bool, bool]:
         core = self.core
-        if not (core._all_ready and not ended):
+        kernels = core.kernels
+        assert kernels is not None  # chosen only with an estimator's fused kernels
+        if not (kernels.all_ready and not ended):
             return super().step(act, w, ended)
         first = max(core.delivered, 1)
         target = core._target(core.collected + 1)
-        if core._since_refresh + target - first >= core.schedule.refresh:
+        if kernels.since_refresh + target - first >= kernels.refresh:
             return super().step(act, w, ended)
         new = target > core.delivered
         obs = np.empty(core._obs_shape, dtype=np.float32)
@@ -246,7 +248,7 @@ class FusedStep(CompiledIdealStep):
         core.collected += 1
         core.new = new
         if new:
-            core._since_refresh += target - first
+            kernels.since_refresh += target - first
             core.delivered = target
             core.history.append((target, float(core.state.eps[0])))
             if core.helper is not None and target - core._gram_upto >= core.schedule.gram_batch:
