@@ -14,14 +14,20 @@ Per sampling period ``k`` of the attack (Definition def:adversary):
    seconds, Definition def:sdt, when the scheme gives every sample its own key);
 2. samples whose delay has passed are delivered: state ``x_j`` with the input ``u_{j-1}``;
    each delivered state adds the regression column ``([x_{j-1}; u_{j-1}], x_j)`` of eq:data
-   to recursive least squares (Sherman-Morrison), which is re-anchored to the exact solve of
-   eq:estimate from the running Gram matrices every ``schedule.refresh`` columns and at the end;
-3. the agent acts; its input is held to the energy budget, forged into the input ciphertext,
-   decrypted by the plant (``u_k``) and applied: ``x_{k+1} = A x_k + B u_k + w_k``.
+   to the attacker's estimator (least squares: recursive, by Sherman-Morrison, re-anchored to
+   the exact solve of eq:estimate from the running Gram matrices every ``schedule.refresh``
+   columns and at the end);
+3. the defender (:mod:`encctl_gym.loop.defender`) decides on what the plant side knows: noise
+   ``v_k`` on the input it applies, or the end of the attack (the default does neither);
+4. the agent acts; its input is held to the energy budget, forged into the input ciphertext,
+   decrypted by the plant (``u_k``) and applied: ``x_{k+1} = A x_k + B (u_k + v_k) + w_k``.
 
-When the loop backend exposes its arithmetic (:attr:`~encctl_gym.loop.backend.LoopBackend.quantization`,
-the ideal backend), the steady state of a ``fused`` reward runs as one compiled call per step;
-otherwise the backend is called period by period.
+How a step runs is chosen once, when the episode is built (:mod:`encctl_gym.envs.steps`): the
+backend called period by period; the period in one compiled call when the backend exposes its
+arithmetic (:attr:`~encctl_gym.loop.backend.LoopBackend.quantization`, the ideal backend); and,
+when the reward and the estimator have compiled forms too (a ``fused`` reward; an estimator
+whose :meth:`online_kernels` are fused, :mod:`encctl_gym.ident.compiled`), the steady state in
+one compiled call per step. An estimator without kernels is updated column by column.
 
 Work that no step waits for can run on a :class:`~encctl_gym.envs.helper.HelperThread` (the
 compiled kernels release the GIL): drawing the next ``schedule.chunk`` periods of noise, and
@@ -264,7 +270,7 @@ class EpisodeCore:
         self.stepper: StepStrategy = choose_step(self, q, fused, parallel)
         # the other party: the plant side's decisions, each step, on what the plant knows
         self.defender = make_defender(p.defender) if defender is None else make_defender(defender)
-        self.plant_view = PlantView(s.x, s.U)
+        self.plant_view = PlantView(s.x, s.U, self._attack_step)
         self.stopped = False  # the defender ended the attack
         C = sch.chunk
         self._noise_draws = np.zeros((K, C, n))  # each copy's chunk, as its generator draws it
@@ -561,9 +567,7 @@ class EpisodeCore:
         act = self.check_actions(action)
         w = self._draw_noise()
         ended = self.collected >= self.p.horizon or self.expired
-        view = self.plant_view
-        view.step = self.collected - 1
-        decision = self.defender.act(view)
+        decision = self.defender.act(self.plant_view)
         if decision is not None:
             noise, stop = check_defender_action(decision, self.K, self.m)
             if noise is not None:  # u + v applied, u recorded: to the attacker, process noise B v
@@ -571,6 +575,10 @@ class EpisodeCore:
             if stop:
                 self.stopped = ended = True
         return self.stepper.step(act, w, ended)
+
+    def _attack_step(self) -> int:
+        """The attack step about to run (0 at the first): its input goes to ``U[collected - 1]``."""
+        return self.collected - 1
 
     def finish_step(self, ended: bool) -> tuple[np.ndarray, bool, bool]:
         """What follows the period of a step on every path: the delivery (all paid samples if

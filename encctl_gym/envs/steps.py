@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..errors import ParameterError
 from . import _kernels as kern
 
 if TYPE_CHECKING:
@@ -212,11 +213,13 @@ class FusedStep(CompiledIdealStep):
     def __init__(self, core: EpisodeCore, quant: tuple[Any, ...], parallel: bool = False) -> None:
         super().__init__(core, quant)
         self._kernel = kern.step_fused_parallel if parallel else kern.step_fused
+        if core.kernels is None:
+            raise ParameterError("the fused step needs an estimator with fused kernels (online_kernels)")
+        self.kernels = core.kernels
 
     def step(self, act: np.ndarray, w: np.ndarray, ended: bool) -> tuple[np.ndarray, bool, bool]:
         core = self.core
-        kernels = core.kernels
-        assert kernels is not None  # chosen only with an estimator's fused kernels
+        kernels = self.kernels
         if not (kernels.all_ready and not ended):
             return super().step(act, w, ended)
         first = max(core.delivered, 1)

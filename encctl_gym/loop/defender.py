@@ -27,7 +27,7 @@ every step path.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol, overload, runtime_checkable
 
@@ -69,20 +69,30 @@ class DefenderAction:
 class PlantView:
     """What the plant side knows, read-only, as the episode updates it (no copies).
 
+    Parameters
+    ----------
+    x, U : numpy.ndarray
+        The episode's state (K, n) and applied inputs (N, K, m), which the view reads.
+    step : callable
+        Returns the attack step about to run.
+
     Attributes
     ----------
-    step : int
-        The attack step about to run (0 at the first).
     state : numpy.ndarray, shape (K, n)
         The plant's current state ``x_k`` (read-only view).
     """
 
-    def __init__(self, x: np.ndarray, U: np.ndarray) -> None:
+    def __init__(self, x: np.ndarray, U: np.ndarray, step: Callable[[], int]) -> None:
         self.state = x.view()
         self.state.flags.writeable = False
         self._U = U.view()
         self._U.flags.writeable = False
-        self.step = 0
+        self._step = step
+
+    @property
+    def step(self) -> int:
+        """The attack step about to run (0 at the first)."""
+        return self._step()
 
     @property
     def last_input(self) -> np.ndarray:
