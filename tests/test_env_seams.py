@@ -3,6 +3,7 @@ from outside the package."""
 
 from __future__ import annotations
 
+import copy
 import hashlib
 
 import gymnasium as gym
@@ -198,6 +199,17 @@ def test_a_detector_from_outside_the_package_ends_the_episode():
     assert info["samples_delivered"] == info["samples_collected"] == 7
     with pytest.raises(ParameterError, match="after the episode ended"):
         env.step(small)
+
+
+def test_a_copied_episode_shows_its_defender_its_own_plant():
+    env = gym.make(ENV_ID, config={**SMALL, "defender": InputWatchdog(limit=10.0)})
+    env.reset(seed=0)
+    twin = copy.deepcopy(env.unwrapped.episode)
+    view = twin.plant_view
+    assert np.shares_memory(view.state, twin.state.x) and not np.shares_memory(view.state, env.unwrapped.episode.state.x)
+    assert not view.state.flags.writeable and view.step == 0
+    twin.step(np.full(4, 0.5, dtype=np.float32))
+    assert view.step == 1 and np.array_equal(view.last_input, twin.U[0]) and not view.last_input.flags.writeable
 
 
 def test_a_defender_runs_in_the_vector_env_with_a_stream_per_copy():

@@ -75,19 +75,10 @@ class PlantView:
         The episode's state (K, n) and applied inputs (N, K, m), which the view reads.
     step : callable
         Returns the attack step about to run.
-
-    Attributes
-    ----------
-    state : numpy.ndarray, shape (K, n)
-        The plant's current state ``x_k`` (read-only view).
     """
 
     def __init__(self, x: np.ndarray, U: np.ndarray, step: Callable[[], int]) -> None:
-        self.state = x.view()
-        self.state.flags.writeable = False
-        self._U = U.view()
-        self._U.flags.writeable = False
-        self._step = step
+        self._x, self._U, self._step = x, U, step  # the episode's own arrays (a copy of the episode keeps them shared)
 
     @property
     def step(self) -> int:
@@ -95,11 +86,15 @@ class PlantView:
         return self._step()
 
     @property
+    def state(self) -> np.ndarray:
+        """The plant's current state ``x_k``, shape (K, n) (a read-only view)."""
+        return _read_only(self._x)
+
+    @property
     def last_input(self) -> np.ndarray:
         """The input ``u_{k-1}`` the plant decoded and applied last step, shape (K, m) (zeros at the first)."""
-        if self.step < 1:
-            return np.zeros(self._U.shape[1:])
-        return self._U[self.step - 1]
+        k = self.step
+        return np.zeros(self._U.shape[1:]) if k < 1 else _read_only(self._U[k - 1])
 
 
 class DefenderStreams(Sequence[np.random.Generator]):
@@ -131,6 +126,12 @@ class DefenderStreams(Sequence[np.random.Generator]):
                 raise ParameterError(f"the episode's generator {i} cannot spawn a stream for the defender ({exc})") from None
             self._children[i] = child
         return child
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    v = a.view()
+    v.flags.writeable = False
+    return v
 
 
 @runtime_checkable
