@@ -267,7 +267,7 @@ def test_a_constant_input_gets_the_minimum_norm_estimate_every_step():
             assert info["epsilon"] == pytest.approx(np.sum((th - theta) ** 2) / theta.size, rel=1e-6)
         if te or tr:
             break
-    assert not core.ready.any()
+    assert not core.kernels.ready.any()
     assert np.isfinite(info["epsilon"]) and info["epsilon"] > 0
 
 
