@@ -2,6 +2,8 @@
 
 Imports are read from the source with ``ast`` (module level and inside functions alike: an
 import deferred into a function is still a dependency), so the test needs no optional extra.
+Imports under ``if TYPE_CHECKING:`` are left out: they exist for the type checker only, and no
+module loads another through them.
 """
 
 from __future__ import annotations
@@ -40,7 +42,7 @@ def imports_of(module: str, source: str, modules: Mapping[str, Path], *, is_pack
     """The modules of ``modules`` that ``source`` (the text of ``module``) imports."""
     package = module if is_package else module.rpartition(".")[0]
     found: set[str] = set()
-    for node in ast.walk(ast.parse(source)):
+    for node in _runtime_nodes(ast.parse(source)):
         if isinstance(node, ast.Import):
             targets = [alias.name for alias in node.names]
         elif isinstance(node, ast.ImportFrom):
@@ -59,6 +61,24 @@ def imports_of(module: str, source: str, modules: Mapping[str, Path], *, is_pack
             if hit is not None and hit != module:
                 found.add(hit)
     return found
+
+
+def _is_type_checking(test: ast.expr) -> bool:
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING"
+    )
+
+
+def _runtime_nodes(tree: ast.AST) -> Iterable[ast.AST]:
+    """Every node of ``tree`` except the bodies of ``if TYPE_CHECKING:`` (their ``else`` stays)."""
+    todo = [tree]
+    while todo:
+        node = todo.pop()
+        yield node
+        if isinstance(node, ast.If) and _is_type_checking(node.test):
+            todo.extend(node.orelse)
+            continue
+        todo.extend(ast.iter_child_nodes(node))
 
 
 def import_graph(packages: Iterable[str] = PACKAGES) -> dict[str, set[str]]:
@@ -184,3 +204,15 @@ def test_no_layer_imports_a_higher_one(layer: str) -> None:
     # the CLI is the application's entry point: it may reach the applications by name
     upward = [edge for edge in upward if not edge.startswith("encctl_gym.cli ->")]
     assert not upward, "upward imports:\n" + "\n".join(upward)
+
+
+def test_type_checking_imports_are_not_runtime_dependencies() -> None:
+    modules = {"pkg": Path("pkg/__init__.py"), "pkg.a": Path("pkg/a.py"), "pkg.b": Path("pkg/b.py"), "pkg.c": Path("pkg/c.py")}
+    source = (
+        "from typing import TYPE_CHECKING\n"
+        "if TYPE_CHECKING:\n    from .b import B\nelse:\n    from .c import C\n"
+        "def f():\n    from . import b\n"
+    )
+    # the deferred import inside f counts, the type-only one does not, the else branch does
+    assert imports_of("pkg.a", source, modules) == {"pkg.b", "pkg.c"}
+    assert imports_of("pkg.a", "import typing\nif typing.TYPE_CHECKING:\n    from .b import B\n", modules) == set()
