@@ -137,13 +137,18 @@ def read_run(run_dir: str | Path) -> RunInfo:
     Raises
     ------
     ConfigError
-        If the directory or its ``run.json`` is missing, larger than :data:`MAX_RUN_FILE_BYTES`,
+        If the directory does not exist (naming its ``-quick`` sibling when there is one, the
+        directory ``train --quick`` writes), its ``run.json`` is missing, larger than :data:`MAX_RUN_FILE_BYTES`,
         is not valid JSON (including integers of over 4300 digits and nesting deeper than
         Python's recursion limit), or lacks a field (``algo``, ``observation``, ``env``) or has
         one of the wrong type.
     """
     path = Path(run_dir)
     meta_path = path / RUN_FILE
+    if not path.exists():
+        quick = path.with_name(path.name + "-quick") if path.name else None
+        hint = f"; a smoke-test run (--quick) of that name is {str(quick)!r}" if quick is not None and (quick / RUN_FILE).is_file() else ""
+        raise ConfigError(f"the run directory {str(path)!r} does not exist{hint}")
     if not meta_path.is_file():
         raise ConfigError(f"{str(path)!r} is not a training run (no {RUN_FILE})")
     size = meta_path.stat().st_size
