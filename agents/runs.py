@@ -176,11 +176,14 @@ def read_run(run_dir: str | Path) -> RunInfo:
                    seed=seed, quick=bool(config.get("quick", False)), meta=meta)
 
 
-def find_runs(roots: Sequence[str | Path], *, include_quick: bool = False) -> list[RunInfo]:
+def find_runs(roots: Sequence[str | Path], *, include_quick: bool = False,
+              left_out: list[tuple[Path, str]] | None = None) -> list[RunInfo]:
     """The training runs (a ``run.json`` and a ``model.zip``) under ``roots``.
 
     A root that is itself a run is taken as given; under any other root every direct
     subdirectory that is a run counts, quick (smoke-test) runs only with ``include_quick``.
+    The directories with a ``run.json`` that are not taken (a quick run, a run without
+    ``model.zip``) are appended to ``left_out`` with the reason, when it is given.
 
     Raises
     ------
@@ -197,10 +200,14 @@ def find_runs(roots: Sequence[str | Path], *, include_quick: bool = False) -> li
             raise ConfigError(f"runs directory {str(root)!r} does not exist")
         for meta in sorted(root.glob(f"*/{RUN_FILE}")):
             if not (meta.parent / MODEL_FILES["final"]).exists():
+                if left_out is not None:
+                    left_out.append((meta.parent, f"no {MODEL_FILES['final']} (training unfinished or failed)"))
                 continue
             info = read_run(meta.parent)
             if include_quick or not info.quick:
                 out.append(info)
+            elif left_out is not None:
+                left_out.append((meta.parent, "a smoke-test run (--quick); give its directory to --runs to include it"))
     return out
 
 
