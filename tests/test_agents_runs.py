@@ -85,7 +85,8 @@ def test_compare_plays_a_run_in_the_environment_it_was_trained_in(ars_run, tmp_p
                   attackers=("gaussian",))
     assert [c.attacker for c in res.curves[("small", 0)]] == ["gaussian", "ars"]
     assert cli.main(["compare", "--quick", "--systems", "small", "--delays", "0", "--runs", str(ars_run), "--points", "2",
-                     "--episodes", "2", "--elgamal-episodes", "0", "--no-progress", "--out", str(tmp_path / "c")]) == 0
+                     "--episodes", "2", "--elgamal-episodes", "0", "--no-progress", "--out", str(tmp_path / "c"),
+                     "--attackers", "gaussian"]) == 0
     assert "| ars |" in capsys.readouterr().out
 
 
@@ -123,7 +124,7 @@ def test_compare_says_which_runs_it_leaves_out_and_why(ars_run, tmp_path, capsys
     assert "sigma_w2 = 0.5" in why
     assert cli.main(["compare", "--quick", "--systems", "paper-example", "--delays", "0", "--runs", str(ars_run.parent),
                      "--runs", str(other), "--points", "2", "--episodes", "2", "--elgamal-episodes", "0", "--no-progress",
-                     "--out", str(tmp_path / "c")]) == 0
+                     "--out", str(tmp_path / "c"), "--attackers", "gaussian"]) == 0
     err = [line for line in capsys.readouterr().err.splitlines() if "leaving out" in line]
     assert len(err) == 2 and str(ars_run) in err[0] and "--quick" in err[0]
     assert str(other) in err[1] and "trained on 'small'" in err[1]

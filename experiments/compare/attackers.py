@@ -28,8 +28,7 @@ from encctl_gym.registry import Registry
 
 from .settings import Setting
 
-__all__ = ["ATTACKERS", "make_attackers", "system_config", "run_setting", "run_applies", "left_out", "learned_players",
-           "learned_attackers"]
+__all__ = ["ATTACKERS", "make_attackers", "system_config", "run_setting", "run_applies", "left_out", "learned_players"]
 
 #: Baseline and oracle attackers by name -> factory for a setting.
 ATTACKERS: Registry[Callable[[Setting], Attacker]] = Registry(
@@ -169,8 +168,3 @@ def learned_players(setting: Setting, runs: Sequence[RunInfo], which: str = "bes
         out.append((load_attacker(run.path, which=w, params=play.params, name=label, deterministic=deterministic), play))
     return out
 
-
-def learned_attackers(setting: Setting, runs: Sequence[RunInfo], which: str = "best", *, deterministic: bool = False) -> list[Attacker]:
-    """The attackers of :func:`learned_players` without their settings. Each must be played in
-    its own setting (the environment it was trained in), not necessarily ``setting``'s."""
-    return [a for a, _ in learned_players(setting, runs, which, deterministic=deterministic)]
