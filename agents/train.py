@@ -264,6 +264,21 @@ def _summary(r: Any) -> dict[str, Any]:
 
 
 # --------------------------------------------------------------------------- command line
+def system_summary(cfg: dict[str, Any], plant: str | Path) -> str:
+    """The line ``train --system FILE`` prints: the plant's values and the system's own defense
+    period ``tau_c``, then the training attack length and the shortened defense period that sets
+    it (``horizon``, :func:`agents.evaluate.budget_config`), which is not the system's."""
+    p = resolve_params({**cfg["env"], "gamma_opt": False})
+    text = (f"plant A ({p.n} x {p.n}), B ({p.n} x {p.m}) from {plant}; sigma_w2 = {p.sigma_w2:g}, sigma_u2 = {p.sigma_u2:g}, "
+            f"sigma_x2 = {p.sigma_x2:g}, gamma_c = {p.gamma_c:g}, defense period tau_c = {p.tau_c:g} s, Upsilon = {p.upsilon:g} "
+            f"(the values the file does not give are preset {cfg['env'].get('preset')}'s unless set with --set env.KEY=VALUE)")
+    t = resolve_params(env_config(cfg))
+    if t.horizon != p.horizon:
+        text += (f"; training attacks of N = {t.horizon} samples (horizon), through a defense period shortened to "
+                 f"{t.tau_c:g} s at lambda = {t.security_parameter:g} (the system's tau_c allows N = {p.horizon})")
+    return text
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``encctl-gym train``."""
     parser.add_argument("--algo", required=True, choices=list(ALGORITHMS), help="learning algorithm")
@@ -302,10 +317,7 @@ def run(args: argparse.Namespace) -> int:
     for item in args.overrides:
         apply_override(cfg, item)
     if args.system is not None:
-        p = resolve_params(env_config(cfg))
-        print(f"plant A ({p.n} x {p.n}), B ({p.n} x {p.m}) from {args.system}; sigma_w2 = {p.sigma_w2:g}, "
-              f"sigma_u2 = {p.sigma_u2:g}, sigma_x2 = {p.sigma_x2:g}, gamma_c = {p.gamma_c:g}, tau_c = {p.tau_c:g} s, "
-              f"Upsilon = {p.upsilon:g} from preset {cfg['env'].get('preset')} unless set with --set env.KEY=VALUE")
+        print(system_summary(cfg, args.system))
     run_dir = train(cfg, out=args.out, seed=args.seed, progress=not args.no_progress, tensorboard=not args.no_tensorboard,
                     verbose=args.verbose, name=args.name, overwrite=args.overwrite)
     meta = read_run(run_dir).meta

@@ -37,7 +37,7 @@ from encctl_gym.envs.config import resolve_params
 from encctl_gym.resources import check_memory
 from encctl_gym.sim.montecarlo import log_grid
 
-from .attackers import ATTACKERS, learned_attackers, make_attackers
+from .attackers import ATTACKERS, learned_players, make_attackers
 from .records import Curve, Result
 from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, Setting, length_grid, make_setting
 from .statistics import mean_se
@@ -98,7 +98,7 @@ def planned_steps(setting: Setting, n_attackers: int, episodes: int, points: int
     return n_attackers * per * padded
 
 
-def record_bytes(plan: Sequence[tuple[Setting, Sequence[Attacker]]], episodes: int, points: int) -> int:
+def record_bytes(plan: Sequence[tuple[Setting, Sequence[Any]]], episodes: int, points: int) -> int:
     """Estimated bytes of what :func:`compute` keeps per episode (float64): each curve's errors at
     every grid point and its finals, and, with delivered states, the largest running record of one
     full-length attack (error and energy at every step)."""
@@ -164,7 +164,8 @@ def compute(
         Attack lengths per curve (:func:`length_grid`).
     runs : sequence
         Training runs (directories or :class:`agents.runs.RunInfo`) whose learned attackers play
-        where they apply.
+        where they apply, each in the environment it was trained in
+        (:func:`~experiments.compare.attackers.run_setting`).
     which : {"best", "final"}
         Which model of a run.
     elgamal_episodes, elgamal_N : int
@@ -197,8 +198,9 @@ def compute(
     settings = list(settings)
     for s in settings:  # the grid of every setting is checked before any attacker is built or loaded
         length_grid(s.params, points)
-    plan = [(s, [*make_attackers(s, attackers), *learned_attackers(s, infos, which, deterministic=deterministic),
-                 *(players(s) if players is not None else ())]) for s in settings]
+    # every attacker with the setting it plays in: a learned one in the environment it was trained in
+    plan = [(s, [*((a, s) for a in make_attackers(s, attackers)), *learned_players(s, infos, which, deterministic=deterministic),
+                 *((a, s) for a in (players(s) if players is not None else ()))]) for s in settings]
     total = sum(planned_steps(s, len(a), episodes, points) for s, a in plan)
     check_memory(f"keeping the per-episode records of episodes = {format_value(episodes)} over {len(plan)} setting(s) at points = "
                  f"{format_value(points)}", record_bytes(plan, episodes, points), advice="use fewer episodes")
@@ -215,12 +217,12 @@ def compute(
     try:
         for setting, atts in plan:
             curves[setting.key] = []
-            for att in atts:
+            for att, play in atts:
                 if bar is not None:
                     bar.set_postfix_str(f"{setting.system} d={setting.delay} {att.name}")
-                curves[setting.key].append(evaluate(setting, att, episodes=episodes, seed=seed, points=points, progress=bar))
+                curves[setting.key].append(evaluate(play, att, episodes=episodes, seed=seed, points=points, progress=bar))
                 if elgamal_episodes > 0:
-                    elgamal.extend(elgamal_check(setting, att, episodes=elgamal_episodes, N=elgamal_N, seed=seed))
+                    elgamal.extend(elgamal_check(play, att, episodes=elgamal_episodes, N=elgamal_N, seed=seed))
             cs = curves[setting.key]
             gauss = next((c for c in cs if c.attacker == GAUSSIAN_NAME), None)
             oracle = next((c for c in cs if c.oracle), None)
