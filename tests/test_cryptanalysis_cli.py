@@ -234,6 +234,25 @@ def test_models_figure_and_from_csv(quick_rows: list, tmp_path) -> None:
     assert deciphering_time.main(["--from-csv", str(tmp_path / "missing.csv"), "--out", str(out)]) == 2
 
 
+def test_a_redraw_from_csv_leaves_data_files_that_hold_the_same_values_untouched(quick_rows: list, tmp_path) -> None:
+    """The fit CSV on disk differs from a refit only in the last digit (another machine's
+    rounding): a redraw keeps it byte for byte; a real change of value is written."""
+    out = tmp_path / "fig"
+    out.mkdir()
+    source = deciphering_time.write_csv(quick_rows, out / "deciphering_time.csv")
+    fits = deciphering_time.fit(quick_rows)
+    nudged = [dict(f, T_first=float(np.nextafter(f["T_first"], np.inf))) for f in fits]
+    fit_path = deciphering_time.write_csv(nudged, out / "deciphering_time_fit.csv", deciphering_time.FIT_COLUMNS)
+    before = {p.name: p.read_bytes() for p in (source, fit_path)}
+    assert deciphering_time.main(["--from-csv", str(source), "--out", str(out), "--no-progress"]) == 0
+    assert {p.name: p.read_bytes() for p in (source, fit_path)} == before
+    changed = [dict(f, T_first=2 * f["T_first"]) for f in fits]
+    deciphering_time.write_csv(changed, fit_path, deciphering_time.FIT_COLUMNS)
+    assert deciphering_time.main(["--from-csv", str(source), "--out", str(out), "--no-progress"]) == 0
+    redone = deciphering_time.read_csv(fit_path)
+    assert [r["T_first"] for r in redone] == pytest.approx([f["T_first"] for f in fits], rel=1e-12)
+
+
 # ----------------------------------------------------------------------------- hardening
 @pytest.mark.parametrize(
     "args, message",
