@@ -142,6 +142,10 @@ class EncryptedLTIAttackEnv(gym.Env):
     **overrides)``. See :func:`encctl_gym.envs.config.default_config` for every key
     (preset, A, B, variances, scheme, adversary, security_parameter or key_length, upsilon,
     tau_c, max_samples, decipher_delay, warmup_steps, reward, crypto, delta, ...).
+    A plant of one's own, ``config={"A": A, "B": B}``, takes the values it does not give
+    (variances, ``gamma_c``, ``tau_c``, ``upsilon``) from ``preset`` (default
+    ``"paper-example"``) with a warning naming them; ``preset=None`` completes nothing, and
+    every value must then be given (the same rule as ``encctl-gym train --system FILE``).
     ``schedule`` (:class:`~encctl_gym.envs.episode.EpisodeSchedule`) sets how the work is
     batched (noise chunks, exact-refresh period); the default is what the benchmarks measure.
 
