@@ -269,6 +269,32 @@ def test_crack_refuses_unbounded_work_in_one_line(capsys: pytest.CaptureFixture,
     assert len(err) == 1 and message in err[0], err
 
 
+def test_crack_refuses_at_once_what_the_environment_refuses_and_prints_its_estimate_first(capsys, monkeypatch) -> None:
+    """The environment's estimate (Breaker.check_time) decides for crack too: two rho keys at 64
+    bits are refused before any work, naming --max-seconds; raising it lets the job start, and
+    the estimate is the first line printed."""
+    from encctl_gym.cryptanalysis import get_breaker
+    from encctl_gym.cryptanalysis.cli import DEFAULT_MAX_SECONDS
+    from encctl_gym.crypto.group import shipped_group
+
+    started = []
+
+    def no_work(*args, **kwargs):
+        started.append(True)
+        raise KeyboardInterrupt  # stop before any key is broken (a real run takes about 17 minutes)
+
+    monkeypatch.setattr("encctl_gym.cryptanalysis.cli.break_sequence", no_work)
+    first, per_key = get_breaker("rho").expected_seconds(shipped_group(64))
+    assert first + per_key > DEFAULT_MAX_SECONDS  # the case of the check below
+    assert main(["crack", "--bits", "64", "--keys", "2", "--breaker", "rho", "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--max-seconds" in err[0] and "rho" in err[0] and not started, err
+    limit = str(2 * (first + per_key))
+    assert main(["crack", "--bits", "64", "--keys", "2", "--breaker", "rho", "--no-progress", "--max-seconds", limit]) == 130
+    out = capsys.readouterr().out.strip().splitlines()
+    assert started and out and "expected about" in out[0] and "2 keys" in out[0], out
+
+
 def test_crack_keys_limit_and_its_memory_estimate() -> None:
     from encctl_gym.cryptanalysis.cli import MAX_KEYS, check_keys
     from encctl_gym.errors import ResourceLimitError
