@@ -203,6 +203,19 @@ class AttackParams:
     tr_psi_u: float
     tr_psi_w: float
     sources: dict[str, str] = field(default_factory=dict)  # where A, B, the variances and design values came from
+    horizon_capped: bool = False  # no max_samples and a budget beyond MAX_DEFAULT_HORIZON: N is that cap
+
+    def warn_if_capped(self) -> None:
+        """Warn (once per environment, when it is made) that the attack length is the default cap
+        :data:`MAX_DEFAULT_HORIZON`, not what the budget buys."""
+        if self.horizon_capped:
+            warnings.warn(
+                f"the deciphering budget buys N = {format_value(self.budget_samples)} samples within tau_c = "
+                f"{self.tau_c:g} s (k = {self.key_length} bits); without max_samples the attack is capped at "
+                f"N = {self.horizon} (MAX_DEFAULT_HORIZON) and truncated there: set max_samples for another length",
+                UserWarning,
+                stacklevel=3,
+            )
 
     @property
     def n(self) -> int:
@@ -445,14 +458,7 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     if max_samples is not None and max_samples < budget:
         horizon, budget_limited = max_samples, False
     elif max_samples is None and budget > MAX_DEFAULT_HORIZON:
-        horizon, budget_limited = MAX_DEFAULT_HORIZON, False
-        warnings.warn(
-            f"the deciphering budget buys N = {format_value(budget)} samples within tau_c = {tau_c:g} s (k = {key_length} "
-            f"bits); without max_samples the attack is capped at N = {MAX_DEFAULT_HORIZON} (MAX_DEFAULT_HORIZON) and "
-            "truncated there: set max_samples for another length",
-            UserWarning,
-            stacklevel=3,
-        )
+        horizon, budget_limited = MAX_DEFAULT_HORIZON, False  # the environment warns (AttackParams.warn_if_capped)
     else:
         horizon, budget_limited = int(budget), True
     if horizon < n + m + 1:
@@ -530,4 +536,5 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         tr_psi_u=tr_psi_u,
         tr_psi_w=tr_psi_w,
         sources=sources,
+        horizon_capped=max_samples is None and horizon < budget,
     )

@@ -133,7 +133,10 @@ class EncryptedLTIAttackEnv(gym.Env):
     ``terminated`` when the next sample can no longer be paid for within ``tau_c``: the
     deciphering budget is part of the environment's state (its spent fraction is observed) and
     no reward can follow, so this is a true terminal state. ``truncated`` when ``max_samples``
-    ends the attack first: a cap from outside the attacker's problem. Either way all paid
+    ends the attack first: a cap from outside the attacker's problem. Without ``max_samples``, a
+    budget that buys more than ``MAX_DEFAULT_HORIZON`` = 2^20 samples (short keys: 64 bits buy
+    about 9e18) is capped there, with a warning when the environment is made
+    (``params.horizon_capped``), and the episode is truncated at that length. Either way all paid
     samples are delivered in the final observation. ``N`` samples mean ``N`` actions.
 
     ## Arguments
@@ -186,6 +189,7 @@ class EncryptedLTIAttackEnv(gym.Env):
         **kwargs: Any,
     ) -> None:
         self.params: AttackParams = resolve_params(config, **kwargs)
+        self.params.warn_if_capped()
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ParameterError(
                 f"unknown render_mode {format_value(render_mode)}; choose one of {self.metadata['render_modes']}"
