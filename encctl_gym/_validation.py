@@ -28,7 +28,6 @@ __all__ = [
     "format_value",
     "check_positive",
     "check_nonnegative",
-    "check_real",
     "check_int",
     "check_bool",
     "parse_number",
@@ -136,12 +135,6 @@ def _as_float(name: str, value: Any) -> float:
     if not math.isfinite(v):
         raise ParameterError(f"{name} must be finite, got {format_value(value)}")
     return v
-
-
-def check_real(name: str, value: Any) -> float:
-    """Return ``value`` as a float, raising :class:`ParameterError` unless it is a finite real
-    number (not a bool, not complex, within the float64 range)."""
-    return _as_float(name, value)
 
 
 def check_positive(name: str, value: Any) -> float:

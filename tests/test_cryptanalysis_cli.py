@@ -296,7 +296,7 @@ def test_crack_refuses_at_once_what_the_environment_refuses_and_prints_its_estim
 
 
 def test_crack_keys_limit_and_its_memory_estimate() -> None:
-    from encctl_gym.cryptanalysis.cli import MAX_KEYS, check_keys
+    from encctl_gym.cryptanalysis.keys import MAX_KEYS, check_keys
     from encctl_gym.errors import ResourceLimitError
 
     assert check_keys(MAX_KEYS) == MAX_KEYS and check_keys(1) == 1

@@ -9,7 +9,8 @@ Backends implement :class:`~encctl_gym.loop.backend.LoopBackend` and are picked 
 * ``"elgamal"`` (:class:`~encctl_gym.loop.elgamal.ElGamalLoop`): real dynamic-key ElGamal
   ciphertexts, one copy.
 
-Both use the group of :func:`~encctl_gym.loop.backend.loop_group`, so their trajectories agree
+Both use the group the defender picks (:mod:`encctl_gym.loop.defender`; by default that of
+:func:`~encctl_gym.loop.backend.loop_group` for the key length), so their trajectories agree
 bit for bit.
 """
 
@@ -19,6 +20,7 @@ from typing import Any
 
 from ..errors import ParameterError
 from .backend import LoopBackend, loop_group, lqr_gain, table_limit
+from .defender import DEFENDERS, DefenderAction, DefenderPolicy, FixedDefender, PlantView, make_defender
 from .elgamal import ElGamalLoop
 from .ideal import IdealLoop
 from .quantize import Quantization
@@ -33,16 +35,25 @@ __all__ = [
     "loop_group",
     "lqr_gain",
     "table_limit",
+    "DEFENDERS",
+    "DefenderAction",
+    "DefenderPolicy",
+    "FixedDefender",
+    "PlantView",
+    "make_defender",
 ]
 
 #: Backends by the name the environment's ``crypto`` key gives.
 BACKENDS: dict[str, type] = {"ideal": IdealLoop, "elgamal": ElGamalLoop}
 
 
-def make_loop(params: Any) -> LoopBackend:
-    """The backend selected by ``params.crypto``, on the group of :func:`loop_group`."""
+def make_loop(params: Any, defender: DefenderPolicy | None = None) -> LoopBackend:
+    """The backend selected by ``params.crypto``, on the group the defender picks
+    (``defender``, else the policy of ``params.defender``; by default :func:`loop_group` of the
+    key length)."""
     try:
         backend = BACKENDS[params.crypto]
     except KeyError:
         raise ParameterError(f"unknown crypto backend {params.crypto!r}; choose one of {', '.join(BACKENDS)}") from None
-    return backend(params, loop_group(params.key_length))
+    policy = defender if defender is not None else make_defender(params.defender)
+    return backend(params, policy.group(params))
