@@ -287,7 +287,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "agents/configs/{algo}_{preset}.yaml is merged over the algorithm's default when it exists")
     parser.add_argument("--system", default=None, metavar="FILE",
                         help="plant file (JSON/YAML {A: ..., B: ...} or NPZ, as `design` reads) replacing the preset's A and B; "
-                        "noise variances, gamma_c, tau_c and Upsilon stay the preset's unless set with --set env.KEY=VALUE")
+                        "the values the file does not give (noise variances, gamma_c, tau_c, Upsilon) come from the config's env.preset "
+                        "(default paper-example; env.preset=null: the file must give them), as for the environment's "
+                        "config={'A': A, 'B': B}; --set env.KEY=VALUE overrides any")
     parser.add_argument("--config", default=None, metavar="FILE",
                         help="config file merged over the algorithm's default (instead of the preset's tuned file)")
     parser.add_argument("--quick", action="store_true", help="smoke test: the configs' quick sections (a few thousand steps)")

@@ -43,7 +43,7 @@ from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, Setting, length_grid
 from .statistics import mean_se
 from .tables import bound_rows, security_row
 
-__all__ = ["evaluate", "planned_steps", "record_bytes", "elgamal_check", "compute"]
+__all__ = ["evaluate", "planned_steps", "record_bytes", "elgamal_check", "warm_up", "compute"]
 
 #: The name the Gaussian baseline plays under (the reference of the paired ratios).
 GAUSSIAN_NAME = GaussianAttacker.name
@@ -129,6 +129,26 @@ def elgamal_check(setting: Setting, attacker: Attacker, *, episodes: int, N: int
     return rows
 
 
+def warm_up(plan: Sequence[tuple[Setting, Sequence[Attacker]]], *, points: int, elgamal: bool = False) -> float:
+    """Play one short episode of each setting's first attacker (and one through ElGamal), so that
+    the compiled kernels are compiled (or loaded from numba's cache) before a progress bar
+    starts; returns the seconds it took. The episodes are discarded; the attackers are reset by
+    every rollout, so nothing of this reaches the results."""
+    t0 = time.perf_counter()
+    seen: set[tuple[int, int, int, Any]] = set()
+    for setting, atts in plan:
+        p = setting.params
+        key = (p.n, p.m, p.input_history, p.decipher_delay is None)
+        if not atts or key in seen:
+            continue
+        seen.add(key)
+        N = int(length_grid(p, points)[0])
+        rollout(atts[0], budget_config(setting.config, N), episodes=1, seed=0, record=True, covariance=True)
+        if elgamal:
+            rollout(atts[0], elgamal_config(setting.config, N, crypto_seed=0), episodes=1, seed=0, record=False)
+    return time.perf_counter() - t0
+
+
 def compute(
     systems: Sequence[str] = DEFAULT_SYSTEMS,
     *,
@@ -204,6 +224,7 @@ def compute(
     total = sum(planned_steps(s, len(a), episodes, points) for s, a in plan)
     check_memory(f"keeping the per-episode records of episodes = {format_value(episodes)} over {len(plan)} setting(s) at points = "
                  f"{format_value(points)}", record_bytes(plan, episodes, points), advice="use fewer episodes")
+    warm_up(plan, points=points, elgamal=elgamal_episodes > 0)  # the bar's rate (its ETA) counts no compile time
     bar = None
     if progress:
         from tqdm import tqdm
