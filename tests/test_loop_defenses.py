@@ -104,3 +104,17 @@ def test_the_chi2_detector_stops_a_large_injection_and_noise_changes_the_traject
 def test_bad_defender_options_are_refused(spec, match):
     with pytest.raises(ParameterError, match=match):
         make_defender(spec)
+
+
+def test_the_measured_defence_table_on_a_small_plant():
+    from experiments.defenses import MEASURED_DEFENDERS, format_measured, measure
+
+    rows = measure("small", episodes=1, seed=0)
+    assert len(rows) == 3 * len(MEASURED_DEFENDERS)
+    by = {(r["defender"], r["attacker"]): r for r in rows}
+    assert all(
+        by[("none", a)]["detection_rate"] == 0.0 and by[("none", a)]["time_ratio"] == 1.0 for a in ("gaussian", "ar1", "optimal")
+    )
+    assert all(r["detection_rate"] == 1.0 for r in rows if r["defender"].startswith("chi2"))  # every step injects
+    assert all(r["samples_median"] <= r["horizon"] for r in rows)
+    assert format_measured(rows).count("\n") == len(rows) + 1
