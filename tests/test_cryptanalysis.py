@@ -517,3 +517,48 @@ def test_a_pari_failure_is_a_one_line_breaker_error(monkeypatch: pytest.MonkeyPa
     with pytest.raises(BreakerError, match="pari: znlog failed for h = 4") as err:
         pre.break_key(4)
     assert "\n" not in str(err.value) and type(failure).__name__ == "PariError"
+
+
+# ----------------------------------------------------------------------------- small q in a large p
+@lru_cache(maxsize=None)
+def small_order_group(q_bits: int, p_bits: int, seed: int = 0) -> GroupParams:
+    """A group p = n q + 1 with a q of ``q_bits`` bits and a p of ``p_bits`` bits (not a safe prime)."""
+    rnd = random.Random(seed)
+    q = int(gmpy2.next_prime(rnd.getrandbits(q_bits) | (1 << (q_bits - 1))))
+    while True:
+        n = (rnd.getrandbits(p_bits - q_bits) | (1 << (p_bits - q_bits - 1))) & ~1
+        p = n * q + 1
+        if p.bit_length() == p_bits and n % q and gmpy2.is_prime(p):
+            break
+    g = next(g for g in (pow(x, n, p) for x in range(2, 100)) if g != 1)
+    return GroupParams(p, q, g)
+
+
+def test_index_calculus_breaks_a_group_whose_q_is_too_small_for_relations() -> None:
+    # G has only q elements: a 16-bit q in a 64-bit p holds too few smooth elements for the
+    # relations (every one of them was tried and the system stayed rank-deficient).
+    grp = small_order_group(16, 64)
+    ic = IndexCalculus(rng=1)
+    pre = ic.precompute(grp)
+    for s in (1, 2, 12345, grp.q - 1):
+        key = pre.break_key(pow(grp.g, s, grp.p))
+        assert key.s == s and key.method == "index-calculus"
+    assert ic.uses_baby_steps(grp) and not ic.uses_baby_steps(group(48))
+    assert pickle.loads(pickle.dumps(pre)).break_key(pow(grp.g, 777, grp.p), rng=2).s == 777
+
+
+@pytest.mark.parametrize("name", ["rho", "bsgs"])
+def test_generic_limits_count_the_bits_of_q_not_of_p(name: str) -> None:
+    grp = small_order_group(30, 79)
+    secret = 123456789 % grp.q
+    key = get_breaker(name, rng=1).precompute(grp).break_key(pow(grp.g, secret, grp.p))
+    assert key.s == secret
+    with pytest.raises(BreakerLimitError, match="30-bit q: its limit is 29 bits"):
+        get_breaker(name, max_bits=29).precompute(grp)
+
+
+def test_bsgs_checks_a_match_of_the_low_bits_beyond_64_bit_p() -> None:
+    # p > 2^64: the table keeps the low 64 bits of g^j; every key of the small group is found.
+    grp = small_order_group(12, 72)
+    pre = get_breaker("bsgs").precompute(grp)
+    assert all(pre.break_key(pow(grp.g, s, grp.p)).s == s for s in range(0, grp.q, 97))

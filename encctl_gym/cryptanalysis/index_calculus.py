@@ -57,12 +57,14 @@ from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, GroupError, ParameterError
 from .base import Breaker, Deadline, Precomputation, format_bytes
+from .bsgs import BabyStepGiantStep, BabyStepTable
 from .linalg import flint_backend, solve_mod_prime
 from .smoothness import RHO_MAX_U, FactorBase, check_bound, dickman_rho, rational_reconstruction
 
 __all__ = [
     "IndexCalculus",
     "FactorBaseLogs",
+    "SmallOrderLogs",
     "Relation",
     "collect_relations",
     "choose_bound",
@@ -96,6 +98,9 @@ MAX_MATRIX_BYTES = 4 * 2**30
 #: Share of the primes occurring in the relations whose logarithm must be determined.
 SOLVED_FRACTION = 0.97
 _CHECK_EVERY = 2048
+#: The relations need G to hold many more elements than trials: a q below this multiple of the
+#: expected trials is broken by baby-step giant-step (:meth:`IndexCalculus.uses_baby_steps`).
+SMALL_ORDER_FACTOR = 64
 
 
 #: Largest bit length of p the cost model takes (far beyond any group the package builds; it keeps
@@ -325,6 +330,31 @@ class FactorBaseLogs(Precomputation):
                 raise BreakerError(f"index-calculus: no smooth randomisation after {trials} trials for h = {format_int(h)}")
 
 
+class SmallOrderLogs(Precomputation):
+    """The precomputation of :class:`IndexCalculus` in a group whose order q is small: a
+    baby-step table (:class:`~.bsgs.BabyStepTable`) that breaks every key in about ``sqrt(q)``
+    steps.
+
+    Relations come from elements of G (``g^e`` and ``h g^r``), and G has only q elements: with
+    a q of a few thousand, G holds fewer smooth elements than the factor base has primes, and
+    no number of trials determines the logarithms. Baby-step giant-step needs no relations.
+    :meth:`IndexCalculus.uses_baby_steps` decides, from the two cost models.
+
+    Attributes
+    ----------
+    table : BabyStepTable
+        The baby steps of the group.
+    """
+
+    def __init__(self, group: GroupParams, table: BabyStepTable, rng: RandomSource | None) -> None:
+        super().__init__(IndexCalculus.name, group, rng)
+        self.table = table
+
+    def _solve(self, h: int, deadline: Deadline, src: RandomSource) -> tuple[int, Mapping[str, int], str]:
+        s, ops, _ = self.table._solve(h, deadline, src)
+        return s, ops, ""
+
+
 class IndexCalculus(Breaker):
     """Index calculus with a factor base, rational reconstruction and FLINT linear algebra.
 
@@ -359,8 +389,26 @@ class IndexCalculus(Breaker):
         bound = self.bound or choose_bound(group.bits)
         return max(2, min(bound, group.p - 1))
 
+    def _baby_steps(self, group: GroupParams) -> BabyStepGiantStep:
+        return BabyStepGiantStep(max_bits=group.q.bit_length(), rng=self.rng)
+
+    def uses_baby_steps(self, group: GroupParams) -> bool:
+        """True if G is too small to supply the relations: q below :data:`SMALL_ORDER_FACTOR`
+        times the smoothness trials the relations are expected to take (:func:`cost_model`),
+        where the walk over G would revisit its elements, and the baby-step table of
+        :mod:`.bsgs` fits. The precomputation is then a :class:`SmallOrderLogs`."""
+        bsgs = self._baby_steps(group)
+        if bsgs.table_size(group) > bsgs.max_table:
+            return False
+        model = cost_model(group.bits, self.factor_base_bound(group))
+        trials = model["trials_per_relation"] * (model["factor_base"] * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT)
+        return group.q < SMALL_ORDER_FACTOR * trials
+
     def expected_seconds(self, group: GroupParams) -> tuple[float, float]:
-        """``(first, per_key)`` of :func:`cost_model` at :meth:`factor_base_bound`."""
+        """``(first, per_key)`` of :func:`cost_model` at :meth:`factor_base_bound`, or of
+        baby-step giant-step when :meth:`uses_baby_steps`."""
+        if self.uses_baby_steps(group):
+            return self._baby_steps(group).expected_seconds(group)
         model = cost_model(group.bits, self.factor_base_bound(group))
         return model["first"], model["per_key"]
 
@@ -373,8 +421,10 @@ class IndexCalculus(Breaker):
 
     def check_feasible(self, group: GroupParams) -> None:
         """The limits of :class:`~.base.Breaker`, and the memory of the dense linear algebra
-        (:meth:`matrix_bytes` at most :data:`MAX_MATRIX_BYTES`)."""
+        (:meth:`matrix_bytes` at most :data:`MAX_MATRIX_BYTES`; none when :meth:`uses_baby_steps`)."""
         super().check_feasible(group)
+        if self.uses_baby_steps(group):
+            return
         need = self.matrix_bytes(group)
         if need > MAX_MATRIX_BYTES:
             bound = self.factor_base_bound(group)
@@ -391,7 +441,10 @@ class IndexCalculus(Breaker):
                 f"index-calculus needs an odd q that does not divide the cofactor (p - 1) / q; got q = {group.q}, cofactor = {n}"
             )
 
-    def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[FactorBaseLogs, Mapping[str, int]]:
+    def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[Precomputation, Mapping[str, int]]:
+        if self.uses_baby_steps(group):
+            table, ops = self._baby_steps(group)._precompute(group, deadline)
+            return SmallOrderLogs(group, table, self.rng), ops
         src = self.rng or arith.secure_random()
         clock = _PhaseClock()
         # Phase 1: the factor base.
