@@ -72,20 +72,26 @@ def solve_mod_prime(rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols
         return [None] * ncols, 0
     pos = {j: i for i, j in enumerate(used)}
     width = len(used) + 1
-    entries = [0] * (len(rows) * width)
+    # Built entry by entry into a zero matrix: the rows are sparse (a dozen entries of a few
+    # thousand), and a full list of Python integers costs more than the elimination.
+    if q < _WORD:
+        mat = flint.nmod_mat(len(rows), width, q)
+    else:
+        mat = flint.fmpz_mod_mat(len(rows), width, flint.fmpz_mod_ctx(q))
     for i, (row, r) in enumerate(zip(rows, rhs)):
-        base = i * width
         for j, c in row.items():
             if c % q:
-                entries[base + pos[j]] = c % q
-        entries[base + width - 1] = r % q
-    if q < _WORD:
-        mat = flint.nmod_mat(len(rows), width, entries, q)
-    else:
-        mat = flint.fmpz_mod_mat(len(rows), width, entries, flint.fmpz_mod_ctx(q))
+                mat[i, pos[j]] = c % q
+        mat[i, width - 1] = r % q
     reduced, rank = mat.rref()
-    values = [int(v) for v in reduced.entries()]
     solution: list[int | None] = [None] * ncols
+    if rank == width - 1 and int(reduced[rank - 1, width - 2]) == 1:
+        # Full column rank (the last pivot is in the last unknown's column, not in the right-hand
+        # side's): the reduced form is [I | x] above zero rows, every unknown determined.
+        for i, j in enumerate(used):
+            solution[j] = int(reduced[i, width - 1])
+        return solution, rank
+    values = [int(v) for v in reduced.entries()]
     pivots = []
     for i in range(rank):
         reduced_row = values[i * width : (i + 1) * width]
