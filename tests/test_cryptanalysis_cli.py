@@ -14,7 +14,7 @@ from hypothesis import given, settings, strategies as st
 
 from encctl_gym.cli import SUBCOMMANDS, main
 from encctl_gym.cryptanalysis import pari_available
-from encctl_gym.cryptanalysis.index_calculus import choose_bound, cost_model, relation_probability
+from encctl_gym.cryptanalysis.index_calculus import choose_bound, cost_model, relation_probability, sieve_probability
 from encctl_gym.cryptanalysis.linalg import solve_mod_prime
 from encctl_gym.cryptanalysis.smoothness import FactorBase, dickman_rho, primes_up_to, rational_reconstruction
 from encctl_gym.errors import ParameterError
@@ -200,7 +200,7 @@ def test_cost_model_is_consistent() -> None:
         model = cost_model(bits, bound)
         assert model["first"] == pytest.approx(model["relations"] + model["linear_algebra"] + model["descent"])
         assert model["per_key"] < 0.05 * model["first"]
-        assert 1 / model["trials_per_relation"] == pytest.approx(relation_probability(bits, bound))
+        assert 1 / model["cells_per_relation"] == pytest.approx(sieve_probability(bits, bound))
     assert choose_bound(96) > choose_bound(64) > choose_bound(32)
 
 

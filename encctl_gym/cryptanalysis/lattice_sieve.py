@@ -62,15 +62,25 @@ class SievePlan:
         The region ``1 <= i <= rows``, ``-half_width <= j < half_width``.
     max_power : int
         Prime powers ``l^e`` up to this bound are sieved too (``l`` itself always).
+    skip_below : int
+        Moduli below this are not sieved (they hit every few cells and cost the most additions
+        for the fewest bits); :attr:`skipped_bits`, their mean share of a smooth number, is
+        added to the slack.
     """
 
-    def __init__(self, primes: tuple[int, ...], rows: int, half_width: int, max_power: int = 1 << 16) -> None:
+    def __init__(
+        self, primes: tuple[int, ...], rows: int, half_width: int, max_power: int = 1 << 16, skip_below: int = 32
+    ) -> None:
         moduli, logs = [], []
+        self.skipped_bits = 0.0
         for ell in primes:
             m = ell
             while True:
-                moduli.append(m)
-                logs.append(math.log2(ell))
+                if m >= skip_below:
+                    moduli.append(m)
+                    logs.append(math.log2(ell))
+                else:
+                    self.skipped_bits += math.log2(ell) / m * (1 - 1 / ell)  # E[bits of l in x] from l^e alone
                 if m * ell > max_power:
                     break
                 m *= ell
@@ -124,7 +134,9 @@ def _roots(r1: np.ndarray, r2: np.ndarray, moduli: np.ndarray, out: np.ndarray) 
 
 
 @njit(cache=True)
-def _add_row(acc: np.ndarray, i: int, roots: np.ndarray, moduli: np.ndarray, logs: np.ndarray, half: int) -> None:
+def _add_row(acc: np.ndarray, offsets: np.ndarray, roots: np.ndarray, moduli: np.ndarray, logs: np.ndarray) -> None:
+    # Adds log2 l at every index t = offsets[k] (mod m), then moves each offset on by its root
+    # (row i + 1 has the root (i + 1) root_1): no division in the loop over the moduli.
     width = len(acc)
     for k in range(len(moduli)):
         root = roots[k]
@@ -136,8 +148,13 @@ def _add_row(acc: np.ndarray, i: int, roots: np.ndarray, moduli: np.ndarray, log
                 acc[t] += w
             continue
         m = moduli[k]
-        for t in range((i * root + half) % m, width, m):  # j = t - half = i root (mod m)
+        start = offsets[k]
+        for t in range(start, width, m):
             acc[t] += w
+        start += root
+        if start >= m:
+            start -= m
+        offsets[k] = start
 
 
 @njit(cache=True)
@@ -165,13 +182,18 @@ def _sieve(
     root_b = np.empty(len(moduli), dtype=np.int64)
     _roots(ra1, ra2, moduli, root_a)
     _roots(rb1, rb2, moduli, root_b)
+    off_a = np.empty(len(moduli), dtype=np.int64)
+    off_b = np.empty(len(moduli), dtype=np.int64)
+    for k in range(len(moduli)):  # row i = 1: j = root, at index root + half
+        off_a[k] = (max(root_a[k], 0) + half) % moduli[k]
+        off_b[k] = (max(root_b[k], 0) + half) % moduli[k]
     found = 0
     cap = len(out_i)
     for i in range(1, rows + 1):
         sa[:] = 0.0
         sb[:] = 0.0
-        _add_row(sa, i, root_a, moduli, logs, half)
-        _add_row(sb, i, root_b, moduli, logs, half)
+        _add_row(sa, off_a, root_a, moduli, logs)
+        _add_row(sb, off_b, root_b, moduli, logs)
         # Cheap filter first: a cell within 2^-12 of the row's largest |a| (or |b|) needs a sum
         # of at least log2(max) - 12 - slack; only those get the exact threshold.
         big_a = max(abs(i * fa1 - half * fa2), abs(i * fa1 + half * fa2))
@@ -202,6 +224,7 @@ def sieve_candidates(y: int, p: int, plan: SievePlan, slack: float) -> tuple[tup
     out_i = np.empty(cap, dtype=np.int64)
     out_j = np.empty(cap, dtype=np.int64)
     mod = plan.moduli
+    slack = slack + plan.skipped_bits
     found = _sieve(
         _residues(a1, mod),
         _residues(a2, mod),
@@ -219,5 +242,7 @@ def sieve_candidates(y: int, p: int, plan: SievePlan, slack: float) -> tuple[tup
         out_i,
         out_j,
     )
-    pairs = [(int(i), int(j)) for i, j in zip(out_i[: min(found, cap)], out_j[: min(found, cap)]) if math.gcd(int(i), int(j)) == 1]
+    pairs = [
+        (int(i), int(j)) for i, j in zip(out_i[: min(found, cap)], out_j[: min(found, cap)]) if math.gcd(int(i), int(j)) == 1
+    ]
     return (a1, b1, a2, b2), pairs

@@ -85,12 +85,24 @@ def solve_mod_prime(rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols
         mat[i, width - 1] = r % q
     reduced, rank = mat.rref()
     solution: list[int | None] = [None] * ncols
-    if rank == width - 1 and int(reduced[rank - 1, width - 2]) == 1:
-        # Full column rank (the last pivot is in the last unknown's column, not in the right-hand
-        # side's): the reduced form is [I | x] above zero rows, every unknown determined.
-        for i, j in enumerate(used):
-            solution[j] = int(reduced[i, width - 1])
-        return solution, rank
+    # Only the entries needed are read back (reading the whole reduced matrix costs half as
+    # much as the elimination): the leading column of each nonzero row, found by one scan since
+    # they increase, then each pivot row's entries in the free columns and its right-hand side.
+    leads: list[int] = []
+    lead = 0
+    for i in range(rank):
+        while int(reduced[i, lead]) == 0:
+            lead += 1
+        leads.append(lead)
+        lead += 1
+    if leads and leads[-1] == width - 1:
+        raise BreakerError("the relations are inconsistent modulo q (a wrong relation)")
+    pivot_cols = set(leads)
+    free = [k for k in range(width - 1) if k not in pivot_cols]
+    for i, lead in enumerate(leads):
+        if all(int(reduced[i, k]) == 0 for k in free):  # this unknown does not depend on a free one
+            solution[used[lead]] = int(reduced[i, width - 1])
+    return solution, rank
     values = [int(v) for v in reduced.entries()]
     pivots = []
     for i in range(rank):
