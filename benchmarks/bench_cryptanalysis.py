@@ -29,12 +29,12 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from encctl_gym.crypto import arith
-from encctl_gym.crypto.group import generate_safe_prime_group
 from encctl_gym.cryptanalysis import bsgs, index_calculus, pari_available, rho
 from encctl_gym.cryptanalysis.cli import key_sequence
 from encctl_gym.cryptanalysis.registry import get_breaker
 from encctl_gym.cryptanalysis.sequence import break_sequence
+from encctl_gym.crypto import arith
+from encctl_gym.crypto.group import generate_safe_prime_group
 
 GENERIC = ("bsgs", "rho", "rho-multi")
 
@@ -49,8 +49,9 @@ def calibrate() -> None:
     print(f"rho: {step * 1e9:.0f} ns per walk step (documented rho.SECONDS_PER_STEP = {rho.SECONDS_PER_STEP * 1e9:.0f} ns)")
     table = get_breaker("bsgs").precompute(grp)
     per_baby = table.cost.cpu_seconds / table.m
-    print(f"bsgs: {per_baby * 1e9:.0f} ns per baby step (documented bsgs.SECONDS_PER_STEP = "
-          f"{bsgs.SECONDS_PER_STEP * 1e9:.0f} ns)")
+    print(
+        f"bsgs: {per_baby * 1e9:.0f} ns per baby step (documented bsgs.SECONDS_PER_STEP = {bsgs.SECONDS_PER_STEP * 1e9:.0f} ns)"
+    )
     get_breaker("index-calculus", rng=1).precompute(generate_safe_prime_group(40, rng=1))  # load the compiled sieve
     for bits in (64, 80):
         grp = generate_safe_prime_group(bits, rng=1)
@@ -61,10 +62,20 @@ def calibrate() -> None:
         phases = pre.phase_cpu_seconds
         rows, half = index_calculus.sieve_region(bits)
         cell = phases["relations"] / (pre.cost.operations["sieved_lattices"] * 2 * rows * half)
-        print(f"index-calculus {bits} bits (B = {bound}): {cell * 1e9:.2f} ns per sieved cell (documented "
-              f"CELL_SECONDS = {index_calculus.CELL_SECONDS * 1e9:.2f} ns); relations {phases['relations']:.2f} s (model "
-              f"{model['relations']:.2f} s), linear algebra {phases['linear_algebra']:.2f} s (model "
-              f"{model['linear_algebra']:.2f} s)")
+        print(
+            f"index-calculus {bits} bits (B = {bound}): {cell * 1e9:.2f} ns per sieved cell (documented "
+            f"CELL_SECONDS = {index_calculus.CELL_SECONDS * 1e9:.2f} ns); relations {phases['relations']:.2f} s (model "
+            f"{model['relations']:.2f} s), linear algebra {phases['linear_algebra']:.2f} s (model "
+            f"{model['linear_algebra']:.2f} s)"
+        )
+
+
+def _med(values: list[float]) -> float:
+    return float(statistics.median(values))
+
+
+def _span(values: list[float]) -> str:
+    return f"{_med(values):.3g} [{min(values):.3g}, {max(values):.3g}]"
 
 
 def bench(sizes: list[int], keys: int, repeats: int = 1, only: list[str] | None = None) -> list[dict]:
@@ -77,12 +88,16 @@ def bench(sizes: list[int], keys: int, repeats: int = 1, only: list[str] | None 
     if only:
         breakers = [b for b in breakers if b in only]
     if not pari_available():
-        print("cypari is not installed: ratios are against the index calculus instead of PARI "
-              "(pip install 'encctl-gym[cryptanalysis]')")
+        print(
+            "cypari is not installed: ratios are against the index calculus instead of PARI "
+            "(pip install 'encctl-gym[cryptanalysis]')"
+        )
     reference = breakers[0]
     rows = []
-    print(f"{'bits':>5} {'breaker':<15} {'T_first (s)':>12} {'T_1 (s)':>12} {'T_first/ref':>22} {'T_1/ref':>22}"
-          f"   (ref = {reference}, same keys, paired within each of {repeats} repeat(s); median [min, max])")
+    print(
+        f"{'bits':>5} {'breaker':<15} {'T_first (s)':>12} {'T_1 (s)':>12} {'T_first/ref':>22} {'T_1/ref':>22}"
+        f"   (ref = {reference}, same keys, paired within each of {repeats} repeat(s); median [min, max])"
+    )
     for bits in sizes:
         runs: dict[str, list[tuple[float, float]]] = {}
         for rep in range(repeats):
@@ -92,8 +107,9 @@ def bench(sizes: list[int], keys: int, repeats: int = 1, only: list[str] | None 
                 if name in GENERIC and bits > 44:
                     continue
                 kwargs = {"inner": "index-calculus"} if name == "token-chain" else {}
-                report = break_sequence(get_breaker(name, rng=2 + rep, **kwargs), grp, hs,
-                                        tokens=tokens if name == "token-chain" else None)
+                report = break_sequence(
+                    get_breaker(name, rng=2 + rep, **kwargs), grp, hs, tokens=tokens if name == "token-chain" else None
+                )
                 assert report.secrets == secrets  # every key recovered and checked (g^s = h)
                 t = report.key_seconds("cpu")
                 runs.setdefault(name, []).append((report.precomputation.cpu_seconds + t[0], float(t[1:].mean())))
@@ -101,14 +117,24 @@ def bench(sizes: list[int], keys: int, repeats: int = 1, only: list[str] | None 
         for name, times in runs.items():
             first = [f / r[0] for (f, _), r in zip(times, ref)]
             later = [k / r[1] for (_, k), r in zip(times, ref)]
-            med = lambda v: float(statistics.median(v))  # noqa: E731
-            span = lambda v: f"{med(v):.3g} [{min(v):.3g}, {max(v):.3g}]"  # noqa: E731
-            print(f"{bits:>5} {name:<15} {med([t[0] for t in times]):12.4g} {med([t[1] for t in times]):12.4g} "
-                  f"{span(first):>22} {span(later):>22}")
-            rows.append({"bits": bits, "breaker": name, "reference": reference,
-                         "first_s": med([t[0] for t in times]), "per_key_s": med([t[1] for t in times]),
-                         "first_ratio": med(first), "per_key_ratio": med(later),
-                         "first_ratios": first, "per_key_ratios": later, "repeats": repeats})
+            print(
+                f"{bits:>5} {name:<15} {_med([t[0] for t in times]):12.4g} {_med([t[1] for t in times]):12.4g} "
+                f"{_span(first):>22} {_span(later):>22}"
+            )
+            rows.append(
+                {
+                    "bits": bits,
+                    "breaker": name,
+                    "reference": reference,
+                    "first_s": _med([t[0] for t in times]),
+                    "per_key_s": _med([t[1] for t in times]),
+                    "first_ratio": _med(first),
+                    "per_key_ratio": _med(later),
+                    "first_ratios": first,
+                    "per_key_ratios": later,
+                    "repeats": repeats,
+                }
+            )
         sys.stdout.flush()
     return rows
 
@@ -136,11 +162,18 @@ def main() -> int:
 
         largest = max(r["bits"] for r in rows)
         ic = next(r for r in rows if r["bits"] == largest and r["breaker"] == "index-calculus")
-        write("bench_cryptanalysis", {"rows": rows}, [
-            (f"index calculus vs {ic['reference']} at {largest} bits (same keys, CPU time)",
-             f"first key {ic['first_s']:.3g} s ({ic['first_ratio']:.2g}x), each further key {ic['per_key_s'] * 1e3:.3g} ms "
-             f"({ic['per_key_ratio']:.2g}x)"),
-        ], sys.argv[1:])
+        write(
+            "bench_cryptanalysis",
+            {"rows": rows},
+            [
+                (
+                    f"index calculus vs {ic['reference']} at {largest} bits (same keys, CPU time)",
+                    f"first key {ic['first_s']:.3g} s ({ic['first_ratio']:.2g}x), each further key {ic['per_key_s'] * 1e3:.3g} ms "
+                    f"({ic['per_key_ratio']:.2g}x)",
+                )
+            ],
+            sys.argv[1:],
+        )
     return 0
 
 
