@@ -302,7 +302,7 @@ def test_time_limit_stops_a_breaker_with_a_clear_error() -> None:
     with pytest.raises(BreakerTimeoutError, match="precomputation"):
         IndexCalculus(rng=1).precompute(group(90), time_limit=0.05)
     with pytest.raises(BreakerTimeoutError, match="before its linear algebra"):
-        IndexCalculus(rng=1, bound=30000).precompute(group(40), time_limit=2.0)  # 3245 unknowns: ~13 s
+        IndexCalculus(rng=1, bound=60000).precompute(group(40), time_limit=2.0)  # 6057 unknowns: ~3.7 s
     with pytest.raises(ParameterError):
         Deadline(-1.0, "x")
     assert issubclass(BreakerTimeoutError, (BreakerError, TimeoutError))
@@ -424,12 +424,14 @@ def test_index_calculus_refuses_a_factor_base_beyond_its_memory_limits() -> None
         IndexCalculus(bound=10**12)
     assert "1000000000000" in str(err.value)
     grp = group(32)
-    ic = IndexCalculus(bound=100_000)
-    # Independently: pi(10^5) = 9592 unknowns, (1.05 * 9592 + 20) rows of 9593 entries.
-    k = int(sympy.primepi(100_000))
-    assert k == 9592
-    assert ic.matrix_bytes(grp) == pytest.approx((1.05 * k + 20) * (k + 1) * MATRIX_BYTES_PER_ENTRY, rel=0.01)
-    with pytest.raises(BreakerLimitError, match="bound 100000") as err:
+    ic = IndexCalculus(bound=400_000)
+    # Independently: pi(4 10^5) = 33860 unknowns; the dense core keeps 0.4 of the (1.05 k + 20)
+    # rows and of the k unknowns (plus the right-hand side).
+    k = int(sympy.primepi(400_000))
+    assert k == 33860
+    core = 0.4 * (1.05 * k + 20) * (0.4 * k + 1) * MATRIX_BYTES_PER_ENTRY
+    assert ic.matrix_bytes(grp) == pytest.approx(core, rel=0.01)
+    with pytest.raises(BreakerLimitError, match="bound 400000") as err:
         ic.precompute(grp)
     assert "MAX_MATRIX_BYTES" in str(err.value) and ic.matrix_bytes(grp) > MAX_MATRIX_BYTES
     assert MAX_BOUND == 2**24 and IndexCalculus(bound=MAX_BOUND).bound == MAX_BOUND

@@ -82,17 +82,19 @@ __all__ = [
 #: Calibration of the cost model, measured on this machine (2 cores, Python 3.11, numba 0.68,
 #: python-flint 0.9; ``python benchmarks/bench_cryptanalysis.py`` prints current values):
 #: seconds per cell of the lattice sieve (:mod:`.lattice_sieve`; both sieves of a row, the
-#: threshold pass and the exact tests of the candidates), at 80 bits ...
-CELL_SECONDS = 5.2e-9
-#: ... the share of the smooth pairs the sieve reports (its slack misses pairs whose prime
-#: powers above 2^16 or rounding leave the sum short; measured at 80 bits, B = 6316) ...
-SIEVE_YIELD = 0.6
-#: ... and seconds per k^3 of the dense elimination (k unknowns), for word-size q and larger q.
-LINALG_WORD = 2.5e-10
-LINALG_MULTI = 1.0e-9
-#: Seconds per nonzero entry written into the FLINT matrix (about ROW_ENTRIES per relation).
-MATRIX_ENTRY = 3.0e-6
-ROW_ENTRIES = 15
+#: threshold pass and the exact tests of the candidates), at 80 and 96 bits ...
+CELL_SECONDS = 6.0e-9
+#: ... the share of the model's smooth pairs the sieve reports and finds smooth (its slack of
+#: 0.8 log2 B misses pairs whose sum falls short; Dickman's rho also overrates numbers of
+#: this size; measured at 80 and 96 bits, B = 8192 and 21247) ...
+SIEVE_YIELD = 0.33
+#: ... and the linear algebra (:func:`~.linalg.solve_mod_prime`, structured elimination then
+#: the dense core) as ``LINALG_* k^3 + ELIMINATION_PER_UNKNOWN k``, k unknowns, fitted at
+#: 80 and 96 bits to k = 704 ... 2660 (0.11 s to 1.4 s) for q above a machine word; the cube
+#: term is a quarter of that for word-size q (FLINT's nmod_mat).
+LINALG_WORD = 1.2e-11
+LINALG_MULTI = 4.8e-11
+ELIMINATION_PER_UNKNOWN = 1.8e-4
 
 #: Relations collected beyond the number of unknowns (fraction, plus a constant).
 EXTRA_FRACTION = 0.05
@@ -101,8 +103,12 @@ EXTRA_CONSTANT = 20
 #: Python entry list, the FLINT matrix, its echelon form and the entries read back), measured for
 #: a 2120 x 2001 system with a 61-bit q: 91 bytes.
 MATRIX_BYTES_PER_ENTRY = 91
+#: Share of the rows and of the unknowns left to the dense elimination by the structured one
+#: (:func:`~.linalg.structured_elimination`): measured 0.38 of the rows and 0.30 of the unknowns
+#: at 80 and 96 bits; 0.4 for both, with a margin.
+CORE_FRACTION = 0.4
 #: Largest expected peak memory of the linear algebra (bytes): 4 GiB. The default bound of a
-#: 128-bit group (6547 unknowns, about 3.8 GiB) fits.
+#: 128-bit group (about 9700 unknowns, a core of about 1.3 GiB) fits.
 MAX_MATRIX_BYTES = 4 * 2**30
 #: Share of the primes occurring in the relations whose logarithm must be determined.
 SOLVED_FRACTION = 0.97
@@ -176,7 +182,7 @@ def cost_model(bits: int, bound: float) -> dict[str, float]:
     dict
         ``factor_base`` (k, the number of unknowns), ``cells_per_relation`` (sieved cells, the
         inverse of :func:`sieve_probability`), ``relations`` (seconds of phase 2),
-        ``linear_algebra`` (phase 3, dense elimination and the matrix build), ``descent``
+        ``linear_algebra`` (phase 3, structured and dense elimination), ``descent``
         (phase 4, per key: at least one residue's region), ``first`` (phases 2-4) and
         ``per_key``.
     """
@@ -186,7 +192,7 @@ def cost_model(bits: int, bound: float) -> dict[str, float]:
     rows, half = sieve_region(bits)
     relations = (k * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT) * cells * CELL_SECONDS
     cube = LINALG_WORD if bits <= 64 else LINALG_MULTI
-    linear = cube * k**3 + MATRIX_ENTRY * ROW_ENTRIES * k
+    linear = cube * k**3 + ELIMINATION_PER_UNKNOWN * k
     descent = max(cells, 2 * rows * half) * CELL_SECONDS
     return {
         "factor_base": k,
@@ -465,11 +471,13 @@ class IndexCalculus(Breaker):
         return model["first"], model["per_key"]
 
     def matrix_bytes(self, group: GroupParams) -> float:
-        """Expected peak memory of the first linear algebra (bytes): ``k (1 + EXTRA_FRACTION) +
-        EXTRA_CONSTANT`` rows of ``k + 1`` entries, k the (estimated) size of the factor base, at
+        """Expected peak memory of the first linear algebra (bytes): the dense core of
+        :data:`CORE_FRACTION` of ``k (1 + EXTRA_FRACTION) + EXTRA_CONSTANT`` rows and of ``k``
+        unknowns (plus the right-hand side), k the (estimated) size of the factor base, at
         :data:`MATRIX_BYTES_PER_ENTRY` each."""
         k = _prime_count(self.factor_base_bound(group))
-        return (k * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT) * (k + 1) * MATRIX_BYTES_PER_ENTRY
+        rows = CORE_FRACTION * (k * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT)
+        return rows * (CORE_FRACTION * k + 1) * MATRIX_BYTES_PER_ENTRY
 
     def check_feasible(self, group: GroupParams) -> None:
         """The limits of :class:`~.base.Breaker`, and the memory of the dense linear algebra

@@ -153,14 +153,16 @@ def solve_mod_prime(rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols
     rows, rhs, pivots = structured_elimination(rows, rhs, q)
     solution, rank = _solve_dense(flint, rows, rhs, ncols, q)
     for col, prow, r in reversed(pivots):  # back-substitution, latest pivot first
-        rest = [(j, c) for j, c in prow.items() if j != col]
-        if all(solution[j] is not None for j, _ in rest):
-            total = sum(c * solution[j] for j, c in rest)  # type: ignore[operator]
+        known = [(c, solution[j]) for j, c in prow.items() if j != col]
+        if all(v is not None for _, v in known):
+            total = sum(c * v for c, v in known if v is not None)
             solution[col] = (r - total) * pow(prow[col], -1, q) % q
     return solution, rank + len(pivots)
 
 
-def _solve_dense(flint, rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols: int, q: int) -> tuple[list[int | None], int]:
+def _solve_dense(
+    flint, rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols: int, q: int
+) -> tuple[list[int | None], int]:
     # The dense elimination of a (reduced) system with FLINT: every unknown it determines.
     used = sorted({j for row in rows for j, c in row.items() if c % q})
     if not used:
