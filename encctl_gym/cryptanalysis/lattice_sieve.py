@@ -34,8 +34,9 @@ __all__ = ["reduced_basis", "SievePlan", "sieve_candidates"]
 def reduced_basis(y: int, p: int) -> tuple[int, int, int, int]:
     """A Lagrange-reduced basis ``(a1, b1, a2, b2)`` of ``{(a, b): a = b y (mod p)}``.
 
-    Both vectors have Euclidean length at most about ``sqrt(4 p / 3)`` (a reduced basis of a
-    2-dimensional lattice of determinant p), and ``a1 b2 - a2 b1 = +-p``.
+    ``|v1| <= |v2|`` and ``2 |v1 . v2| <= |v1|^2``, so ``|v1|^2 <= 4 p / 3`` and
+    ``|v1| |v2| <= 2 p / sqrt(3)`` (the lattice has determinant ``a1 b2 - a2 b1 = +-p``): for a
+    random y both lengths are about ``sqrt(p)``.
     """
     u0, u1, v0, v1 = p, 0, y % p, 1
     nu, nv = u0 * u0 + u1 * u1, v0 * v0 + v1 * v1
