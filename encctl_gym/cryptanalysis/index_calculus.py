@@ -411,7 +411,7 @@ class SmallOrderLogs(Precomputation):
 
 
 class IndexCalculus(Breaker):
-    """Index calculus with a factor base, rational reconstruction and FLINT linear algebra.
+    """Index calculus with a factor base, a lattice sieve and FLINT linear algebra.
 
     See the module docstring for the logarithms solved for and the phases.
 
@@ -422,8 +422,8 @@ class IndexCalculus(Breaker):
         :func:`choose_bound` for the group's size); a bound whose linear algebra would need more
         than :data:`MAX_MATRIX_BYTES` is refused by :meth:`check_feasible`.
     max_bits : int, optional
-        Size limit (default 112 bits: about six minutes and a dense matrix of about 3500 x 3500
-        on this machine; at most 128, where the halves a and b still fit in 64 bits).
+        Size limit (default 112 bits: about 35 s for the first key on this machine, a factor
+        base of about 5200 primes; at most 128).
     rng
         See :class:`~encctl_gym.cryptanalysis.base.Breaker`.
     """
