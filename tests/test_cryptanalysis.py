@@ -302,7 +302,9 @@ def test_time_limit_stops_a_breaker_with_a_clear_error() -> None:
     with pytest.raises(BreakerTimeoutError, match="precomputation"):
         IndexCalculus(rng=1).precompute(group(90), time_limit=0.05)
     with pytest.raises(BreakerTimeoutError, match="before its linear algebra"):
-        IndexCalculus(rng=1, bound=60000).precompute(group(40), time_limit=2.0)  # 6057 unknowns: ~3.7 s
+        # 13848 unknowns: relations in seconds, the linear algebra above 33 s by the model
+        # (about 34 s), so it is refused whenever the relations finish within the limit.
+        IndexCalculus(rng=1, bound=150_000).precompute(group(40), time_limit=33.0)
     with pytest.raises(ParameterError):
         Deadline(-1.0, "x")
     assert issubclass(BreakerTimeoutError, (BreakerError, TimeoutError))
