@@ -14,7 +14,7 @@ from hypothesis import given, settings, strategies as st
 
 from encctl_gym.cli import SUBCOMMANDS, main
 from encctl_gym.cryptanalysis import pari_available
-from encctl_gym.cryptanalysis.index_calculus import choose_bound, cost_model, relation_probability
+from encctl_gym.cryptanalysis.index_calculus import choose_bound, cost_model, relation_probability, sieve_probability
 from encctl_gym.cryptanalysis.linalg import solve_mod_prime
 from encctl_gym.cryptanalysis.smoothness import FactorBase, dickman_rho, primes_up_to, rational_reconstruction
 from encctl_gym.errors import ParameterError
@@ -200,7 +200,7 @@ def test_cost_model_is_consistent() -> None:
         model = cost_model(bits, bound)
         assert model["first"] == pytest.approx(model["relations"] + model["linear_algebra"] + model["descent"])
         assert model["per_key"] < 0.05 * model["first"]
-        assert 1 / model["trials_per_relation"] == pytest.approx(relation_probability(bits, bound))
+        assert 1 / model["cells_per_relation"] == pytest.approx(sieve_probability(bits, bound))
     assert choose_bound(96) > choose_bound(64) > choose_bound(32)
 
 
@@ -412,3 +412,60 @@ def test_solve_mod_prime_refuses_a_bad_modulus_or_column() -> None:
     with pytest.raises(ParameterError, match="ncols must be an integer"):
         solve_mod_prime([{0: 1}], [1], 1.5, 7)
     assert solve_mod_prime([{0: 3}], [1], 1, 7) == ([5], 1)  # 3 x = 1 (mod 7): x = 5
+
+
+def test_structured_elimination_keeps_the_solutions_and_the_excess() -> None:
+    from encctl_gym.cryptanalysis.linalg import _flint, _solve_dense, structured_elimination
+
+    q = 1_000_003
+    rng = random.Random(7)
+    ncols = 60
+    x = [rng.randrange(q) for _ in range(ncols)]
+    # Sparse rows, light columns at the end (as the large primes of a factor base).
+    rows = []
+    for _ in range(70):
+        cols = {rng.randrange(10) for _ in range(3)} | {rng.randrange(ncols) for _ in range(2)}
+        rows.append({j: rng.choice([-2, -1, 1, 2, 3]) for j in cols})
+    rhs = [sum(c * x[j] for j, c in row.items()) % q for row in rows]
+    core, core_rhs, pivots = structured_elimination(rows, rhs, q)
+    assert pivots and len(core) + len(pivots) == len(rows)  # one row per eliminated column
+    eliminated = {col for col, _, _ in pivots}
+    assert not eliminated & {j for row in core for j in row}
+    for row, r in zip(core, core_rhs):  # the core holds for the true solution
+        assert sum(c * x[j] for j, c in row.items()) % q == r
+    # The same answer as the dense elimination of the whole system, and every value true.
+    sol, rank = solve_mod_prime(rows, rhs, ncols, q)
+    dense, dense_rank = _solve_dense(_flint(), rows, rhs, ncols, q)
+    assert rank == dense_rank
+    assert all(v is None or v == x[j] for j, v in enumerate(sol))
+    assert [v is not None for v in sol] == [v is not None for v in dense]
+
+
+def test_lattice_sieve_pairs_satisfy_the_congruence() -> None:
+    import gmpy2
+
+    from encctl_gym.cryptanalysis.lattice_sieve import SievePlan, reduced_basis, sieve_candidates
+
+    p = int(gmpy2.next_prime(1 << 61))
+    for y in (2, 12345678901, p - 1):
+        a1, b1, a2, b2 = reduced_basis(y, p)
+        assert abs(a1 * b2 - a2 * b1) == p  # a basis of the lattice of determinant p
+        assert (a1 - b1 * y) % p == 0 and (a2 - b2 * y) % p == 0
+        n1, n2, dot = a1 * a1 + b1 * b1, a2 * a2 + b2 * b2, a1 * a2 + b1 * b2
+        assert n1 <= n2 and 2 * abs(dot) <= n1  # Lagrange-reduced
+        assert 3 * n1 <= 4 * p and 3 * n1 * n2 <= 4 * p * p  # Hermite's bound in dimension 2
+    plan = SievePlan(primes_up_to(5000), 8, 256)
+    fb = FactorBase(5000)
+    y = 98765432123
+    (a1, b1, a2, b2), pairs = sieve_candidates(y, p, plan, slack=12.0)
+    assert pairs and all(1 <= i <= 8 and -256 <= j < 256 and math.gcd(i, j) == 1 for i, j in pairs)
+    # Every smooth pair of the region (found by exact tests) is among the candidates of a
+    # sieve with a generous slack; with no slack at all only candidates that are smooth remain.
+    smooth = {
+        (i, j)
+        for i in range(1, 9)
+        for j in range(-256, 256)
+        if math.gcd(i, j) == 1 and fb.is_smooth(i * a1 + j * a2 or 1) and fb.is_smooth(i * b1 + j * b2 or 1)
+        and i * a1 + j * a2 and i * b1 + j * b2
+    }
+    assert smooth and smooth <= set(sieve_candidates(y, p, plan, slack=40.0)[1])

@@ -307,8 +307,11 @@ class Breaker(abc.ABC):
 
     #: Registry name.
     name: ClassVar[str] = ""
-    #: Default size limit (bits of p).
+    #: Default size limit (bits of p, or of q when :attr:`LIMIT_COUNTS_Q`).
     DEFAULT_MAX_BITS: ClassVar[int] = 0
+    #: Whether :attr:`max_bits` counts the bits of q (generic attacks, whose cost depends on q
+    #: only) rather than of p.
+    LIMIT_COUNTS_Q: ClassVar[bool] = False
     #: Set by breakers that need a process's main thread (PARI).
     MAIN_THREAD_ONLY: ClassVar[bool] = False
     #: The constructor option that takes another breaker (the token chain's ``inner``): the
@@ -338,11 +341,13 @@ class Breaker(abc.ABC):
         BreakerLimitError
             Naming the limit and the expected time of the first key.
         """
-        if group.bits > self.max_bits:
+        size = group.q.bit_length() if self.LIMIT_COUNTS_Q else group.bits
+        if size > self.max_bits:
             first, per_key = self.expected_seconds(group)
+            what = f"a {group.bits}-bit group with a {size}-bit q" if self.LIMIT_COUNTS_Q else f"a {group.bits}-bit group"
             raise BreakerLimitError(
-                f"breaker {self.name!r} refuses a {group.bits}-bit group: its limit is {self.max_bits} bits "
-                f"(max_bits); expected time on this machine about {format_seconds(first)} for the first key "
+                f"breaker {self.name!r} refuses {what}: its limit is {self.max_bits} bits "
+                f"({'of q, ' if self.LIMIT_COUNTS_Q else ''}max_bits); expected time on this machine about {format_seconds(first)} for the first key "
                 f"and {format_seconds(per_key)} for each later one"
             )
         first, per_key = self.expected_seconds(group)

@@ -8,8 +8,11 @@ So the first key of a group costs about 1.5 m group operations, each later one a
 even the oldest generic attack amortises over a dynamic-key sequence (Example ex:dyn_elgamal),
 with ``T_1 / T_first`` near 1/3.
 
-Residues are stored exactly as unsigned 64-bit integers, so the breaker is limited to
-p < 2^64 (and by default to 56 bits, where the table holds 2^27.5 entries: about 3 GB).
+The table stores the low 64 bits of each residue (the residue itself when p < 2^64), so p may
+be of any size; a match of the low bits is checked with ``g^s = h`` before it is returned (for
+p >= 2^64 two residues may share their low bits). The cost depends on q only, so the size limit
+counts the bits of q (by default 56, where the table would hold 2^28 entries, 4 GB: the
+table limit ``max_table`` refuses it first).
 """
 
 from __future__ import annotations
@@ -37,13 +40,16 @@ SECONDS_PER_STEP = 3.0e-7
 _CHUNK = 1 << 14
 
 
+_LOW = (1 << 64) - 1
+
+
 def _powers(y: Any, step: Any, p: Any, n: int) -> tuple[np.ndarray, Any]:
-    """``y, y step, ..., y step^(n-1)`` modulo p as uint64 (p below 2^64), and ``y step^n``:
+    """The low 64 bits of ``y, y step, ..., y step^(n-1)`` modulo p (uint64), and ``y step^n``:
     the baby steps of the table, or the giant steps of a key."""
     out: list[Any] = []
     append = out.append
     for _ in range(n):
-        append(int(y))
+        append(int(y) & _LOW)
         y = y * step % p
     return np.array(out, dtype=np.uint64), y
 
@@ -56,7 +62,7 @@ class BabyStepTable(Precomputation):
     m : int
         Number of baby steps.
     residues, exponents : numpy.ndarray
-        ``g^j mod p`` (uint64, sorted) and the matching ``j`` (int64).
+        The low 64 bits of ``g^j mod p`` (uint64, sorted) and the matching ``j`` (int64).
     giant : int
         ``g^-m mod p``.
     """
@@ -79,11 +85,15 @@ class BabyStepTable(Precomputation):
             n = min(_CHUNK, n_giant - steps)
             values, y = _powers(y, giant, p, n)
             pos = np.minimum(np.searchsorted(table, values), last)
-            hits = np.flatnonzero(table[pos] == values)
-            if hits.size:
-                i = steps + int(hits[0])
-                j = int(self.exponents[pos[hits[0]]])
-                return (i * m + j) % q, {"group_operations": i + 1, "table_lookups": i + 1}, ""
+            for hit in np.flatnonzero(table[pos] == values):
+                i = steps + int(hit)
+                # Every baby step with these low bits (one, unless p >= 2^64 and two share them).
+                for k in range(int(pos[hit]), len(table)):
+                    if table[k] != values[hit]:
+                        break
+                    s = (i * m + int(self.exponents[k])) % q
+                    if gmpy2.powmod(self.group.g, s, p) == h:
+                        return s, {"group_operations": i + 1, "table_lookups": i + 1}, ""
             steps += n
             deadline.check()
         raise BreakerError(f"bsgs: no giant step met the table for h = {format_int(h)} (is h in <g>?)")
@@ -98,19 +108,21 @@ class BabyStepGiantStep(Breaker):
         Table size m (default ``ceil(sqrt(q))``; a larger table makes later keys cheaper).
     max_table : int, default 2**26
         Largest table accepted (memory: 16 bytes per entry); a larger one is refused.
-    max_bits, rng
+    max_bits : int, optional
+        The largest bit length of q accepted (default 56); p may be larger.
+    rng
         See :class:`~encctl_gym.cryptanalysis.base.Breaker`.
     """
 
     name: ClassVar[str] = "bsgs"
+    #: Bits of q.
     DEFAULT_MAX_BITS: ClassVar[int] = 56
+    LIMIT_COUNTS_Q: ClassVar[bool] = True
 
     def __init__(
         self, *, baby_steps: int | None = None, max_table: int = 1 << 26, max_bits: int | None = None, rng: RngLike = None
     ) -> None:
         super().__init__(max_bits=max_bits, rng=rng)
-        if self.max_bits > 64:
-            raise BreakerLimitError(f"bsgs stores residues in 64 bits: max_bits must be <= 64, got {self.max_bits}")
         self.baby_steps = None if baby_steps is None else check_int("baby_steps", baby_steps, minimum=1)
         self.max_table = check_int("max_table", max_table, minimum=1)
 

@@ -27,19 +27,22 @@ The phases
 ----------
 1. **Factor base** (:class:`~.smoothness.FactorBase`): the primes ``l <= B``, with B chosen by
    the cost model :func:`choose_bound` (Dickman's rho for the smoothness probability, the
-   measured cost of a smoothness test and of the linear algebra).
-2. **Relation collection** (:func:`collect_relations`): for ``y = g^e`` write ``y = a / b
-   (mod p)`` with ``|a|, |b| < sqrt(p)`` (:func:`~.smoothness.rational_reconstruction`); if
-   both are B-smooth, ``lambda(y) = lambda(a) - lambda(|b|)`` (by (i) and (ii)) gives the
-   relation ``sum_l (alpha_l - beta_l) lambda_l = n e (mod q)`` (by (iii)).
+   measured cost of a sieved cell and of the linear algebra).
+2. **Relation collection** (:func:`collect_relations`): for ``y = g^e`` every pair
+   ``a = b y (mod p)`` of y's lattice (:mod:`.lattice_sieve`: a reduced basis of about
+   ``sqrt(p)``, a region of small combinations sieved row by row) with a and b B-smooth gives
+   ``lambda(y) = lambda(|a|) - lambda(|b|)`` (by (i) and (ii)), the relation
+   ``sum_l (alpha_l - beta_l) lambda_l = n e (mod q)`` (by (iii)).
 3. **Linear algebra modulo q** (:func:`~.linalg.solve_mod_prime`, python-flint): all the
    ``lambda_l`` the relations determine.
-4. **Descent**, per key (:class:`FactorBaseLogs`): randomise ``z = h g^r`` until z = a / b with
-   a, b smooth over the solved primes; then ``n (log_g h + r) = lambda(a) - lambda(|b|)``.
+4. **Descent**, per key (:class:`FactorBaseLogs`): sieve the lattices of ``z = h g^r`` until a
+   pair a = b z has a, b smooth over the solved primes; then
+   ``n (log_g h + r) = lambda(|a|) - lambda(|b|)``.
 
-Phases 1-3 depend only on (p, q, g): they are the precomputation. Phase 4 needs about
-``1 / rho(u/2)^2`` smoothness tests per key, a small fraction of the precomputation, so after the
-first key a dynamic-key sequence (Example ex:dyn_elgamal) costs little per key.
+Phases 1-3 depend only on (p, q, g): they are the precomputation. Phase 4 needs about one
+relation's worth of sieving per key (usually one lattice), a small fraction of the
+precomputation, so after the first key a dynamic-key sequence (Example ex:dyn_elgamal) costs
+little per key.
 """
 
 from __future__ import annotations
@@ -57,31 +60,41 @@ from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, GroupError, ParameterError
 from .base import Breaker, Deadline, Precomputation, format_bytes
+from .bsgs import BabyStepGiantStep, BabyStepTable
+from .lattice_sieve import SievePlan, sieve_candidates
 from .linalg import flint_backend, solve_mod_prime
-from .smoothness import RHO_MAX_U, FactorBase, check_bound, dickman_rho, rational_reconstruction
+from .smoothness import RHO_MAX_U, FactorBase, check_bound, dickman_rho
 
 __all__ = [
     "IndexCalculus",
     "FactorBaseLogs",
+    "SmallOrderLogs",
     "Relation",
     "collect_relations",
     "choose_bound",
     "cost_model",
     "relation_probability",
+    "sieve_probability",
+    "sieve_region",
     "MAX_MODEL_BITS",
 ]
 
-#: Calibration of the cost model, measured on this machine (2 cores, Python 3.11, gmpy2 2.3,
+#: Calibration of the cost model, measured on this machine (2 cores, Python 3.11, numba 0.68,
 #: python-flint 0.9; ``python benchmarks/bench_cryptanalysis.py`` prints current values):
-#: seconds per smoothness trial = TRIAL_BASE + TRIAL_PER_BIT bits + TRIAL_PER_BOUND B ...
-TRIAL_BASE = 3.0e-6
-TRIAL_PER_BIT = 2.0e-8
-TRIAL_PER_BOUND = 7.0e-11
-#: ... and seconds per k^3 of the dense elimination (k unknowns), for word-size q and larger q.
-LINALG_WORD = 2.5e-10
-LINALG_MULTI = 1.5e-9
-#: Seconds per entry of building the dense matrix (Python lists into FLINT).
-MATRIX_ENTRY = 5.0e-7
+#: seconds per cell of the lattice sieve (:mod:`.lattice_sieve`; both sieves of a row, the
+#: threshold pass and the exact tests of the candidates), at 80 and 96 bits ...
+CELL_SECONDS = 6.0e-9
+#: ... the share of the model's smooth pairs the sieve reports and finds smooth (its slack of
+#: 0.8 log2 B misses pairs whose sum falls short; Dickman's rho also overrates numbers of
+#: this size; measured at 80 and 96 bits, B = 8192 and 21247) ...
+SIEVE_YIELD = 0.33
+#: ... and the linear algebra (:func:`~.linalg.solve_mod_prime`, structured elimination then
+#: the dense core) as ``LINALG_* k^3 + ELIMINATION_PER_UNKNOWN k``, k unknowns, fitted at
+#: 80 and 96 bits to k = 704 ... 2660 (0.11 s to 1.4 s) for q above a machine word; the cube
+#: term is a quarter of that for word-size q (FLINT's nmod_mat).
+LINALG_WORD = 1.2e-11
+LINALG_MULTI = 4.8e-11
+ELIMINATION_PER_UNKNOWN = 1.8e-4
 
 #: Relations collected beyond the number of unknowns (fraction, plus a constant).
 EXTRA_FRACTION = 0.05
@@ -90,12 +103,19 @@ EXTRA_CONSTANT = 20
 #: Python entry list, the FLINT matrix, its echelon form and the entries read back), measured for
 #: a 2120 x 2001 system with a 61-bit q: 91 bytes.
 MATRIX_BYTES_PER_ENTRY = 91
+#: Share of the rows and of the unknowns left to the dense elimination by the structured one
+#: (:func:`~.linalg.structured_elimination`): measured 0.38 of the rows and 0.30 of the unknowns
+#: at 80 and 96 bits; 0.4 for both, with a margin.
+CORE_FRACTION = 0.4
 #: Largest expected peak memory of the linear algebra (bytes): 4 GiB. The default bound of a
-#: 128-bit group (6547 unknowns, about 3.8 GiB) fits.
+#: 128-bit group (about 9700 unknowns, a core of about 1.3 GiB) fits.
 MAX_MATRIX_BYTES = 4 * 2**30
 #: Share of the primes occurring in the relations whose logarithm must be determined.
 SOLVED_FRACTION = 0.97
 _CHECK_EVERY = 2048
+#: The relations need G to hold many more elements than residues sieved: a q below this multiple
+#: of the expected residues is broken by baby-step giant-step (:meth:`IndexCalculus.uses_baby_steps`).
+SMALL_ORDER_FACTOR = 64
 
 
 #: Largest bit length of p the cost model takes (far beyond any group the package builds; it keeps
@@ -133,27 +153,50 @@ def _prime_count(bound: float) -> float:
     return bound / (math.log(bound) - 1.08) if bound > 10 else 4.0
 
 
+def sieve_region(bits: int) -> tuple[int, int]:
+    """``(rows, half_width)`` of the region ``1 <= i <= rows``, ``|j| <= half_width`` sieved in
+    each residue's lattice (:mod:`.lattice_sieve`): ``half_width = 2^min(11, max(4, bits // 7))``
+    and ``rows = max(2, half_width // 32)``; the pairs are about ``half_width sqrt(p)``."""
+    bits = check_int("bits", bits, minimum=2, maximum=MAX_MODEL_BITS)
+    half = 1 << min(11, max(4, bits // 7))
+    return max(2, half // 32), half
+
+
+def sieve_probability(bits: int, bound: float) -> float:
+    """Probability that a cell of the lattice sieve gives a relation: both ``a`` and ``b`` of
+    about ``bits / 2 + log2(half_width)`` bits are ``bound``-smooth, ``rho(u)^2`` (Dickman's rho),
+    times the share :data:`SIEVE_YIELD` the sieve reports; 0 past ``u > 40``."""
+    bits, bound = _model_args(bits, bound)
+    _, half = sieve_region(bits)
+    u = (bits / 2 + math.log2(half)) * math.log(2) / math.log(bound)
+    if u > RHO_MAX_U:
+        return 0.0
+    return SIEVE_YIELD * dickman_rho(u) ** 2
+
+
 def cost_model(bits: int, bound: float) -> dict[str, float]:
     """Expected seconds of each phase for a ``bits``-bit p and factor-base bound B.
 
     Returns
     -------
     dict
-        ``factor_base`` (k, the number of unknowns), ``trials_per_relation``, ``relations``
-        (seconds of phase 2), ``linear_algebra`` (phase 3, dense elimination and the matrix
-        build), ``descent`` (phase 4, per key), ``first`` (phases 2-4) and ``per_key``.
+        ``factor_base`` (k, the number of unknowns), ``cells_per_relation`` (sieved cells, the
+        inverse of :func:`sieve_probability`), ``relations`` (seconds of phase 2),
+        ``linear_algebra`` (phase 3, structured and dense elimination), ``descent``
+        (phase 4, per key: at least one residue's region), ``first`` (phases 2-4) and
+        ``per_key``.
     """
     bits, bound = _model_args(bits, bound)
     k = _prime_count(bound)
-    trials = 1.0 / max(relation_probability(bits, bound), 1e-300)
-    trial = TRIAL_BASE + TRIAL_PER_BIT * bits + TRIAL_PER_BOUND * bound
-    relations = (k * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT) * trials * trial
+    cells = 1.0 / max(sieve_probability(bits, bound), 1e-300)
+    rows, half = sieve_region(bits)
+    relations = (k * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT) * cells * CELL_SECONDS
     cube = LINALG_WORD if bits <= 64 else LINALG_MULTI
-    linear = cube * k**3 + MATRIX_ENTRY * k * k
-    descent = trials * trial
+    linear = cube * k**3 + ELIMINATION_PER_UNKNOWN * k
+    descent = max(cells, 2 * rows * half) * CELL_SECONDS
     return {
         "factor_base": k,
-        "trials_per_relation": trials,
+        "cells_per_relation": cells,
         "relations": relations,
         "linear_algebra": linear,
         "descent": descent,
@@ -204,10 +247,9 @@ class Relation(tuple):
         return self[1]
 
 
-def _split(fb: FactorBase, y: int, p: int, half: int) -> dict[int, int] | None:
-    """The exponent vector of lambda(y) = lambda(a) - lambda(|b|), or None if a or b is not smooth."""
-    a, b = rational_reconstruction(y, p, half)
-    if not (fb._is_smooth(a) and fb._is_smooth(b)):
+def _pair_row(fb: FactorBase, a: int, b: int) -> dict[int, int] | None:
+    """The exponent vector of lambda(|a|) - lambda(|b|), or None if a or b is not smooth (or 0)."""
+    if a == 0 or b == 0 or not (fb._is_smooth(a) and fb._is_smooth(b)):
         return None
     fa, fb_ = fb.factor(a), fb.factor(b)
     assert fa is not None and fb_ is not None  # both smooth
@@ -217,41 +259,58 @@ def _split(fb: FactorBase, y: int, p: int, half: int) -> dict[int, int] | None:
     return {j: e for j, e in row.items() if e}
 
 
+def _sieve_slack(fb: FactorBase) -> float:
+    # Bits a sieve sum may fall short of log2 |a|: prime powers above 2^16 and rounding.
+    return 0.8 * math.log2(fb.bound) + 2.0
+
+
+def _smooth_pairs(fb: FactorBase, plan: SievePlan, y: int, p: int) -> tuple[list[dict[int, int]], int]:
+    """The rows lambda(|a|) - lambda(|b|) = lambda(y) of the smooth pairs of y's lattice, and the
+    number of candidates the sieve reported (each tested exactly)."""
+    (a1, b1, a2, b2), pairs = sieve_candidates(y, p, plan, _sieve_slack(fb))
+    rows = [_pair_row(fb, i * a1 + j * a2, i * b1 + j * b2) for i, j in pairs]
+    return [row for row in rows if row is not None], len(pairs)
+
+
+def _plan(group: GroupParams, fb: FactorBase) -> SievePlan:
+    rows, half = sieve_region(group.bits)
+    return SievePlan(fb.primes, rows, half)
+
+
 def collect_relations(
     group: GroupParams, fb: FactorBase, count: int, src: RandomSource, deadline: Deadline
-) -> tuple[list[Relation], int]:
+) -> tuple[list[Relation], int, int]:
     """Phase 2: ``count`` relations ``sum (alpha_l - beta_l) lambda_l = n e (mod q)``.
 
-    Walks ``y = g^e`` with ``e = e_0 + i c`` for random e_0 and c (one multiplication by
-    ``g^c`` per trial) and keeps the y whose rational reconstruction a / b is smooth on both
-    sides. (Consecutive exponents would not do: with g = 4, ``4y`` is ``4a / b`` and repeats
-    the relation of y plus that of 4.)
+    For residues ``y = g^e`` with ``e = e_0 + i c`` (random e_0 and c; one multiplication by
+    ``g^c`` per residue) it sieves the region :func:`sieve_region` of y's lattice
+    (:func:`~.lattice_sieve.sieve_candidates`) and keeps every pair ``a = b y (mod p)`` with a
+    and b smooth (checked exactly). (Consecutive exponents would not do: with g = 4, ``4y`` has
+    the lattice of y scaled by 4 and repeats its relations plus that of 4.)
 
     Returns
     -------
-    (list of Relation, int)
-        The relations and the number of smoothness trials.
+    (list of Relation, int, int)
+        The relations, the number of residues sieved and of candidates tested exactly.
     """
     p, q, n = group.p, group.q, group.cofactor
-    half = math.isqrt(p)
+    plan = _plan(group, fb)
     e, c = src.between(1, q), src.between(1, q)
     y = gmpy2.powmod(group.g, e, p)
     step = gmpy2.powmod(group.g, c, p)
     pm = gmpy2.mpz(p)
     relations: list[Relation] = []
-    trials = 0
+    lattices = tests = 0
     while len(relations) < count:
-        for _ in range(_CHECK_EVERY):
-            trials += 1
-            row = _split(fb, int(y), p, half)
-            if row is not None:
-                relations.append(Relation((row, n * e % q)))
-                if len(relations) >= count:
-                    break
-            y = y * step % pm
-            e += c
+        lattices += 1
+        rhs = n * e % q
+        rows, tested = _smooth_pairs(fb, plan, int(y), p)
+        tests += tested
+        relations += [Relation((row, rhs)) for row in rows]
+        y = y * step % pm
+        e += c
         deadline.check()
-    return relations, trials
+    return relations, lattices, tests
 
 
 class FactorBaseLogs(Precomputation):
@@ -297,36 +356,62 @@ class FactorBaseLogs(Precomputation):
         return sum(v is not None for v in self.logs)
 
     def _solve(self, h: int, deadline: Deadline, src: RandomSource) -> tuple[int, Mapping[str, int], str]:
-        # Phase 4, the descent: z = h g^r = a / b with a, b smooth over the solved primes gives
-        # n (log h + r) = lambda(a) - lambda(|b|).
+        # Phase 4, the descent: a pair a = b z (mod p) of the lattice of z = h g^r with a, b
+        # smooth over the solved primes gives n (log h + r) = lambda(a) - lambda(|b|).
         group, fb, logs = self.group, self.factor_base, self.logs
         p, q = group.p, group.q
-        half = math.isqrt(p)
         n_inv = pow(group.cofactor, -1, q)
         pm = gmpy2.mpz(p)
+        plan = _plan(group, fb)
         r, c = src.between(0, q), src.between(1, q)  # z = h g^r, then r += c (see collect_relations)
         z = gmpy2.mpz(h) * gmpy2.powmod(group.g, r, p) % pm
         step = gmpy2.powmod(group.g, c, p)
-        trials = 0
-        give_up = 1000 * relation_probability(group.bits, self.bound) ** -1 + 100_000
+        lattices = tests = 0
+        give_up = 1000 * cost_model(group.bits, self.bound)["cells_per_relation"] / (2 * plan.rows * plan.half_width) + 1000
         while True:
-            for _ in range(_CHECK_EVERY):
-                trials += 1
-                row = _split(fb, int(z), p, half)
-                known = None if row is None else [(e, logs[j]) for j, e in row.items()]
-                if known is not None and all(v is not None for _, v in known):
+            lattices += 1
+            rows, tested = _smooth_pairs(fb, plan, int(z), p)
+            tests += tested
+            for row in rows:
+                known = [(e, logs[j]) for j, e in row.items()]
+                if all(v is not None for _, v in known):
                     lam = sum(e * v for e, v in known if v is not None)
                     s = (lam * n_inv - r) % q
-                    return s, {"smoothness_tests": trials}, ""
-                z = z * step % pm
-                r += c
+                    return s, {"sieved_lattices": lattices, "smoothness_tests": tests}, ""
+            z = z * step % pm
+            r += c
             deadline.check()
-            if trials > give_up:
-                raise BreakerError(f"index-calculus: no smooth randomisation after {trials} trials for h = {format_int(h)}")
+            if lattices > give_up:
+                raise BreakerError(f"index-calculus: no smooth pair in {lattices} lattices for h = {format_int(h)}")
+
+
+class SmallOrderLogs(Precomputation):
+    """The precomputation of :class:`IndexCalculus` in a group whose order q is small: a
+    baby-step table (:class:`~.bsgs.BabyStepTable`) that breaks every key in about ``sqrt(q)``
+    steps.
+
+    Relations come from elements of G (``g^e`` and ``h g^r``), and G has only q elements: with
+    a q of a few thousand, G holds fewer smooth elements than the factor base has primes, and
+    no number of trials determines the logarithms. Baby-step giant-step needs no relations.
+    :meth:`IndexCalculus.uses_baby_steps` decides, from the two cost models.
+
+    Attributes
+    ----------
+    table : BabyStepTable
+        The baby steps of the group.
+    """
+
+    def __init__(self, group: GroupParams, table: BabyStepTable, rng: RandomSource | None) -> None:
+        super().__init__(IndexCalculus.name, group, rng)
+        self.table = table
+
+    def _solve(self, h: int, deadline: Deadline, src: RandomSource) -> tuple[int, Mapping[str, int], str]:
+        s, ops, _ = self.table._solve(h, deadline, src)
+        return s, ops, ""
 
 
 class IndexCalculus(Breaker):
-    """Index calculus with a factor base, rational reconstruction and FLINT linear algebra.
+    """Index calculus with a factor base, a lattice sieve and FLINT linear algebra.
 
     See the module docstring for the logarithms solved for and the phases.
 
@@ -337,14 +422,15 @@ class IndexCalculus(Breaker):
         :func:`choose_bound` for the group's size); a bound whose linear algebra would need more
         than :data:`MAX_MATRIX_BYTES` is refused by :meth:`check_feasible`.
     max_bits : int, optional
-        Size limit (default 112 bits: about six minutes and a dense matrix of about 3500 x 3500
-        on this machine; at most 128, where the halves a and b still fit in 64 bits).
+        Size limit (default and at most 128 bits: measured on this machine, the first key of a
+        112-bit group takes about 33 s of CPU time, of a 128-bit group about 260 s, with a
+        factor base of about 9700 primes, and each further key about 0.06 s).
     rng
         See :class:`~encctl_gym.cryptanalysis.base.Breaker`.
     """
 
     name: ClassVar[str] = "index-calculus"
-    DEFAULT_MAX_BITS: ClassVar[int] = 112
+    DEFAULT_MAX_BITS: ClassVar[int] = 128
     #: Rounds of extra relations collected when the system leaves too many unknowns free.
     MAX_ROUNDS: ClassVar[int] = 6
 
@@ -359,22 +445,47 @@ class IndexCalculus(Breaker):
         bound = self.bound or choose_bound(group.bits)
         return max(2, min(bound, group.p - 1))
 
+    def _baby_steps(self, group: GroupParams) -> BabyStepGiantStep:
+        return BabyStepGiantStep(max_bits=group.q.bit_length(), rng=self.rng)
+
+    def uses_baby_steps(self, group: GroupParams) -> bool:
+        """True if G is too small to supply the relations: q below :data:`SMALL_ORDER_FACTOR`
+        times the residues whose lattices the relations are expected to take (:func:`cost_model`),
+        where the walk over G would revisit its elements, and the baby-step table of
+        :mod:`.bsgs` fits. The precomputation is then a :class:`SmallOrderLogs`."""
+        bsgs = self._baby_steps(group)
+        if bsgs.table_size(group) > bsgs.max_table:
+            return False
+        model = cost_model(group.bits, self.factor_base_bound(group))
+        rows, half = sieve_region(group.bits)
+        lattices = (
+            model["cells_per_relation"] / (2 * rows * half) * (model["factor_base"] * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT)
+        )
+        return group.q < SMALL_ORDER_FACTOR * max(lattices, 1.0)
+
     def expected_seconds(self, group: GroupParams) -> tuple[float, float]:
-        """``(first, per_key)`` of :func:`cost_model` at :meth:`factor_base_bound`."""
+        """``(first, per_key)`` of :func:`cost_model` at :meth:`factor_base_bound`, or of
+        baby-step giant-step when :meth:`uses_baby_steps`."""
+        if self.uses_baby_steps(group):
+            return self._baby_steps(group).expected_seconds(group)
         model = cost_model(group.bits, self.factor_base_bound(group))
         return model["first"], model["per_key"]
 
     def matrix_bytes(self, group: GroupParams) -> float:
-        """Expected peak memory of the first linear algebra (bytes): ``k (1 + EXTRA_FRACTION) +
-        EXTRA_CONSTANT`` rows of ``k + 1`` entries, k the (estimated) size of the factor base, at
+        """Expected peak memory of the first linear algebra (bytes): the dense core of
+        :data:`CORE_FRACTION` of ``k (1 + EXTRA_FRACTION) + EXTRA_CONSTANT`` rows and of ``k``
+        unknowns (plus the right-hand side), k the (estimated) size of the factor base, at
         :data:`MATRIX_BYTES_PER_ENTRY` each."""
         k = _prime_count(self.factor_base_bound(group))
-        return (k * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT) * (k + 1) * MATRIX_BYTES_PER_ENTRY
+        rows = CORE_FRACTION * (k * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT)
+        return rows * (CORE_FRACTION * k + 1) * MATRIX_BYTES_PER_ENTRY
 
     def check_feasible(self, group: GroupParams) -> None:
         """The limits of :class:`~.base.Breaker`, and the memory of the dense linear algebra
-        (:meth:`matrix_bytes` at most :data:`MAX_MATRIX_BYTES`)."""
+        (:meth:`matrix_bytes` at most :data:`MAX_MATRIX_BYTES`; none when :meth:`uses_baby_steps`)."""
         super().check_feasible(group)
+        if self.uses_baby_steps(group):
+            return
         need = self.matrix_bytes(group)
         if need > MAX_MATRIX_BYTES:
             bound = self.factor_base_bound(group)
@@ -391,7 +502,10 @@ class IndexCalculus(Breaker):
                 f"index-calculus needs an odd q that does not divide the cofactor (p - 1) / q; got q = {group.q}, cofactor = {n}"
             )
 
-    def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[FactorBaseLogs, Mapping[str, int]]:
+    def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[Precomputation, Mapping[str, int]]:
+        if self.uses_baby_steps(group):
+            table, ops = self._baby_steps(group)._precompute(group, deadline)
+            return SmallOrderLogs(group, table, self.rng), ops
         src = self.rng or arith.secure_random()
         clock = _PhaseClock()
         # Phase 1: the factor base.
@@ -403,15 +517,16 @@ class IndexCalculus(Breaker):
         # the primes that occur in the relations are: the descent needs those.
         need = int(k * (1 + EXTRA_FRACTION)) + EXTRA_CONSTANT
         relations: list[Relation] = []
-        trials = 0
+        lattices = tests = 0
         rank = 0
         logs: list[int | None] = [None] * k
         small = sum(1 for ell in fb.primes if ell <= max(2, math.isqrt(min(fb.bound, group.p))))
         for _ in range(self.MAX_ROUNDS):
             with clock("relations"):
-                more, t = collect_relations(group, fb, need - len(relations), src, deadline)
+                more, t, tested = collect_relations(group, fb, need - len(relations), src, deadline)
             relations += more
-            trials += t
+            lattices += t
+            tests += tested
             # The elimination runs inside FLINT and cannot be interrupted: refuse it up front
             # when the cost model says it would overrun the time limit.
             expected = cost_model(group.bits, fb.bound)["linear_algebra"]
@@ -436,5 +551,12 @@ class IndexCalculus(Breaker):
         pre = FactorBaseLogs(group, fb.bound, logs, self.rng)
         pre._fb = fb
         pre.phase_seconds, pre.phase_cpu_seconds = clock.wall, clock.cpu
-        ops = {"factor_base": k, "smoothness_tests": trials, "relations": len(relations), "rank": rank, "solved_logs": pre.solved}
+        ops = {
+            "factor_base": k,
+            "sieved_lattices": lattices,
+            "smoothness_tests": tests,
+            "relations": len(relations),
+            "rank": rank,
+            "solved_logs": pre.solved,
+        }
         return pre, ops

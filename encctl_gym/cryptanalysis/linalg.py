@@ -9,14 +9,20 @@ unknowns it leaves free are reported as ``None``, never guessed.
 
 from __future__ import annotations
 
+import heapq
 from collections.abc import Mapping, Sequence
 
 from .._validation import check_int, format_value
 from ..errors import BreakerError, OptionalDependencyError, ParameterError
 
-__all__ = ["solve_mod_prime", "flint_backend"]
+__all__ = ["solve_mod_prime", "flint_backend", "structured_elimination"]
 
 _WORD = 1 << 63
+#: Structured elimination pivots on columns of at most this weight (rows containing them) ...
+MAX_PIVOT_WEIGHT = 24
+#: ... while an elimination step costs at most this many entry updates (weight times the
+#: pivot row's length); beyond, the rest is left to the dense elimination.
+MAX_STEP_WORK = 4096
 
 
 def _flint():  # python-flint is a core dependency; the error is for broken installs
@@ -30,6 +36,77 @@ def _flint():  # python-flint is a core dependency; the error is for broken inst
 def flint_backend(q: int) -> str:
     """``"nmod_mat"`` for ``q < 2^63``, else ``"fmpz_mod_mat"``."""
     return "nmod_mat" if q < _WORD else "fmpz_mod_mat"
+
+
+def structured_elimination(
+    rows: Sequence[Mapping[int, int]], rhs: Sequence[int], q: int
+) -> tuple[list[dict[int, int]], list[int], list[tuple[int, dict[int, int], int]]]:
+    """Shrink a sparse system modulo a prime q before the dense elimination.
+
+    Repeatedly takes the column of smallest weight (number of rows containing it, at most
+    :data:`MAX_PIVOT_WEIGHT`), picks its shortest row as the pivot, subtracts multiples of the
+    pivot from the other rows containing the column (so they no longer do) and sets the pivot
+    aside. Each step removes one row and one column, so the excess of rows over columns is kept,
+    and the remaining system (the *core*) has the same solutions in the remaining unknowns; an
+    eliminated unknown follows from its pivot row once the later ones are known
+    (back-substitution, in :func:`solve_mod_prime`). A column of weight 1 is a singleton: its row
+    is only needed for its own unknown. Stops when every column is heavier, or a step would
+    update more than :data:`MAX_STEP_WORK` entries.
+
+    Returns
+    -------
+    (list of dict, list of int, list of (int, dict, int))
+        The core rows and right-hand sides (reduced modulo q), and the pivots
+        ``(column, row, rhs)`` in the order of elimination.
+    """
+    work = [{j: c % q for j, c in row.items() if c % q} for row in rows]
+    right = [r % q for r in rhs]
+    holders: dict[int, set[int]] = {}
+    for i, row in enumerate(work):
+        for j in row:
+            holders.setdefault(j, set()).add(i)
+    heap = [(len(h), j) for j, h in holders.items()]
+    heapq.heapify(heap)
+    pivots: list[tuple[int, dict[int, int], int]] = []
+    alive = set(range(len(work)))
+    while heap:
+        weight, col = heapq.heappop(heap)
+        held = holders.get(col)
+        if held is None or len(held) != weight:
+            continue  # a stale entry (the column was eliminated or its weight changed)
+        if weight > MAX_PIVOT_WEIGHT:
+            break
+        if weight == 0:  # every row holding it was eliminated: the column has left the system
+            del holders[col]
+            continue
+        piv = min(held, key=lambda i: len(work[i]))
+        prow = work[piv]
+        if (weight - 1) * len(prow) > MAX_STEP_WORK:
+            break
+        pivots.append((col, prow, right[piv]))
+        alive.discard(piv)
+        for j in prow:
+            holders[j].discard(piv)
+        inv = pow(prow[col], -1, q)
+        for other in list(held):
+            orow = work[other]
+            factor = orow[col] * inv % q
+            for j, c in prow.items():
+                v = (orow.get(j, 0) - factor * c) % q
+                if v:
+                    if j not in orow:
+                        holders[j].add(other)
+                    orow[j] = v
+                elif j in orow:
+                    del orow[j]
+                    holders[j].discard(other)
+            right[other] = (right[other] - factor * right[piv]) % q
+        del holders[col]
+        for j in prow:
+            if j != col and j in holders:
+                heapq.heappush(heap, (len(holders[j]), j))
+    core = sorted(alive)
+    return [work[i] for i in core], [right[i] for i in core], pivots
 
 
 def solve_mod_prime(rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols: int, q: int) -> tuple[list[int | None], int]:
@@ -50,7 +127,10 @@ def solve_mod_prime(rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols
     -------
     (list of int or None, int)
         ``x_j`` in ``[0, q)`` for every determined unknown (``None`` for a free or absent one),
-        and the rank of the system.
+        and the rank of the system. The system is first shrunk by
+        :func:`structured_elimination`; an unknown it eliminated is reported when the unknowns of
+        its pivot row are (a determined unknown whose pivot row holds a free one is reported as
+        ``None``: never a guess).
 
     Raises
     ------
@@ -70,22 +150,59 @@ def solve_mod_prime(rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols
         raise ParameterError(f"a row has a coefficient in column {format_value(bad)}, outside [0, ncols = {ncols})")
     if not used:
         return [None] * ncols, 0
+    rows, rhs, pivots = structured_elimination(rows, rhs, q)
+    solution, rank = _solve_dense(flint, rows, rhs, ncols, q)
+    for col, prow, r in reversed(pivots):  # back-substitution, latest pivot first
+        known = [(c, solution[j]) for j, c in prow.items() if j != col]
+        if all(v is not None for _, v in known):
+            total = sum(c * v for c, v in known if v is not None)
+            solution[col] = (r - total) * pow(prow[col], -1, q) % q
+    return solution, rank + len(pivots)
+
+
+def _solve_dense(
+    flint, rows: Sequence[Mapping[int, int]], rhs: Sequence[int], ncols: int, q: int
+) -> tuple[list[int | None], int]:
+    # The dense elimination of a (reduced) system with FLINT: every unknown it determines.
+    used = sorted({j for row in rows for j, c in row.items() if c % q})
+    if not used:
+        if any(r % q for r in rhs):
+            raise BreakerError("the relations are inconsistent modulo q (a wrong relation)")
+        return [None] * ncols, 0
     pos = {j: i for i, j in enumerate(used)}
     width = len(used) + 1
-    entries = [0] * (len(rows) * width)
+    # Built entry by entry into a zero matrix: the rows are sparse (a dozen entries of a few
+    # thousand), and a full list of Python integers costs more than the elimination.
+    if q < _WORD:
+        mat = flint.nmod_mat(len(rows), width, q)
+    else:
+        mat = flint.fmpz_mod_mat(len(rows), width, flint.fmpz_mod_ctx(q))
     for i, (row, r) in enumerate(zip(rows, rhs)):
-        base = i * width
         for j, c in row.items():
             if c % q:
-                entries[base + pos[j]] = c % q
-        entries[base + width - 1] = r % q
-    if q < _WORD:
-        mat = flint.nmod_mat(len(rows), width, entries, q)
-    else:
-        mat = flint.fmpz_mod_mat(len(rows), width, entries, flint.fmpz_mod_ctx(q))
+                mat[i, pos[j]] = c % q
+        mat[i, width - 1] = r % q
     reduced, rank = mat.rref()
-    values = [int(v) for v in reduced.entries()]
     solution: list[int | None] = [None] * ncols
+    # Only the entries needed are read back (reading the whole reduced matrix costs half as
+    # much as the elimination): the leading column of each nonzero row, found by one scan since
+    # they increase, then each pivot row's entries in the free columns and its right-hand side.
+    leads: list[int] = []
+    lead = 0
+    for i in range(rank):
+        while int(reduced[i, lead]) == 0:
+            lead += 1
+        leads.append(lead)
+        lead += 1
+    if leads and leads[-1] == width - 1:
+        raise BreakerError("the relations are inconsistent modulo q (a wrong relation)")
+    pivot_cols = set(leads)
+    free = [k for k in range(width - 1) if k not in pivot_cols]
+    for i, lead in enumerate(leads):
+        if all(int(reduced[i, k]) == 0 for k in free):  # this unknown does not depend on a free one
+            solution[used[lead]] = int(reduced[i, width - 1])
+    return solution, rank
+    values = [int(v) for v in reduced.entries()]
     pivots = []
     for i in range(rank):
         reduced_row = values[i * width : (i + 1) * width]

@@ -167,12 +167,16 @@ class PollardRho(Breaker):
 
     Parameters
     ----------
-    max_bits, rng
+    max_bits : int, optional
+        The largest bit length of q accepted (default 64); p may be larger.
+    rng
         See :class:`~encctl_gym.cryptanalysis.base.Breaker`.
     """
 
     name: ClassVar[str] = "rho"
+    #: Bits of q (the walk's cost depends on q only).
     DEFAULT_MAX_BITS: ClassVar[int] = 64
+    LIMIT_COUNTS_Q: ClassVar[bool] = True
     _REUSE: ClassVar[bool] = False
 
     def expected_seconds(self, group: GroupParams) -> tuple[float, float]:
