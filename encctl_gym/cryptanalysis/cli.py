@@ -40,7 +40,7 @@ from .._validation import check_int, check_positive
 from ..crypto import arith
 from ..crypto.group import SHIPPED_BITS, GroupParams, generate_safe_prime_group, shipped_group
 from ..errors import BreakerError, ParameterError
-from ..parallel import check_scheduler
+from ..parallel import check_n_jobs, check_scheduler
 from .base import format_seconds
 from .keys import MAX_KEYS, check_keys, key_sequence
 from .registry import BREAKERS, get_breaker
@@ -155,6 +155,7 @@ def run(args: argparse.Namespace) -> int:
     breaker = get_breaker(args.breaker, **kwargs)
     group, source = crack_group(args.bits, args.group, seed)
     check_scheduler(args.scheduler)  # every refusal comes before the estimate is printed
+    check_n_jobs(args.n_jobs)
     advice = "raise --max-seconds, or use fewer --keys, a smaller --bits or another --breaker"
     max_seconds = check_positive("--max-seconds", args.max_seconds)
     first, per_key, total = breaker.check_time(group, max_seconds, keys=n, limit_name="--max-seconds", advice=advice)
