@@ -35,3 +35,38 @@ def test_an_environment_with_a_budget_beyond_the_float_range_is_refused_for_its_
     with pytest.raises(ResourceLimitError, match="max_samples"):
         gym.make(ENV_ID, config={**HUGE_BUDGET, "max_samples": None, "key_length": 3072})
     assert issubclass(ResourceLimitError, EncctlError)
+
+
+def _no_generation(bits: int) -> None:
+    raise AssertionError(f"a {bits}-bit safe-prime group was generated")
+
+
+def test_the_ideal_backend_never_generates_a_group_above_the_shipped_sizes(monkeypatch: pytest.MonkeyPatch) -> None:
+    # lambda = 128 at Upsilon = 1e30, tau_c = 1e10 s asks for a key of more than 2048 bits.
+    import encctl_gym.loop.backend as backend
+    from encctl_gym.crypto.group import SHIPPED_BITS
+    from encctl_gym.loop import IdealLoop, make_loop
+
+    monkeypatch.setattr(backend, "_generated_group", _no_generation)
+    params = resolve_params({"security_parameter": 128, "upsilon": 1e30, "tau_c": 1e10})
+    assert params.key_length > max(SHIPPED_BITS)
+    loop = make_loop(params)
+    assert isinstance(loop, IdealLoop)
+    assert loop.table.p.bit_length() == max(SHIPPED_BITS)
+
+
+def test_the_elgamal_backend_still_asks_for_the_group_of_its_key_length(monkeypatch: pytest.MonkeyPatch) -> None:
+    import encctl_gym.loop.backend as backend
+    from encctl_gym.loop import make_loop
+
+    asked: list[int] = []
+
+    def record(bits: int) -> None:
+        asked.append(bits)
+        raise ResourceLimitError("recorded")
+
+    monkeypatch.setattr(backend, "_generated_group", record)
+    params = resolve_params({"security_parameter": 128, "upsilon": 1e30, "tau_c": 1e10, "crypto": "elgamal"})
+    with pytest.raises(ResourceLimitError, match="recorded"):
+        make_loop(params)
+    assert asked == [params.key_length]

@@ -10,13 +10,17 @@ Backends implement :class:`~encctl_gym.loop.backend.LoopBackend` and are picked 
   ciphertexts, one copy.
 
 Both use the group of :func:`~encctl_gym.loop.backend.loop_group`, so their trajectories agree
-bit for bit.
+bit for bit up to the largest shipped group (2048 bits). Above it the ElGamal backend generates a
+safe-prime group of the key length (minutes at 2500 bits), while the ideal backend, which needs
+the group only for the residue pattern of its quantisation, stays on the 2048-bit group: it
+generates nothing, and its trajectories then differ from ElGamal's in the rounding pattern only.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
+from ..crypto.group import SHIPPED_BITS
 from ..errors import ParameterError
 from .backend import LoopBackend, loop_group, lqr_gain, table_limit
 from .elgamal import ElGamalLoop
@@ -40,9 +44,13 @@ BACKENDS: dict[str, type] = {"ideal": IdealLoop, "elgamal": ElGamalLoop}
 
 
 def make_loop(params: Any) -> LoopBackend:
-    """The backend selected by ``params.crypto``, on the group of :func:`loop_group`."""
+    """The backend selected by ``params.crypto``, on the group of :func:`loop_group`.
+
+    A backend without ciphertexts (``needs_key_length_group = False``: the ideal one) gets the
+    group of ``min(key_length, max(SHIPPED_BITS))`` bits, so it never generates a group."""
     try:
         backend = BACKENDS[params.crypto]
     except KeyError:
         raise ParameterError(f"unknown crypto backend {params.crypto!r}; choose one of {', '.join(BACKENDS)}") from None
-    return backend(params, loop_group(params.key_length))
+    bits = params.key_length if backend.needs_key_length_group else min(params.key_length, max(SHIPPED_BITS))
+    return backend(params, loop_group(bits))
