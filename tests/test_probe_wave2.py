@@ -70,3 +70,21 @@ def test_the_elgamal_backend_still_asks_for_the_group_of_its_key_length(monkeypa
     with pytest.raises(ResourceLimitError, match="recorded"):
         make_loop(params)
     assert asked == [params.key_length]
+
+
+@pytest.mark.parametrize("bad", [10**400, "0.5", True, float("nan"), 0.0, 1.5, -(10**400)])
+def test_a_forgetting_factor_that_is_not_a_real_number_in_0_1_is_refused(bad: object) -> None:
+    from encctl_gym.errors import ParameterError
+    from encctl_gym.ident import make_estimator
+
+    with pytest.raises(ParameterError, match="forgetting_factor"):
+        make_estimator({"name": "forgetting", "forgetting_factor": bad})
+
+
+def test_a_forgetting_factor_in_0_1_is_kept() -> None:
+    import numpy as np
+
+    from encctl_gym.ident import make_estimator
+
+    assert make_estimator({"name": "forgetting", "forgetting_factor": np.float32(0.5)}).forgetting_factor == 0.5
+    assert make_estimator({"name": "forgetting", "forgetting_factor": 1}).forgetting_factor == 1.0
