@@ -88,3 +88,29 @@ def test_a_forgetting_factor_in_0_1_is_kept() -> None:
 
     assert make_estimator({"name": "forgetting", "forgetting_factor": np.float32(0.5)}).forgetting_factor == 0.5
     assert make_estimator({"name": "forgetting", "forgetting_factor": 1}).forgetting_factor == 1.0
+
+
+def test_iv_lags_beyond_the_bound_are_refused_when_the_estimator_is_made() -> None:
+    from encctl_gym.errors import ParameterError
+    from encctl_gym.ident import make_estimator
+    from encctl_gym.ident.instrumental import MAX_LAGS
+
+    assert make_estimator({"name": "iv", "lags": MAX_LAGS}).lags == MAX_LAGS
+    with pytest.raises(ParameterError, match="lags"):
+        make_estimator({"name": "iv", "lags": 10**5})
+    with pytest.raises(ParameterError, match="lags"):
+        resolve_params({"preset": "small", "estimator": {"name": "iv", "lags": 10**5}})
+
+
+def test_an_estimator_whose_moments_do_not_fit_is_refused_before_allocating() -> None:
+    from encctl_gym.ident import make_estimator
+    from encctl_gym.ident.instrumental import MAX_LAGS
+
+    est = make_estimator({"name": "iv", "lags": MAX_LAGS})
+    # 10^4 copies of (2 * 8200^2) float64 moments: about 10 TB, refused with the sizes named
+    with pytest.raises(ResourceLimitError, match="K = 10000 copies"):
+        est.start(10_000, 2, 2)
+    assert est.online_bytes(3, 2, 2) == 3 * est.online_bytes(1, 2, 2)
+    small = make_estimator({"name": "iv", "lags": 64})
+    small.start(10_000, 2, 2)  # 10^4 copies of 136 features fit (about 3 GiB is not allocated up front)
+    assert small.num_copies == 10_000
