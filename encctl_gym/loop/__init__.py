@@ -52,5 +52,5 @@ def make_loop(params: Any) -> LoopBackend:
         backend = BACKENDS[params.crypto]
     except KeyError:
         raise ParameterError(f"unknown crypto backend {params.crypto!r}; choose one of {', '.join(BACKENDS)}") from None
-    bits = params.key_length if backend.needs_key_length_group else min(params.key_length, max(SHIPPED_BITS))
+    bits = params.key_length if getattr(backend, "needs_key_length_group", True) else min(params.key_length, max(SHIPPED_BITS))
     return backend(params, loop_group(bits))
