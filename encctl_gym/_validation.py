@@ -15,13 +15,15 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
+import stat
 import sys
 from fractions import Fraction
 from typing import Any
 
 import numpy as np
 
-from .errors import ParameterError, ShapeError, UnstableSystemError
+from .errors import ConfigError, ParameterError, ShapeError, UnstableSystemError
 
 __all__ = [
     "one_line",
@@ -36,6 +38,7 @@ __all__ = [
     "check_system",
     "spectral_radius",
     "check_schur_stable",
+    "check_regular_file",
     "FLOAT_MAX",
 ]
 
@@ -271,3 +274,27 @@ def check_schur_stable(A: np.ndarray) -> float:
     if not rho < 1.0:
         raise UnstableSystemError(f"A must be Schur stable (spectral radius < 1), got spectral radius {rho:.6g}")
     return rho
+
+
+_FILE_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+               (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))  # fmt: skip
+
+
+def check_regular_file(what: str, path: Any) -> str:
+    """Return ``path`` as a string, raising :class:`ConfigError` unless it names an existing
+    regular file; the message says what it is instead ("does not exist", "is a directory",
+    "is not a regular file: a FIFO (named pipe)", ...). Only ``os.stat`` is called: a FIFO is
+    never opened, so the check cannot block."""
+    name = os.fspath(path)
+    try:
+        mode = os.stat(name).st_mode
+    except FileNotFoundError:
+        raise ConfigError(f"{what} {name!r} does not exist") from None
+    except (OSError, ValueError) as exc:  # permission, a name too long, an embedded NUL
+        raise ConfigError(f"{what} {name!r} cannot be examined: {getattr(exc, 'strerror', None) or exc}") from None
+    if stat.S_ISREG(mode):
+        return name
+    if stat.S_ISDIR(mode):
+        raise ConfigError(f"{what} {name!r} is a directory, not a file")
+    kind = next((label for test, label in _FILE_KINDS if test(mode)), "a special file")
+    raise ConfigError(f"{what} {name!r} is not a regular file: it is {kind}")

@@ -114,3 +114,66 @@ def test_an_estimator_whose_moments_do_not_fit_is_refused_before_allocating() ->
     small = make_estimator({"name": "iv", "lags": 64})
     small.start(10_000, 2, 2)  # 10^4 copies of 136 features fit (about 3 GiB is not allocated up front)
     assert small.num_copies == 10_000
+
+
+# ------------------------------------------------------------------ plant files that are not regular files
+def test_a_directory_given_as_a_plant_file_is_called_a_directory(tmp_path) -> None:
+    from encctl_gym.errors import ConfigError
+    from encctl_gym.plant_file import load_plant_file
+
+    (tmp_path / "plant.json").mkdir()
+    with pytest.raises(ConfigError, match="is a directory"):
+        load_plant_file(tmp_path / "plant.json")
+    with pytest.raises(ConfigError, match="does not exist"):
+        load_plant_file(tmp_path / "missing.json")
+
+
+def test_a_fifo_given_as_a_plant_file_is_refused_without_opening_it(tmp_path) -> None:
+    import os
+
+    from encctl_gym.errors import ConfigError
+    from encctl_gym.plant_file import load_plant_file
+
+    if not hasattr(os, "mkfifo"):
+        pytest.skip("no named pipes on this platform")
+    fifo = tmp_path / "plant.json"
+    os.mkfifo(fifo)  # opening it for reading would block: no writer ever comes
+    with pytest.raises(ConfigError, match=r"is not a regular file: it is a FIFO"):
+        load_plant_file(fifo)
+
+
+def test_a_device_given_as_a_plant_file_is_called_a_device() -> None:
+    import os
+
+    from encctl_gym.errors import ConfigError
+    from encctl_gym.plant_file import load_plant_file
+
+    if not os.path.exists("/dev/null"):
+        pytest.skip("no /dev/null")
+    with pytest.raises(ConfigError, match="is not a regular file: it is a character device"):
+        load_plant_file("/dev/null")
+
+
+def test_the_cli_says_a_directory_is_a_directory(tmp_path, capsys) -> None:
+    from encctl_gym import cli
+
+    (tmp_path / "plant.json").mkdir()
+    assert cli.main(["design", str(tmp_path / "plant.json")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "is a directory" in err and len(err.splitlines()) == 1
+
+
+# ------------------------------------------------------------------ eq:opt_key's real range of lambda
+def test_minimum_key_length_states_the_security_parameters_it_reaches() -> None:
+    from encctl_gym.errors import ModelRangeError
+    from encctl_gym.security.cost_models import MAX_KEY_LENGTH, PaperModel, gnfs_log2_complexity, minimum_key_length
+
+    low, high = PaperModel().security_parameter_range()
+    assert high == pytest.approx(float(gnfs_log2_complexity(MAX_KEY_LENGTH, 0.0)), abs=1e-12)
+    assert 481 < high < 482  # the formula at 65536 bits
+    assert minimum_key_length(481) <= MAX_KEY_LENGTH
+    for lam in (482, 2048):
+        with pytest.raises(ModelRangeError, match=rf"lam <= log2 Omega\({MAX_KEY_LENGTH}\) - c = {high:.3f} bits"):
+            minimum_key_length(lam)
+    c_low, c_high = PaperModel(10.0).security_parameter_range()  # a correction lowers both ends by c
+    assert (c_low, c_high) == pytest.approx((low - 10.0, high - 10.0), abs=1e-9)
