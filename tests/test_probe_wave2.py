@@ -177,3 +177,47 @@ def test_minimum_key_length_states_the_security_parameters_it_reaches() -> None:
             minimum_key_length(lam)
     c_low, c_high = PaperModel(10.0).security_parameter_range()  # a correction lowers both ends by c
     assert (c_low, c_high) == pytest.approx((low - 10.0, high - 10.0), abs=1e-9)
+
+
+# ------------------------------------------------------------------ an estimation error that overflows is loud
+def test_a_bayes_prior_whose_error_overflows_is_refused() -> None:
+    import numpy as np
+
+    from encctl_gym.errors import ParameterError
+    from encctl_gym.ident import make_estimator
+
+    with pytest.raises(ParameterError, match="prior_mean's squared entries overflow"):
+        make_estimator({"name": "bayes", "prior_mean": np.full((2, 4), 1e200)})
+    with pytest.raises(ParameterError, match="prior_mean"):
+        resolve_params({"preset": "small", "estimator": {"name": "bayes", "prior_mean": np.full((2, 4), 1e200).tolist()}})
+    assert make_estimator({"name": "bayes", "prior_mean": np.full((2, 4), 1e100)}).prior_mean.max() == 1e100
+
+
+def test_an_estimation_error_that_overflows_ends_the_episode_loudly() -> None:
+    import gymnasium as gym
+    import numpy as np
+
+    from encctl_gym.errors import SolverError
+    from encctl_gym.registration import ENV_ID
+
+    env = gym.make(ENV_ID, config={"preset": "small", "estimator": {"name": "bayes"}, "max_samples": 12, "gamma_opt": False})
+    env.reset(seed=0)
+    est = env.unwrapped.episode.estimator
+    est.error = lambda A, B: np.full(1, np.inf)  # an estimate too far from the plant to measure
+    with pytest.raises(SolverError, match=r"error overflowed float64 \(epsilon = inf\)"):
+        for _ in range(12):
+            env.step(env.action_space.sample())
+
+
+def test_an_estimator_without_an_estimate_yet_keeps_the_previous_error() -> None:
+    import gymnasium as gym
+    import numpy as np
+
+    from encctl_gym.registration import ENV_ID
+
+    env = gym.make(ENV_ID, config={"preset": "small", "estimator": {"name": "bayes"}, "max_samples": 12, "gamma_opt": False})
+    _, info0 = env.reset(seed=0)
+    env.unwrapped.episode.estimator.error = lambda A, B: np.full(1, np.nan)  # NaN: no estimate for this copy
+    for _ in range(3):
+        _, _, _, _, info = env.step(env.action_space.sample())
+    assert info["epsilon"] == info0["epsilon"]

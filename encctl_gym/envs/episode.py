@@ -557,6 +557,13 @@ class EpisodeCore:
             est.update(np.concatenate([self.X[j - 1], self.U[j - 1]], axis=1), self.X[j])
         if est.ready:
             err = est.error(self.p.A, self.p.B)
+            if np.isinf(err).any():  # NaN: no estimate yet (kept stale); inf: an estimate whose error overflowed
+                from ..errors import SolverError
+
+                raise SolverError(
+                    f"the {est.label} estimator's error overflowed float64 (epsilon = inf) after {target} samples "
+                    f"(copy {int(np.argmax(np.isinf(err)))}): its estimate is too far from any plant to measure"
+                )
             ok = np.isfinite(err)
             self.eps[ok] = err[ok]
 
