@@ -221,3 +221,43 @@ def test_an_estimator_without_an_estimate_yet_keeps_the_previous_error() -> None
     for _ in range(3):
         _, _, _, _, info = env.step(env.action_space.sample())
     assert info["epsilon"] == info0["epsilon"]
+
+
+# ------------------------------------------------------------------ a tight memory estimate
+@pytest.mark.parametrize("num_envs", [100, 400])
+def test_the_episode_memory_estimate_covers_the_measured_peak_within_ten_percent(num_envs: int) -> None:
+    import tracemalloc
+
+    import gymnasium as gym
+    import numpy as np
+
+    from encctl_gym.envs.episode import episode_bytes
+    from encctl_gym.registration import ENV_ID
+
+    cfg = {"gamma_opt": False, "max_samples": 2000}
+
+    def play(k: int) -> gym.vector.VectorEnv:
+        env = gym.make_vec(ENV_ID, num_envs=k, config=cfg)
+        env.reset(seed=0)
+        a = np.zeros(env.action_space.shape, dtype=np.float32)
+        for _ in range(100):
+            env.step(a)
+        return env
+
+    play(2).close()  # compile and warm up outside the measurement
+    tracemalloc.start()
+    try:
+        env = play(num_envs)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    env.close()
+    estimate = episode_bytes(resolve_params(cfg), num_envs)
+    assert peak <= estimate <= 1.10 * peak, (peak, estimate)  # a margin of a half fails the upper bound
+
+
+def test_the_memory_refusal_states_the_margin() -> None:
+    from encctl_gym.envs.episode import check_episode_memory
+
+    with pytest.raises(ResourceLimitError, match="5 % margin"):
+        check_episode_memory(resolve_params({"gamma_opt": False}), 10_000, memory_limit=2**30)
