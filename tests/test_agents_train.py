@@ -364,3 +364,16 @@ def test_a_bad_env_in_run_json_is_blamed_on_run_json(ppo_run, tmp_path):
     with pytest.raises(ConfigError, match=r"run\.json: its env does not make an environment: sigma_w2") as info:
         load_attacker(bad, params=params)
     assert "vecnormalize" not in str(info.value)
+
+
+@pytest.mark.parametrize("lags", [10**5, 4096])
+def test_evaluate_refuses_a_run_whose_estimator_does_not_fit_in_one_line(ppo_run, tmp_path, capsys, lags):
+    big = _copy_run(ppo_run, tmp_path / "iv")
+    meta = json.loads((big / "run.json").read_text())
+    meta["env"]["estimator"] = {"name": "iv", "lags": lags}
+    (big / "run.json").write_text(json.dumps(meta))
+    rc = cli.main(["evaluate", str(big), "--episodes", "64", "--points", "1", "--no-progress", "--out", str(tmp_path / "ev")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2, err
+    assert "lags" in err or "iv(lags=4096) estimator's moments" in err
+    assert len(err.splitlines()) == 1 and "Traceback" not in err
