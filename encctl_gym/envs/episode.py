@@ -566,7 +566,7 @@ class EpisodeCore:
                 from ..errors import SolverError
 
                 raise SolverError(
-                    f"the {est.label} estimator's error overflowed float64 (epsilon = inf) after {target} samples "
+                    f"the {getattr(est, 'label', type(est).__name__)} estimator's error overflowed float64 (epsilon = inf) after {target} samples "
                     f"(copy {int(np.argmax(np.isinf(err)))}): its estimate is too far from any plant to measure"
                 )
             ok = np.isfinite(err)
