@@ -7,14 +7,13 @@ environment. The stable-baselines3 pieces (:mod:`agents.sb3`, :mod:`agents.train
 ``[rl]`` extra and are imported lazily.
 """
 
-from .base import OBSERVATION_MODES, Attacker, ObsLayout, observation_indices, params_of
+from .base import OBSERVATION_MODES, Attacker, observation_indices, params_of
 from .baselines import ColoredGaussianAttacker, GaussianAttacker, PRBSAttacker
 from .evaluate import Rollout, env_config, rollout
 from .optimal import OptimalDesignAttacker
 
 __all__ = [
     "Attacker",
-    "ObsLayout",
     "OBSERVATION_MODES",
     "observation_indices",
     "params_of",

@@ -14,7 +14,7 @@ randomness*. :class:`PairedARS` uses that:
   difference ``R_i+ - R_i-`` then measures the perturbation, not the noise: on the design example
   (N = 256, 8 episodes) a change of the feedback gain by 0.05 moves the paired difference by
   0.088 with a standard deviation of 0.002 across seeds. Each iteration draws new seeds.
-* **Batched.** With the native vector environment (:class:`agents.sb3.SB3VecEnv`) all
+* **Batched.** With the native vector environment (:class:`agents.vec_env.SB3VecEnv`) all
   candidates and the current policy play at once, ``(2 n_delta + 1) n_eval_episodes`` copies
   stepped together, the candidates' networks evaluated in one vectorised call.
 * **Normalisation frozen within an iteration.** The observation statistics (``VecNormalize``)
@@ -44,9 +44,12 @@ from sb3_contrib import ARS
 from sb3_contrib.ars.policies import ARSPolicy
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.evaluation import evaluate_policy
+from stable_baselines3.common.policies import BasePolicy
 from stable_baselines3.common.type_aliases import GymEnv, Schedule
 
 from encctl_gym.errors import ConfigError
+
+from .vec_env import SB3VecEnv
 
 __all__ = ["PairedARS", "STEP_RULES"]
 
@@ -55,9 +58,7 @@ STEP_RULES = ("adam", "ars")
 
 
 def _sb3_vec_env(env: Any) -> Any:
-    """The :class:`agents.sb3.SB3VecEnv` under a stack of VecEnv wrappers, or None."""
-    from .sb3 import SB3VecEnv
-
+    """The :class:`agents.vec_env.SB3VecEnv` under a stack of VecEnv wrappers, or None."""
     while env is not None:
         if isinstance(env, SB3VecEnv):
             return env
@@ -78,7 +79,8 @@ class PairedARS(ARS):
         Adam's decay rates of the first and second moments (``step_rule="adam"``).
     """
 
-    policy_aliases: ClassVar[dict[str, type[ARSPolicy]]] = ARS.policy_aliases
+    policy_aliases: ClassVar[dict[str, type[BasePolicy]]] = ARS.policy_aliases
+    weights: th.Tensor  # type: ignore[assignment]  # the flat policy parameters; sb3-contrib declares None
 
     def __init__(
         self,
@@ -112,10 +114,22 @@ class PairedARS(ARS):
         self._paired_env: Any = None
         self._continue = True
         super().__init__(
-            policy, env, n_delta=n_delta, n_top=n_top, learning_rate=learning_rate, delta_std=delta_std,
-            zero_policy=zero_policy, alive_bonus_offset=alive_bonus_offset, n_eval_episodes=n_eval_episodes,
-            policy_kwargs=policy_kwargs, stats_window_size=stats_window_size, tensorboard_log=tensorboard_log,
-            seed=seed, verbose=verbose, device=device, _init_setup_model=_init_setup_model,
+            policy,
+            env,
+            n_delta=n_delta,
+            n_top=n_top,
+            learning_rate=learning_rate,
+            delta_std=delta_std,
+            zero_policy=zero_policy,
+            alive_bonus_offset=alive_bonus_offset,
+            n_eval_episodes=n_eval_episodes,
+            policy_kwargs=policy_kwargs,
+            stats_window_size=stats_window_size,
+            tensorboard_log=tensorboard_log,
+            seed=seed,
+            verbose=verbose,
+            device=device,
+            _init_setup_model=_init_setup_model,
         )
 
     def _excluded_save_params(self) -> list[str]:
@@ -137,6 +151,7 @@ class PairedARS(ARS):
             returns, played = self._evaluate_batched(base, candidate_weights, seed)
         else:
             returns, played = self._evaluate_sequential(candidate_weights, seed)
+        assert self.env is not None  # set by the constructor (SB3 keeps it Optional for loading)
         n_envs = max(int(self.env.num_envs), 1)
         callback.on_rollout_start()
         for _ in range(max(played // n_envs, 1)):
@@ -146,8 +161,16 @@ class PairedARS(ARS):
         callback.on_rollout_end()
         return returns
 
-    def learn(self, total_timesteps: int, callback: Any = None, log_interval: int = 1, tb_log_name: str = "ARS",
-              reset_num_timesteps: bool = True, async_eval: Any = None, progress_bar: bool = False) -> "PairedARS":
+    def learn(  # type: ignore[override]  # sb3-contrib's ARS.learn adds async_eval before progress_bar
+        self,
+        total_timesteps: int,
+        callback: Any = None,
+        log_interval: int = 1,
+        tb_log_name: str = "ARS",
+        reset_num_timesteps: bool = True,
+        async_eval: Any = None,
+        progress_bar: bool = False,
+    ) -> PairedARS:
         """As :meth:`sb3_contrib.ARS.learn`, and a callback returning False stops training."""
         total_steps, callback = self._setup_learn(total_timesteps, callback, reset_num_timesteps, tb_log_name, progress_bar)
         callback.on_training_start(locals(), globals())
@@ -161,8 +184,6 @@ class PairedARS(ARS):
         return self
 
     def _paired(self, base: Any, copies: int) -> Any:
-        from .sb3 import SB3VecEnv
-
         env = self._paired_env
         if env is None or env.num_envs != copies:
             env = SB3VecEnv(base.config, copies, base.observation, base.reward_scaling, features=base.feature_names)
@@ -196,7 +217,7 @@ class PairedARS(ARS):
         while True:
             o = vn.normalize_obs(obs) if vn is not None else obs
             if vn is not None:
-                centre_obs.append(obs[P * E:])
+                centre_obs.append(obs[P * E :])
             with th.no_grad():
                 a = batched(params, th.as_tensor(np.asarray(o, np.float32)).reshape(P + 1, E, -1)).reshape((P + 1) * E, -1)
             obs, reward, dones, _ = env.step(a.cpu().numpy())
@@ -206,7 +227,7 @@ class PairedARS(ARS):
                 break
         if vn is not None and vn.training:
             vn.obs_rms.update(np.concatenate(centre_obs, axis=0))
-        centre = total[P * E:]
+        centre = total[P * E :]
         self._mimic_monitor_wrapper(centre, np.full(E, steps))
         self.logger.record("rollout/centre_return", float(centre.mean()))
         returns = th.as_tensor(total[: P * E].reshape(P, E).mean(axis=1), dtype=th.float32)
@@ -225,9 +246,12 @@ class PairedARS(ARS):
             for i in range(self.pop_size):
                 if vn is not None:
                     vn.training = training and i == 0
-                policy.load_from_vector(candidate_weights[i].cpu())
+                policy.load_from_vector(candidate_weights[i].cpu())  # type: ignore[arg-type]  # SB3 accepts a tensor
+                assert self.env is not None
                 self.env.seed(seed)
-                rew, lens = evaluate_policy(policy, self.env, n_eval_episodes=self.n_eval_episodes, return_episode_rewards=True, warn=False)
+                rew, lens = evaluate_policy(
+                    policy, self.env, n_eval_episodes=self.n_eval_episodes, return_episode_rewards=True, warn=False
+                )
                 returns[i] = float(np.mean(rew))
                 played += int(np.sum(lens))
                 self._mimic_monitor_wrapper(np.asarray(rew), np.asarray(lens))
@@ -247,7 +271,7 @@ class PairedARS(ARS):
         candidates = th.cat([self.weights + delta_std * deltas, self.weights - delta_std * deltas])
         with th.no_grad():
             R = self.evaluate_candidates(candidates, callback, async_eval)
-        grad = ((R[: self.n_delta] - R[self.n_delta:]).to(deltas) @ deltas) / (2.0 * delta_std * self.n_delta)
+        grad = ((R[: self.n_delta] - R[self.n_delta :]).to(deltas) @ deltas) / (2.0 * delta_std * self.n_delta)
         if self._adam is None:
             self._adam = {"m": th.zeros_like(grad), "v": th.zeros_like(grad), "t": 0}
         st, (b1, b2) = self._adam, self.adam_betas
@@ -257,7 +281,7 @@ class PairedARS(ARS):
         m_hat = st["m"] / (1.0 - b1 ** st["t"])
         v_hat = st["v"] / (1.0 - b2 ** st["t"])
         self.weights = self.weights + lr * m_hat / (v_hat.sqrt() + 1e-8)
-        self.policy.load_from_vector(self.weights.cpu())
+        self.policy.load_from_vector(self.weights.cpu())  # type: ignore[arg-type]  # SB3 accepts a tensor
         self.logger.record("train/iterations", self._n_updates, exclude="tensorboard")
         self.logger.record("train/delta_std", delta_std)
         self.logger.record("train/learning_rate", lr)

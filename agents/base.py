@@ -28,7 +28,7 @@ from encctl_gym.envs.config import AttackParams
 from encctl_gym.envs.layout import OBSERVATION_MODES, ObservationLayout
 from encctl_gym.errors import ParameterError
 
-__all__ = ["Attacker", "ObsLayout", "OBSERVATION_MODES", "observation_indices", "params_of"]
+__all__ = ["Attacker", "OBSERVATION_MODES", "observation_indices", "params_of"]
 
 
 def params_of(env: Any) -> AttackParams:
@@ -38,11 +38,6 @@ def params_of(env: Any) -> AttackParams:
         if isinstance(p, AttackParams):
             return p
     raise ParameterError(f"{type(env).__name__} carries no AttackParams (is it an EncryptedLTIAttack environment?)")
-
-
-#: The environment's observation layout (:class:`encctl_gym.envs.layout.ObservationLayout`),
-#: under the name this module gave it before it had one home.
-ObsLayout = ObservationLayout
 
 
 def observation_indices(params: AttackParams, mode: str) -> np.ndarray:
@@ -84,7 +79,7 @@ class Attacker(ABC):
         self._batch: int | None = None
 
     @classmethod
-    def from_env(cls, env: Any, **kwargs: Any) -> "Attacker":
+    def from_env(cls, env: Any, **kwargs: Any) -> Attacker:
         """Build the attacker for ``env`` (single or vector, wrapped or not)."""
         return cls(params_of(env), **kwargs)
 
@@ -107,7 +102,9 @@ class Attacker(ABC):
         if single:
             o = o[None]
         if o.ndim != 2 or o.shape[1] != self.layout.dim:
-            raise ParameterError(f"observation must have shape ({self.layout.dim},) or (K, {self.layout.dim}), got {np.shape(obs)}")
+            raise ParameterError(
+                f"observation must have shape ({self.layout.dim},) or (K, {self.layout.dim}), got {np.shape(obs)}"
+            )
         if self._batch is None:
             self._batch = o.shape[0]
             self._start(self._batch)

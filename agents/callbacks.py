@@ -16,8 +16,9 @@ from __future__ import annotations
 
 import math
 import sys
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
@@ -62,8 +63,15 @@ class ProgressCallback(BaseCallback):
         from tqdm import tqdm
 
         tty = sys.stderr.isatty()
-        self.bar = tqdm(total=self.total, desc=self.desc, unit="step", mininterval=0.5 if tty else 30.0,
-                        dynamic_ncols=tty, file=sys.stderr, ascii=not tty)
+        self.bar = tqdm(
+            total=self.total,
+            desc=self.desc,
+            unit="step",
+            mininterval=0.5 if tty else 30.0,
+            dynamic_ncols=tty,
+            file=sys.stderr,
+            ascii=not tty,
+        )
 
     def _on_step(self) -> bool:
         self.bar.update(min(self.num_timesteps, self.total) - self.bar.n)
@@ -100,8 +108,16 @@ class LearningCurveCallback(EvalCallback):
         ``best_model_save_path``, ``deterministic``, ``verbose``).
     """
 
-    def __init__(self, eval_env: Any, *, curve: LearningCurve, curve_path: str | Path, eval_seed: int,
-                 on_evaluation: Callable[[LearningCurve], bool] | None = None, **kwargs: Any) -> None:
+    def __init__(
+        self,
+        eval_env: Any,
+        *,
+        curve: LearningCurve,
+        curve_path: str | Path,
+        eval_seed: int,
+        on_evaluation: Callable[[LearningCurve], bool] | None = None,
+        **kwargs: Any,
+    ) -> None:
         super().__init__(eval_env, **kwargs)
         self.on_evaluation = on_evaluation
         self.curve = curve

@@ -47,8 +47,9 @@ from __future__ import annotations
 
 import copy
 import numbers
+from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import yaml
 
@@ -179,7 +180,7 @@ def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _algorithms() -> dict[str, type]:
+def _algorithms() -> Mapping[str, type[Any]]:
     from .sb3 import ALGORITHMS
 
     return ALGORITHMS
@@ -307,9 +308,9 @@ def _int(minimum: int, optional: bool = False, maximum: int | None = None) -> Ch
             return v
         if isinstance(v, bool) or not isinstance(v, numbers.Integral):
             raise ConfigError(f"{name} must be an integer{' or null' if optional else ''}, got {format_value(v)}")
-        if v < minimum:
+        if int(v) < minimum:
             raise ConfigError(f"{name} must be >= {minimum}, got {format_value(v)}")
-        if maximum is not None and v > maximum:
+        if maximum is not None and int(v) > maximum:
             raise ConfigError(f"{name} must be <= {maximum}, got {format_value(v)}")
         return int(v)
 

@@ -18,13 +18,15 @@ system, one line per seed).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
 from encctl_gym.errors import ConfigError
+from encctl_gym.plotting import save_figure
 
 __all__ = ["CURVE_FILE", "LearningCurve", "reference_designs", "curve_for", "load_learning_curve", "plot_learning_curves"]
 
@@ -99,8 +101,20 @@ class LearningCurve:
     def save(self, path: str | Path) -> Path:
         """Write the curve as ``.npz`` (read back with :func:`load_learning_curve`)."""
         path = Path(path)
-        np.savez(path, label=self.label, algo=self.algo, system=self.system, seed=self.seed, N=self.N, gamma=self.gamma,
-                 gamma_gauss=self.gamma_gauss, gamma_opt=self.gamma_opt, design_kind=self.design_kind, timesteps=self.timesteps, epsilon=self.epsilon)
+        np.savez(
+            path,
+            label=self.label,
+            algo=self.algo,
+            system=self.system,
+            seed=self.seed,
+            N=self.N,
+            gamma=self.gamma,
+            gamma_gauss=self.gamma_gauss,
+            gamma_opt=self.gamma_opt,
+            design_kind=self.design_kind,
+            timesteps=self.timesteps,
+            epsilon=self.epsilon,
+        )
         return path
 
 
@@ -119,9 +133,17 @@ def curve_for(params: Any, observation: str, *, algo: str, system: str, seed: in
     """An empty :class:`LearningCurve` with the references of an environment at its horizon."""
     design, gauss = reference_designs(params, observation)
     N = params.horizon
-    return LearningCurve(label=f"{algo} {system} s{seed}", algo=algo, system=system, seed=seed, N=N,
-                         gamma=float(params.gamma(N)), gamma_gauss=float(gauss.gamma(N)), gamma_opt=float(design.gamma(N)),
-                         design_kind=design.kind)
+    return LearningCurve(
+        label=f"{algo} {system} s{seed}",
+        algo=algo,
+        system=system,
+        seed=seed,
+        N=N,
+        gamma=float(params.gamma(N)),
+        gamma_gauss=float(gauss.gamma(N)),
+        gamma_opt=float(design.gamma(N)),
+        design_kind=design.kind,
+    )
 
 
 def load_learning_curve(path: str | Path) -> LearningCurve:
@@ -140,9 +162,17 @@ def load_learning_curve(path: str | Path) -> LearningCurve:
     try:
         with np.load(path, allow_pickle=False) as z:
             return LearningCurve(
-                label=str(z["label"]), algo=str(z["algo"]), system=str(z["system"]), seed=int(z["seed"]), N=int(z["N"]),
-                gamma=float(z["gamma"]), gamma_gauss=float(z["gamma_gauss"]), gamma_opt=float(z["gamma_opt"]), design_kind=str(z["design_kind"]),
-                timesteps=np.asarray(z["timesteps"], dtype=np.int64), epsilon=np.asarray(z["epsilon"], dtype=float),
+                label=str(z["label"]),
+                algo=str(z["algo"]),
+                system=str(z["system"]),
+                seed=int(z["seed"]),
+                N=int(z["N"]),
+                gamma=float(z["gamma"]),
+                gamma_gauss=float(z["gamma_gauss"]),
+                gamma_opt=float(z["gamma_opt"]),
+                design_kind=str(z["design_kind"]),
+                timesteps=np.asarray(z["timesteps"], dtype=np.int64),
+                epsilon=np.asarray(z["epsilon"], dtype=float),
             )
     except (OSError, ValueError, KeyError, EOFError) as exc:
         raise ConfigError(f"cannot read learning curve {str(path)!r}: {type(exc).__name__}: {exc}") from exc
@@ -177,8 +207,9 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
     cs = [c if isinstance(c, LearningCurve) else load_learning_curve(c) for c in curves]
     # a run given by its directory (or its .npz) is named by the directory: two runs of one
     # algorithm, system and seed (other settings) stay apart in the legend
-    names = [None if isinstance(c, LearningCurve) else (Path(c).parent if Path(c).suffix == ".npz" else Path(c)).name
-             for c in curves]
+    names = [
+        None if isinstance(c, LearningCurve) else (Path(c).parent if Path(c).suffix == ".npz" else Path(c)).name for c in curves
+    ]
     if not cs:
         raise ConfigError("no learning curve to plot")
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
@@ -191,17 +222,35 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
         within = [j for j, d in enumerate(cs) if (d.algo, d.system, d.design_kind) == key].index(i)
         r, lo, hi = c.ratio()
         col = colors[g % len(colors)]
-        ax.plot(c.timesteps, r, color=col, ls=styles[within % len(styles)], marker="o", ms=3, lw=1.4,
-                label=(f"{name}: " if name else "") + f"{c.algo}, {c.system}, {c.design_kind}, seed {c.seed} "
-                f"(N = {c.N}, {c.epsilon.shape[1]} episodes)")
+        ax.plot(
+            c.timesteps,
+            r,
+            color=col,
+            ls=styles[within % len(styles)],
+            marker="o",
+            ms=3,
+            lw=1.4,
+            label=(f"{name}: " if name else "") + f"{c.algo}, {c.system}, {c.design_kind}, seed {c.seed} "
+            f"(N = {c.N}, {c.epsilon.shape[1]} episodes)",
+        )
         if np.all(np.isfinite(lo)):
             ax.fill_between(c.timesteps, lo, hi, color=col, alpha=0.15, lw=0)
     for system in dict.fromkeys((c.system, c.design_kind, c.N) for c in cs):
         ref = next(c for c in cs if (c.system, c.design_kind, c.N) == system)
-        ax.axhline(ref.gamma / ref.gamma_opt, color="0.35", ls="--", lw=1.0,
-                   label=f"{ref.system}, {ref.design_kind}: paper's gamma(N) (eq:sic) / gamma_opt(N)")
-        ax.axhline(ref.gamma_gauss / ref.gamma_opt, color="0.35", ls="-.", lw=1.0,
-                   label=f"{ref.system}, {ref.design_kind}: Gaussian attack, exact rate / gamma_opt(N)")
+        ax.axhline(
+            ref.gamma / ref.gamma_opt,
+            color="0.35",
+            ls="--",
+            lw=1.0,
+            label=f"{ref.system}, {ref.design_kind}: paper's gamma(N) (eq:sic) / gamma_opt(N)",
+        )
+        ax.axhline(
+            ref.gamma_gauss / ref.gamma_opt,
+            color="0.35",
+            ls="-.",
+            lw=1.0,
+            label=f"{ref.system}, {ref.design_kind}: Gaussian attack, exact rate / gamma_opt(N)",
+        )
     ax.axhline(1.0, color="k", lw=1.0, label="1: the optimal design (gamma_opt, same power)")
     ax.set_xlabel("training steps")
     # the interesting range is near 1: a policy that starts at zero input (ARS) has an error many
@@ -209,18 +258,31 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
     refs = [c.gamma_gauss / c.gamma_opt for c in cs] + [c.gamma / c.gamma_opt for c in cs]
     top = max(2.0, 1.3 * max(refs))
     peak = max(float(np.nanmax(c.ratio()[0])) for c in cs)
-    if peak > top:
-        low = min(0.9, min(float(np.nanmin(c.ratio()[0])) for c in cs) * 0.97)
+    low = min(0.9, min(float(np.nanmin(c.ratio()[0])) for c in cs) * 0.97)
+    # every curve keeps at least its last evaluation in view: a short (quick) run that never came
+    # near the optimum is drawn on a log axis instead of being cut away
+    last_below_cut = all(float(c.ratio()[0][np.isfinite(c.ratio()[0])][-1]) <= top for c in cs)
+    if peak > top and last_below_cut:
         ax.set_ylim(low, top)
-        ax.text(0.5, 0.98, f"cut at {top:.2g}: early evaluations up to {peak:.3g}", transform=ax.transAxes,
-                fontsize=7, va="top", ha="center")
+        ax.text(
+            0.5,
+            0.98,
+            f"cut at {top:.2g}: early evaluations up to {peak:.3g}",
+            transform=ax.transAxes,
+            fontsize=7,
+            va="top",
+            ha="center",
+        )
+    elif peak > top:
+        ax.set_yscale("log")
+        ax.set_ylim(low, 1.5 * peak)
     ax.set_ylabel("E[eps(N)] / gamma_opt(N)  (evaluation episodes)")
     ax.set_title(title or "Learning curves: evaluation error over the optimum", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=110, bbox_inches="tight")
+    save_figure(fig, path, dpi=110, tight=True)
     plt.close(fig)
     return path
 

@@ -16,8 +16,9 @@ from typing import Any
 import numpy as np
 
 from encctl_gym._validation import check_int
-from encctl_gym.envs.config import AttackParams, resolve_params
+from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ParameterError
+from encctl_gym.ident.tails import ErrorSummary, error_tail_exponent, summarize_errors
 
 from .base import Attacker
 
@@ -146,10 +147,18 @@ class Rollout:
     def se_final(self) -> float:
         return float(self.final_epsilon.std(ddof=1) / np.sqrt(self.episodes)) if self.episodes > 1 else float("nan")
 
+    def summary_final(self, n: int | None = None, m: int | None = None) -> ErrorSummary:
+        """Median, quantiles and the status of the mean of the final errors
+        (:func:`encctl_gym.ident.tails.summarize_errors`; with ``n`` and ``m`` the least-squares
+        tail rule at the final ``N``, which assumes inputs with a density, else only the Hill check)."""
+        N = int(self.N[-1])
+        rule = error_tail_exponent(n, m, N) if n is not None and m is not None and N > n + m else None
+        return summarize_errors(self.final_epsilon, tail_exponent=rule)
+
 
 def rollout(
     attacker: Attacker,
-    config: dict[str, Any] | AttackParams,
+    config: dict[str, Any],
     *,
     episodes: int,
     seed: int = 0,
@@ -244,14 +253,14 @@ def rollout(
             attacker.reset(seed=np.random.SeedSequence([seed, e]))
             eps_t, en_t, Ns = [], [], []
             while True:
-                obs, _, te, tr, info = env1.step(attacker.act(obs))
+                obs, _, te1, tr1, info = env1.step(attacker.act(obs))
                 if record:
                     eps_t.append(info["epsilon"])
                     en_t.append(info["input_energy"])
                     Ns.append(info["samples_delivered"])
                 if progress is not None:
                     progress.update(1)
-                if te or tr:
+                if te1 or tr1:
                     break
             if covariance:
                 add_gram(env1.episode, 1)

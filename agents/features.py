@@ -26,11 +26,13 @@ A new feature is a subclass of :class:`Feature` and a row of :data:`FEATURES`.
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
 from encctl_gym.errors import ConfigError, ParameterError
+from encctl_gym.registry import Registry
 
 __all__ = ["Feature", "DitherFeature", "FEATURES", "FeatureSet", "check_features"]
 
@@ -106,7 +108,7 @@ class DitherFeature(Feature):
 
 
 #: Features by the name a configuration's ``features`` list gives.
-FEATURES: dict[str, type[Feature]] = {cls.name: cls for cls in (DitherFeature,)}
+FEATURES: Registry[type[Feature]] = Registry("feature", [DitherFeature], error=ConfigError)
 
 
 def check_features(names: Any, where: str = "features") -> list[str]:
@@ -116,8 +118,10 @@ def check_features(names: Any, where: str = "features") -> list[str]:
     if not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names):
         raise ConfigError(f"{where} must be a list of feature names, got {names!r}")
     for n in names:
-        if n not in FEATURES:
-            raise ConfigError(f"unknown feature {n!r} in {where}; choose among {', '.join(FEATURES)}")
+        try:
+            FEATURES.lookup(n)
+        except ConfigError as exc:
+            raise ConfigError(f"{where}: {exc}") from None
     if len(set(names)) != len(names):
         raise ConfigError(f"{where} names a feature twice: {list(names)!r}")
     return list(names)

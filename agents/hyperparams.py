@@ -29,8 +29,19 @@ from typing import Any
 from encctl_gym._validation import format_value
 from encctl_gym.errors import ConfigError
 
-__all__ = ["ACTIVATIONS", "RESERVED", "SCHEDULED", "INT64_MAX", "type_hints", "check_value", "check_kwargs", "network_bytes", "policy_kwargs",
-           "parse_schedule", "make_schedules"]
+__all__ = [
+    "ACTIVATIONS",
+    "RESERVED",
+    "SCHEDULED",
+    "INT64_MAX",
+    "type_hints",
+    "check_value",
+    "check_kwargs",
+    "network_bytes",
+    "policy_kwargs",
+    "parse_schedule",
+    "make_schedules",
+]
 
 #: ``activation_fn`` names accepted in configs -> ``torch.nn`` class names.
 ACTIVATIONS = {"tanh": "Tanh", "relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "silu": "SiLU", "gelu": "GELU"}
@@ -41,9 +52,22 @@ RESERVED = frozenset({"policy", "env", "seed", "verbose", "device", "tensorboard
 _POLICY_RESERVED = frozenset({"observation_space", "action_space", "lr_schedule", "use_sde"})
 
 #: Hyperparameters that must be positive integers (or floats in (0, 1]) whatever the algorithm.
-_POSITIVE_INT = frozenset({"n_steps", "batch_size", "n_epochs", "buffer_size", "stats_window_size",
-                           "target_update_interval", "policy_delay", "lstm_hidden_size", "n_lstm_layers",
-                           "n_delta", "n_top", "n_eval_episodes"})
+_POSITIVE_INT = frozenset(
+    {
+        "n_steps",
+        "batch_size",
+        "n_epochs",
+        "buffer_size",
+        "stats_window_size",
+        "target_update_interval",
+        "policy_delay",
+        "lstm_hidden_size",
+        "n_lstm_layers",
+        "n_delta",
+        "n_top",
+        "n_eval_episodes",
+    }
+)
 _UNIT_INTERVAL = frozenset({"gamma", "gae_lambda", "tau"})
 #: Largest integer hyperparameter (sizes and counts are int64 in PyTorch and NumPy).
 INT64_MAX = 2**63 - 1
@@ -101,8 +125,11 @@ def type_hints(fn: Any) -> tuple[list[str], dict[str, Any]]:
     (``VecEnv``); they are supplied here. A hint that still cannot be resolved is left out (the
     name is still known, its value is then not type-checked).
     """
-    params = [p.name for p in inspect.signature(fn).parameters.values()
-              if p.name != "self" and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+    params = [
+        p.name
+        for p in inspect.signature(fn).parameters.values()
+        if p.name != "self" and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
+    ]
     try:
         from stable_baselines3.common.vec_env import VecEnv
 
@@ -181,8 +208,10 @@ def check_value(name: str, value: Any, annotation: Any) -> Any:
         raise ConfigError(f"{name}={format_value(value)} does not fit its type {_describe(annotation)}")
     big = _outside_int64(value)
     if big is not None:
-        raise ConfigError(f"{name} holds the integer {format_value(big)}, outside the 64-bit range (|v| <= {INT64_MAX}) that "
-                          "PyTorch and NumPy count in")
+        raise ConfigError(
+            f"{name} holds the integer {format_value(big)}, outside the 64-bit range (|v| <= {INT64_MAX}) that "
+            "PyTorch and NumPy count in"
+        )
     if leaf in _POSITIVE_INT and value is not None and value < 1:
         raise ConfigError(f"{name} must be >= 1, got {value!r}")
     if leaf in _UNIT_INTERVAL and not 0.0 < float(value) <= 1.0:

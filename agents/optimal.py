@@ -58,9 +58,13 @@ class OptimalDesignAttacker(Attacker):
             raise ParameterError("the closed-loop design needs delivered states; with decipher_delay='end' use feedback=False")
         kind = "closed_loop" if feedback else "open_loop"
         if design is None:
-            design = optimal_attack_design(params.A, params.B, sigma_u2=params.sigma_u2, sigma_w2=params.sigma_w2, feedback=feedback)
+            design = optimal_attack_design(
+                params.A, params.B, sigma_u2=params.sigma_u2, sigma_w2=params.sigma_w2, feedback=feedback
+            )
         elif design.kind != kind or design.K.shape != (params.m, params.n):
-            raise ParameterError(f"design of kind {design.kind!r} does not fit a {kind} attacker with (n, m) = ({params.n}, {params.m})")
+            raise ParameterError(
+                f"design of kind {design.kind!r} does not fit a {kind} attacker with (n, m) = ({params.n}, {params.m})"
+            )
         self.design = design
         self.feedback = feedback
         self.needs_states = feedback
@@ -71,7 +75,7 @@ class OptimalDesignAttacker(Attacker):
         self._A, self._B = params.A, params.B
 
     @classmethod
-    def from_env(cls, env: Any, **kwargs: Any) -> "OptimalDesignAttacker":
+    def from_env(cls, env: Any, **kwargs: Any) -> OptimalDesignAttacker:
         """From an environment; reuses the environment's own design when it computed one."""
         from .base import params_of
 
@@ -98,6 +102,7 @@ class OptimalDesignAttacker(Attacker):
         if not self.feedback:
             return self._x
         d = self.params.decipher_delay
+        assert d is not None  # a feedback attacker needs delivered states (checked in __init__)
         j = self._k - d  # index of the latest delivered state
         if d == 0:
             return obs[:, self.layout.state]

@@ -22,7 +22,8 @@ RLlib env runner (one Python ``step`` per copy) does not.
 
 from __future__ import annotations
 
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 from encctl_gym.errors import EncctlError
 
@@ -37,8 +38,9 @@ def _require_rllib() -> Any:
         import ray
         from ray.rllib.algorithms.ppo import PPOConfig  # noqa: F401
     except ModuleNotFoundError as exc:
-        raise EncctlError(f"agents.rllib needs Ray RLlib (module {exc.name!r} is missing); "
-                          "install the extra: pip install 'encctl-gym[ray]'") from exc
+        raise EncctlError(
+            f"agents.rllib needs Ray RLlib (module {exc.name!r} is missing); install the extra: pip install 'encctl-gym[ray]'"
+        ) from exc
     return ray
 
 
@@ -97,8 +99,13 @@ def ppo_config(
         PPOConfig()
         .environment(register(), env_config=dict(env_config))
         .env_runners(num_env_runners=int(num_env_runners), num_envs_per_env_runner=int(num_envs_per_env_runner))
-        .training(train_batch_size=int(train_batch_size), minibatch_size=int(minibatch_size), num_epochs=int(num_epochs),
-                  gamma=float(gamma), lr=float(lr))
+        .training(
+            train_batch_size=int(train_batch_size),
+            minibatch_size=int(minibatch_size),
+            num_epochs=int(num_epochs),
+            gamma=float(gamma),
+            lr=float(lr),
+        )
         .framework("torch")
     )
     if seed is not None:
@@ -106,7 +113,9 @@ def ppo_config(
     return cfg
 
 
-def train_ppo(env_config: Mapping[str, Any], *, iterations: int, address: str | None = None, **kwargs: Any) -> list[dict[str, Any]]:
+def train_ppo(
+    env_config: Mapping[str, Any], *, iterations: int, address: str | None = None, **kwargs: Any
+) -> list[dict[str, Any]]:
     """Train PPO with RLlib for ``iterations`` iterations; one summary per iteration.
 
     Parameters
@@ -140,12 +149,14 @@ def train_ppo(env_config: Mapping[str, Any], *, iterations: int, address: str | 
     try:
         for i in range(iterations):
             r = algo.train()
-            rows.append({
-                "iteration": i + 1,
-                "env_steps": int(r.get("num_env_steps_sampled_lifetime", 0)),
-                "episode_return_mean": r.get("env_runners", {}).get("episode_return_mean"),
-                "seconds": float(r.get("time_this_iter_s", float("nan"))),
-            })
+            rows.append(
+                {
+                    "iteration": i + 1,
+                    "env_steps": int(r.get("num_env_steps_sampled_lifetime", 0)),
+                    "episode_return_mean": r.get("env_runners", {}).get("episode_return_mean"),
+                    "seconds": float(r.get("time_this_iter_s", float("nan"))),
+                }
+            )
     finally:
         algo.stop()
         if started:

@@ -29,9 +29,10 @@ from __future__ import annotations
 import json
 import shutil
 import zipfile
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 from encctl_gym._validation import format_value
 from encctl_gym.errors import ConfigError

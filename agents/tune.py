@@ -32,8 +32,9 @@ from __future__ import annotations
 import argparse
 import copy
 import math
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import yaml
@@ -107,7 +108,18 @@ SEARCH_SPACES: dict[str, Callable[[Any], dict[str, Any]]] = {
 
 #: Top-level entries of a configuration that a tuned file may carry (the rest is the system's or
 #: the run's own).
-TUNED_KEYS = ("env", "horizon", "observation", "features", "reward_scaling", "n_envs", "n_timesteps", "normalize", "policy", "hyperparams")
+TUNED_KEYS = (
+    "env",
+    "horizon",
+    "observation",
+    "features",
+    "reward_scaling",
+    "n_envs",
+    "n_timesteps",
+    "normalize",
+    "policy",
+    "hyperparams",
+)
 
 
 def _set(cfg: dict[str, Any], key: str, value: Any) -> None:
@@ -115,7 +127,9 @@ def _set(cfg: dict[str, Any], key: str, value: Any) -> None:
     apply_override(cfg, f"{key}={yaml.safe_dump(value, default_flow_style=True).strip()}")
 
 
-def objective_ratio(run_dir: str | Path, *, episodes: int, seed: int = OBJECTIVE_SEED, which: str = "best") -> tuple[float, float]:
+def objective_ratio(
+    run_dir: str | Path, *, episodes: int, seed: int = OBJECTIVE_SEED, which: str = "best"
+) -> tuple[float, float]:
     """Paired error ratio of a run's policy to the oracle at the training attack length.
 
     Returns
@@ -139,7 +153,8 @@ def objective_ratio(run_dir: str | Path, *, episodes: int, seed: int = OBJECTIVE
     feedback = params.decipher_delay is not None and run.observation != "blind"
     oracle = OptimalDesignAttacker(params, feedback=feedback)
     d = np.log(rollout(att, cfg, episodes=episodes, seed=seed, record=False).final_epsilon) - np.log(
-        rollout(oracle, cfg, episodes=episodes, seed=seed, record=False).final_epsilon)
+        rollout(oracle, cfg, episodes=episodes, seed=seed, record=False).final_epsilon
+    )
     se = float(d.std(ddof=1) / math.sqrt(d.size)) if d.size > 1 else float("nan")
     return float(math.exp(d.mean())), se
 
@@ -216,8 +231,14 @@ def tune(
     url = storage or f"sqlite:///{(out / 'study.db').resolve()}"
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     pruner = optuna.pruners.MedianPruner(n_startup_trials=3, n_warmup_steps=1) if prune else optuna.pruners.NopPruner()
-    study = optuna.create_study(study_name=name, storage=url, load_if_exists=True, direction="minimize",
-                                sampler=optuna.samplers.TPESampler(seed=sampler_seed), pruner=pruner)
+    study = optuna.create_study(
+        study_name=name,
+        storage=url,
+        load_if_exists=True,
+        direction="minimize",
+        sampler=optuna.samplers.TPESampler(seed=sampler_seed),
+        pruner=pruner,
+    )
 
     def objective(trial: Any) -> float:
         trial_cfg = copy.deepcopy(cfg)
@@ -229,8 +250,16 @@ def tune(
             trial.report(float(curve.ratio()[0][-1]), step)
             return not trial.should_prune()
 
-        run_dir = train(trial_cfg, out=out / "trials", seed=int(cfg["seed"]) + trial.number, progress=progress,
-                        tensorboard=False, name=f"trial_{trial.number:04d}", overwrite=True, on_evaluation=report)
+        run_dir = train(
+            trial_cfg,
+            out=out / "trials",
+            seed=int(cfg["seed"]) + trial.number,
+            progress=progress,
+            tensorboard=False,
+            name=f"trial_{trial.number:04d}",
+            overwrite=True,
+            on_evaluation=report,
+        )
         trial.set_user_attr("run_dir", str(run_dir))
         trial.set_user_attr("config", {k: trial_cfg[k] for k in TUNED_KEYS if k in trial_cfg})
         from .runs import read_run
@@ -248,11 +277,13 @@ def tune(
     best = study.best_trial
     best_cfg = {**copy.deepcopy(cfg), **best.user_attrs["config"]}
     tuned = tuned_config(best_cfg)
-    header = [f"Tuned by `encctl-gym tune` (study {name!r}, {len(done)} completed of {len(study.trials)} trials):",
-              f"best trial {best.number}: paired error ratio to the oracle {best.value:.4f} at N = "
-              f"{cfg.get('horizon') or 'the preset budget'} on {episodes} seeds from {OBJECTIVE_SEED}.",
-              f"Merged over agents/configs/defaults/{algo}.yaml (see agents/config.py for every key); n_timesteps is the",
-              "trials' training budget."]
+    header = [
+        f"Tuned by `encctl-gym tune` (study {name!r}, {len(done)} completed of {len(study.trials)} trials):",
+        f"best trial {best.number}: paired error ratio to the oracle {best.value:.4f} at N = "
+        f"{cfg.get('horizon') or 'the preset budget'} on {episodes} seeds from {OBJECTIVE_SEED}.",
+        f"Merged over agents/configs/defaults/{algo}.yaml (see agents/config.py for every key); n_timesteps is the",
+        "trials' training budget.",
+    ]
     path = out / f"{algo}_{cfg['system']}.yaml"
     path.write_text(_yaml_text(tuned, header))
     return study, path
@@ -265,19 +296,36 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--system", default=None, metavar="FILE", help="plant file (as train --system)")
     parser.add_argument("--config", default=None, metavar="FILE", help="base config file (as train --config)")
     parser.add_argument("--quick", action="store_true", help="the configs' quick sections (a smoke test)")
-    parser.add_argument("--trials", type=int, default=20, help="trials to run now (default 20; a resumed study keeps its earlier ones)")
+    parser.add_argument(
+        "--trials", type=int, default=20, help="trials to run now (default 20; a resumed study keeps its earlier ones)"
+    )
     parser.add_argument("--n-timesteps", type=int, default=None, help="training steps of every trial")
-    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                        help="override a config entry of every trial (as train --set); repeatable")
-    parser.add_argument("--episodes", type=int, default=100, help="seeds of each trial's paired ratio to the oracle (default 100)")
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a config entry of every trial (as train --set); repeatable",
+    )
+    parser.add_argument(
+        "--episodes", type=int, default=100, help="seeds of each trial's paired ratio to the oracle (default 100)"
+    )
     parser.add_argument("--out", default="results/tune", help="output directory (default results/tune)")
-    parser.add_argument("--storage", default=None, metavar="URL",
-                        help="Optuna storage URL shared by several machines (default: sqlite file OUT/study.db)")
+    parser.add_argument(
+        "--storage",
+        default=None,
+        metavar="URL",
+        help="Optuna storage URL shared by several machines (default: sqlite file OUT/study.db)",
+    )
     parser.add_argument("--study-name", default=None, help="study name (default {algo}_{system})")
     parser.add_argument("--seed", type=int, default=0, help="sampler seed; trial i trains with seed + i (default 0)")
     parser.add_argument("--no-prune", action="store_true", help="run every trial to its end")
-    parser.add_argument("--save-config", action="store_true",
-                        help="also write the best configuration to agents/configs/{algo}_{preset}.yaml (needs --preset)")
+    parser.add_argument(
+        "--save-config",
+        action="store_true",
+        help="also write the best configuration to agents/configs/{algo}_{preset}.yaml (needs --preset)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
@@ -296,11 +344,22 @@ def run(args: argparse.Namespace) -> int:
         apply_override(cfg, f"n_timesteps={args.n_timesteps}")
     for item in args.overrides:
         apply_override(cfg, item)
-    study, path = tune(cfg, trials=args.trials, out=args.out, storage=args.storage, study_name=args.study_name,
-                       episodes=args.episodes, sampler_seed=args.seed, prune=not args.no_prune, progress=not args.no_progress)
+    study, path = tune(
+        cfg,
+        trials=args.trials,
+        out=args.out,
+        storage=args.storage,
+        study_name=args.study_name,
+        episodes=args.episodes,
+        sampler_seed=args.seed,
+        prune=not args.no_prune,
+        progress=not args.no_progress,
+    )
     best = study.best_trial
-    print(f"study {study.study_name}: {len(study.trials)} trials; best trial {best.number}: paired error ratio to the oracle "
-          f"{best.value:.4f} (run {best.user_attrs['run_dir']})")
+    print(
+        f"study {study.study_name}: {len(study.trials)} trials; best trial {best.number}: paired error ratio to the oracle "
+        f"{best.value:.4f} (run {best.user_attrs['run_dir']})"
+    )
     for k, v in best.params.items():
         print(f"  {k} = {v}")
     print(f"best configuration: {path}")

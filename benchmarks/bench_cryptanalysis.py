@@ -27,7 +27,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from encctl_gym.crypto import arith
 from encctl_gym.crypto.group import generate_safe_prime_group
 from encctl_gym.cryptanalysis import bsgs, index_calculus, pari_available, rho
-from encctl_gym.cryptanalysis.cli import key_sequence
+from encctl_gym.cryptanalysis.keys import key_sequence
 from encctl_gym.cryptanalysis.registry import get_breaker
 from encctl_gym.cryptanalysis.sequence import break_sequence
 

@@ -28,7 +28,7 @@ import statistics
 import sys
 import time
 import tracemalloc
-from typing import Callable
+from collections.abc import Callable
 
 import gmpy2
 import numpy as np
@@ -41,9 +41,7 @@ from encctl_gym.crypto.group import estimate_generation_seconds, generate_safe_p
 from encctl_gym.crypto.modified import modified_decrypt, modified_eval
 from encctl_gym.crypto.residue_table import ResidueTable, residue_table_bytes
 
-PHI = np.array(
-    [[0.5, -1.2, 0.3, 0.0], [1.0, 2.0, -3.0, 0.25], [0.1, 0.2, 0.3, 0.4], [-1.0, -1.0, -1.0, -1.0]]
-)
+PHI = np.array([[0.5, -1.2, 0.3, 0.0], [1.0, 2.0, -3.0, 0.25], [0.1, 0.2, 0.3, 0.4], [-1.0, -1.0, -1.0, -1.0]])
 
 
 def timeit(fn: Callable[[], object], reps: int) -> float:
@@ -60,7 +58,7 @@ def timeit(fn: Callable[[], object], reps: int) -> float:
     return min(times)
 
 
-def _generate(bits: int, queue: "mp.Queue[float]") -> None:
+def _generate(bits: int, queue: mp.Queue[float]) -> None:
     t0 = time.perf_counter()
     grp = generate_safe_prime_group(bits)
     keygen(grp)
@@ -72,7 +70,7 @@ def fresh_keygen(bits: int, samples: int, timeout: float) -> str:
     times = []
     ctx = mp.get_context("spawn" if sys.platform == "win32" else "fork")
     for _ in range(samples):
-        queue: "mp.Queue[float]" = ctx.Queue()
+        queue: mp.Queue[float] = ctx.Queue()
         proc = ctx.Process(target=_generate, args=(bits, queue), daemon=True)
         proc.start()
         proc.join(timeout)
@@ -120,7 +118,7 @@ def bench_size(bits: int, reps: int, fresh_samples: int, fresh_timeout: float, s
         ctrl = EncryptedLinearController(PHI, grp, 2.0**16, 10.0, scheme=scheme)
         xs = np.random.default_rng(0).uniform(-10, 10, (reps + 1, 4))
         it = iter(xs)
-        t_step = timeit(lambda: ctrl.step(next(it)), reps)
+        t_step = timeit(lambda ctrl=ctrl, it=it: ctrl.step(next(it)), reps)
         with arith.PowmodCounter() as c:
             ctrl.step(xs[0])
         steps[scheme] = (t_step, c.count)
@@ -139,8 +137,14 @@ def bench_size(bits: int, reps: int, fresh_samples: int, fresh_timeout: float, s
             f"  {'control step, ' + scheme + ' (n=m=4)':<34s} {t_step * 1e3:9.3f} ms  "
             f"= {t_step / t_pow:6.1f} powmod times; {count} powmods counted"
         )
-    return {"bits": bits, "powmod_s": t_pow, "python_pow_s": t_pow_py, "fresh_keygen": fresh,
-            **{f"step_{k}_s": v[0] for k, v in steps.items()}, **{f"step_{k}_powmods": v[1] for k, v in steps.items()}}
+    return {
+        "bits": bits,
+        "powmod_s": t_pow,
+        "python_pow_s": t_pow_py,
+        "fresh_keygen": fresh,
+        **{f"step_{k}_s": v[0] for k, v in steps.items()},
+        **{f"step_{k}_powmods": v[1] for k, v in steps.items()},
+    }
 
 
 def bench_generation(sizes: list[tuple[int, int]]) -> None:
@@ -150,8 +154,9 @@ def bench_generation(sizes: list[tuple[int, int]]) -> None:
     grows with the load, the CPU time is what the estimate models.
     """
     print("\n== safe-prime generation: mean of n searches (seeded streams 0..n-1) vs the estimate ==")
-    print(f"  {'bits':>5s} {'n':>3s} {'estimate':>9s} {'wall mean':>10s} {'ratio':>6s} {'cpu mean':>9s} "
-          f"{'ratio':>6s} {'sem':>5s}")
+    print(
+        f"  {'bits':>5s} {'n':>3s} {'estimate':>9s} {'wall mean':>10s} {'ratio':>6s} {'cpu mean':>9s} {'ratio':>6s} {'sem':>5s}"
+    )
     for bits, samples in sizes:
         wall, cpu = [], []
         for i in range(samples):
@@ -175,8 +180,10 @@ def bench_residue_table(limit: int) -> None:
     tracemalloc.stop()
     est = residue_table_bytes(limit)
     print(f"\n== residue table, limit {limit} (712-bit group) ==")
-    print(f"  build {dt:.2f} s (under tracemalloc); peak {peak / 2**20:.1f} MiB; "
-          f"estimate {est / 2**20:.1f} MiB ({est / peak:.2f}x the peak)")
+    print(
+        f"  build {dt:.2f} s (under tracemalloc); peak {peak / 2**20:.1f} MiB; "
+        f"estimate {est / 2**20:.1f} MiB ({est / peak:.2f}x the peak)"
+    )
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -190,7 +197,9 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     reps = args.reps or (8 if args.quick else 30)
     fresh_samples = 1 if args.quick else 3
-    print(f"gmpy2 {gmpy2.version()}, {gmpy2.mp_version()}; reps = {reps}; times are the best of reps (fresh keygen: median of samples)")
+    print(
+        f"gmpy2 {gmpy2.version()}, {gmpy2.mp_version()}; reps = {reps}; times are the best of reps (fresh keygen: median of samples)"
+    )
     sizes = {}
     for bits in args.bits:
         skip = bits >= 2048 and (args.quick or args.skip_fresh_2048)
@@ -207,13 +216,20 @@ def main(argv: list[str] | None = None) -> int:
         f = sizes[712]
         from record import write
 
-        write("bench_crypto", {str(b): v for b, v in sizes.items()}, [
-            ("encrypted control step, modified scheme, n = m = 4, 712 bits",
-             f"{f['step_modified_s'] * 1e3:.2f} ms = {f['step_modified_s'] / f['powmod_s']:.1f} powmod times "
-             f"({f['step_modified_powmods']} modular exponentiations counted); token scheme {f['step_token_powmods']}"),
-            ("gmpy2 vs Python `pow` at 712 bits", f"{f['python_pow_s'] / f['powmod_s']:.1f}x faster"),
-            ("fresh 712-bit safe-prime group and KeyGen", f"{f['fresh_keygen']} (shipped groups: instant)"),
-        ], argv)
+        write(
+            "bench_crypto",
+            {str(b): v for b, v in sizes.items()},
+            [
+                (
+                    "encrypted control step, modified scheme, n = m = 4, 712 bits",
+                    f"{f['step_modified_s'] * 1e3:.2f} ms = {f['step_modified_s'] / f['powmod_s']:.1f} powmod times "
+                    f"({f['step_modified_powmods']} modular exponentiations counted); token scheme {f['step_token_powmods']}",
+                ),
+                ("gmpy2 vs Python `pow` at 712 bits", f"{f['python_pow_s'] / f['powmod_s']:.1f}x faster"),
+                ("fresh 712-bit safe-prime group and KeyGen", f"{f['fresh_keygen']} (shipped groups: instant)"),
+            ],
+            argv,
+        )
     return 0
 
 

@@ -141,8 +141,10 @@ def main(argv: list[str] | None = None) -> int:
         vsps = vector_steps_per_second(vec, vec_acts[:est_steps])
         vec.close()
         est_rows.append((est, single, vsps))
-        print(f"estimator {est:<10}: single {single:10,.0f} steps/s ({single / our_sps:.2g}x ls), "
-              f"vector {vsps:12,.0f} env-steps/s ({vsps / vec_sps:.2g}x ls)")
+        print(
+            f"estimator {est:<10}: single {single:10,.0f} steps/s ({single / our_sps:.2g}x ls), "
+            f"vector {vsps:12,.0f} env-steps/s ({vsps / vec_sps:.2g}x ls)"
+        )
 
     floor = powmod_seconds(712)
     per_step = elgamal_seconds_per_step(5 if args.quick else 30)
@@ -152,17 +154,39 @@ def main(argv: list[str] | None = None) -> int:
     if args.record:
         from record import write
 
-        figures = {"single_sps": our_sps, "pendulum_sps": pend_sps, "vector_sps": vec_sps, "one_thread_sps": one_sps,
-                   "parallel_sps": par_sps, "elgamal_step_s": per_step, "powmod_s": floor}
-        write("bench_env", figures, [
-            ("environment (ideal backend) vs `Pendulum-v1`, both through `gymnasium.make`", f"{our_sps / pend_sps:.2f}x the steps per second ({our_sps:,.0f} steps/s)"),
-            (f"native vector environment, {num_envs} copies, vs the single environment ({n_vec}-step passes)",
-             f"{vec_sps / our_sps:.1f}x as constructed (helper thread); {one_sps / our_sps:.1f}x with `helper_thread=False`; "
-             f"{par_sps / our_sps:.1f}x with `parallel=True`"),
-            ("environment step through real ElGamal at 712 bits", f"{per_step * 1e3:.2f} ms = {per_step / floor:.1f} powmod times"),
-            ("estimators other than least squares: steps per second, single env / vector env (their share of least squares')",
-             "; ".join(f"`{e}` {s1:,.0f} ({s1 / our_sps:.2g}x) / {v:,.0f} ({v / vec_sps:.2g}x)" for e, s1, v in est_rows)),
-        ], argv)
+        figures = {
+            "single_sps": our_sps,
+            "pendulum_sps": pend_sps,
+            "vector_sps": vec_sps,
+            "one_thread_sps": one_sps,
+            "parallel_sps": par_sps,
+            "elgamal_step_s": per_step,
+            "powmod_s": floor,
+        }
+        write(
+            "bench_env",
+            figures,
+            [
+                (
+                    "environment (ideal backend) vs `Pendulum-v1`, both through `gymnasium.make`",
+                    f"{our_sps / pend_sps:.2f}x the steps per second ({our_sps:,.0f} steps/s)",
+                ),
+                (
+                    f"native vector environment, {num_envs} copies, vs the single environment ({n_vec}-step passes)",
+                    f"{vec_sps / our_sps:.1f}x as constructed (helper thread); {one_sps / our_sps:.1f}x with `helper_thread=False`; "
+                    f"{par_sps / our_sps:.1f}x with `parallel=True`",
+                ),
+                (
+                    "environment step through real ElGamal at 712 bits",
+                    f"{per_step * 1e3:.2f} ms = {per_step / floor:.1f} powmod times",
+                ),
+                (
+                    "estimators other than least squares: steps per second, single env / vector env (their share of least squares')",
+                    "; ".join(f"`{e}` {s1:,.0f} ({s1 / our_sps:.2g}x) / {v:,.0f} ({v / vec_sps:.2g}x)" for e, s1, v in est_rows),
+                ),
+            ],
+            argv,
+        )
     return 0
 
 

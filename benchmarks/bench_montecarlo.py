@@ -86,10 +86,17 @@ def main(argv: list[str] | None = None) -> int:
     if args.record:
         from record import write
 
-        write("bench_montecarlo", {"batched_s": t_batched, "loop_s": t_loop, "max_relative_difference": dev}, [
-            (f"batched Monte Carlo engine vs a one-`lstsq`-per-N loop ({args.runs} runs, {grid.size} sample sizes up to {grid[-1]})",
-             f"{t_loop / t_batched:.1f}x (same errors to {dev:.0e})"),
-        ], argv)
+        write(
+            "bench_montecarlo",
+            {"batched_s": t_batched, "loop_s": t_loop, "max_relative_difference": dev},
+            [
+                (
+                    f"batched Monte Carlo engine vs a one-`lstsq`-per-N loop ({args.runs} runs, {grid.size} sample sizes up to {grid[-1]})",
+                    f"{t_loop / t_batched:.1f}x (same errors to {dev:.0e})",
+                )
+            ],
+            argv,
+        )
     return 0
 
 

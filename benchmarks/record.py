@@ -1,11 +1,11 @@
-"""Recorded benchmark results, and the README table made from them.
+"""Recorded benchmark results, and the benchmark table of the docs made from them.
 
 Each benchmark script, run with ``--record``, writes ``benchmarks/results/<name>.json``: the
-figures it measured in that run, the rows it contributes to the README's benchmark table (its
+figures it measured in that run, the rows it contributes to the benchmark table of docs/benchmarks.md (its
 own wording of what was measured), the command, the date and the machine. ``python
-benchmarks/record.py`` rewrites the table in README.md (between the markers
-``<!-- bench:table -->`` and ``<!-- /bench:table -->``) from the recorded files, so the README
-never shows a number that no recorded run printed.
+benchmarks/record.py`` rewrites the table in docs/benchmarks.md (between the markers
+``<!-- bench:table -->`` and ``<!-- /bench:table -->``) from the recorded files, so the docs
+never show a number that no recorded run printed.
 """
 
 from __future__ import annotations
@@ -15,12 +15,13 @@ import json
 import os
 import platform
 import sys
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "results"
-README = ROOT / "README.md"
+README = ROOT / "docs" / "benchmarks.md"  # the page that carries the table
 BEGIN, END = "<!-- bench:table -->", "<!-- /bench:table -->"
 #: The order of the benchmarks in the table.
 ORDER = ("bench_crypto", "bench_montecarlo", "bench_env", "bench_cryptanalysis")
@@ -74,4 +75,4 @@ def update_readme(readme: Path = README, results: Path = RESULTS) -> bool:
 
 if __name__ == "__main__":
     changed = update_readme()
-    print("README benchmark table " + ("updated" if changed else "already up to date"))
+    print(f"{README.relative_to(ROOT)} benchmark table " + ("updated" if changed else "already up to date"))

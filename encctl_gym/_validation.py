@@ -143,7 +143,7 @@ def _as_float(name: str, value: Any) -> float:
 
 def check_real(name: str, value: Any) -> float:
     """Return ``value`` as a float, raising :class:`ParameterError` unless it is a finite real
-    number (not a bool, not complex, within the float64 range)."""
+    number (not a bool, not complex, not a string, within the float64 range)."""
     return _as_float(name, value)
 
 

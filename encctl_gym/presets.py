@@ -23,11 +23,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
-from ._validation import format_value
-from .errors import ParameterError
+from .registry import Registry
 from .units import SECONDS_PER_YEAR
 
 __all__ = [
@@ -99,6 +99,27 @@ class SystemPreset:
     def r_sigma(self) -> float:
         return self.sigma_u2 / self.sigma_w2
 
+    def plant(self) -> Any:
+        """The plant as the value object :class:`~encctl_gym.plant.Plant`."""
+        from .plant import Plant
+
+        return Plant(self.A, self.B)
+
+    def threat(self, cost_model: Any = "paper") -> Any:
+        """The preset's variances and design parameters as a
+        :class:`~encctl_gym.security.threat.ThreatModel` (under ``cost_model``)."""
+        from .security.threat import ThreatModel
+
+        return ThreatModel(
+            sigma_u2=self.sigma_u2,
+            sigma_w2=self.sigma_w2,
+            sigma_x2=self.sigma_x2,
+            gamma_c=self.gamma_c,
+            tau_c=self.tau_c,
+            upsilon=self.upsilon,
+            cost_model=cost_model,
+        )
+
 
 def _diag_system(a: float, b: float, n: int = 4) -> tuple[np.ndarray, np.ndarray]:
     return a * np.eye(n), b * np.eye(n)
@@ -157,19 +178,18 @@ def _build() -> dict[str, SystemPreset]:
     return presets
 
 
-PRESETS: dict[str, SystemPreset] = _build()
+#: The presets by name (:class:`~encctl_gym.registry.Registry`).
+PRESETS: Registry[SystemPreset] = Registry("preset", _build())
 
 
 def preset_names() -> list[str]:
     """Names of the built-in presets."""
-    return list(PRESETS)
+    return PRESETS.names()
 
 
 def get_preset(name: str) -> SystemPreset:
     """Return the preset ``name``, raising :class:`ParameterError` for an unknown name (or a non-string)."""
-    if not isinstance(name, str) or name not in PRESETS:
-        raise ParameterError(f"unknown preset {format_value(name)}; choose one of {', '.join(PRESETS)}")
-    return PRESETS[name]
+    return PRESETS.lookup(name)
 
 
 def design_defaults() -> dict[str, float]:

@@ -12,30 +12,21 @@ import csv
 import os
 import sys
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any
 
 import numpy as np
 
 from encctl_gym.errors import ParameterError
+from encctl_gym.plotting import save_figure
 from encctl_gym.sim.montecarlo import log_grid
 
-__all__ = [
-    "GridConfig",
-    "FULL",
-    "QUICK",
-    "Table",
-    "add_common_arguments",
-    "grid_config",
-    "figure_seed",
-    "ensure_out_dir",
-]
+__all__ = ["GridConfig", "FULL", "QUICK", "Table", "add_common_arguments", "grid_config", "figure_seed", "ensure_out_dir"]
 
 #: CSV columns, in order.
-COLUMNS = (
-    "figure", "panel", "sigma_w2", "sigma_u2", "r_sigma", "psi_u", "N", "run", "error", "gamma", "bound",
-)
+COLUMNS = ("figure", "panel", "sigma_w2", "sigma_u2", "r_sigma", "psi_u", "N", "run", "error", "gamma", "bound")
 
 
 @dataclass(frozen=True)
@@ -79,7 +70,7 @@ class Table:
     columns: dict[str, np.ndarray] = field(default_factory=dict)
 
     @classmethod
-    def concat(cls, parts: Sequence["Table"]) -> "Table":
+    def concat(cls, parts: Sequence[Table]) -> Table:
         """Stack tables with the same columns."""
         if not parts:
             return cls({c: np.array([]) for c in COLUMNS})
@@ -98,26 +89,28 @@ class Table:
         sigma_w2: float,
         sigma_u2: float,
         psi_u: float,
-    ) -> "Table":
+    ) -> Table:
         """Rows of one panel from ``errors`` of shape (runs, K) and per-N curves of shape (K,)."""
         runs, K = errors.shape
         N = np.tile(grid, runs)
         run = np.repeat(np.arange(runs), K)
         rows = runs * K
         bound_col = np.full(K, np.nan) if bound is None else np.asarray(bound, dtype=float)
-        return cls({
-            "figure": np.full(rows, figure, dtype=object),
-            "panel": np.full(rows, panel, dtype=object),
-            "sigma_w2": np.full(rows, sigma_w2),
-            "sigma_u2": np.full(rows, sigma_u2),
-            "r_sigma": np.full(rows, sigma_u2 / sigma_w2),
-            "psi_u": np.full(rows, psi_u),
-            "N": N.astype(np.int64),
-            "run": run.astype(np.int64),
-            "error": errors.reshape(-1),
-            "gamma": np.tile(np.asarray(gamma, dtype=float), runs),
-            "bound": np.tile(bound_col, runs),
-        })
+        return cls(
+            {
+                "figure": np.full(rows, figure, dtype=object),
+                "panel": np.full(rows, panel, dtype=object),
+                "sigma_w2": np.full(rows, sigma_w2),
+                "sigma_u2": np.full(rows, sigma_u2),
+                "r_sigma": np.full(rows, sigma_u2 / sigma_w2),
+                "psi_u": np.full(rows, psi_u),
+                "N": N.astype(np.int64),
+                "run": run.astype(np.int64),
+                "error": errors.reshape(-1),
+                "gamma": np.tile(np.asarray(gamma, dtype=float), runs),
+                "bound": np.tile(bound_col, runs),
+            }
+        )
 
     def __len__(self) -> int:
         return len(self.columns["N"]) if self.columns else 0
@@ -128,7 +121,7 @@ class Table:
         _, idx = np.unique(labels.astype(str), return_index=True)
         return [str(labels[i]) for i in sorted(idx)]
 
-    def panel(self, label: str) -> "Table":
+    def panel(self, label: str) -> Table:
         """The rows of one panel."""
         mask = self.columns["panel"].astype(str) == label
         if not mask.any():
@@ -240,7 +233,9 @@ def add_common_arguments(parser: argparse.ArgumentParser) -> None:
         "--n-jobs", type=_checked(_n_jobs, "n_jobs"), default=-1, help="worker processes (-1: all cores; 1: serial)"
     )
     parser.add_argument(
-        "--scheduler", type=_checked(_scheduler, "scheduler"), default=None,
+        "--scheduler",
+        type=_checked(_scheduler, "scheduler"),
+        default=None,
         help="Dask scheduler: 'local' (start a LocalCluster) or an address like tcp://host:8786 "
         "(default: joblib processes on this machine; needs encctl-gym[dask])",
     )
@@ -260,8 +255,16 @@ def ensure_out_dir(out: str | os.PathLike[str]) -> Path:
 def plot_panel(ax: Any, s: dict[str, Any], title: str, *, bound: bool = False) -> None:
     """One log-log panel: gray dots per run, mean (solid), gamma (dashed), bound (dotted)."""
     N, err = s["N"], s["errors"]
-    ax.loglog(np.broadcast_to(N, err.shape).ravel(), err.ravel(), ".", color="0.6", ms=2, alpha=0.5,
-              rasterized=True, label="error (each run)")
+    ax.loglog(
+        np.broadcast_to(N, err.shape).ravel(),
+        err.ravel(),
+        ".",
+        color="0.6",
+        ms=2,
+        alpha=0.5,
+        rasterized=True,
+        label="error (each run)",
+    )
     ax.loglog(N, s["mean"], "-", color="tab:blue", lw=1.6, label="mean error")
     ax.loglog(N, s["gamma"], "--", color="tab:orange", lw=1.6, label=r"$\gamma(N)$ (eq:sic2)")
     if bound:
@@ -280,9 +283,17 @@ def preset_spec(name: str) -> Any:
 
 
 def figure_table(
-    figure: str, number: int, panels: Sequence[tuple[str, Any]], config: GridConfig, *, seed: int, n_jobs: int,
-    scheduler: Any, progress: bool, bound: bool = False,
-) -> "Table":
+    figure: str,
+    number: int,
+    panels: Sequence[tuple[str, Any]],
+    config: GridConfig,
+    *,
+    seed: int,
+    n_jobs: int,
+    scheduler: Any,
+    progress: bool,
+    bound: bool = False,
+) -> Table:
     """The data of one of the paper's figures: for each ``(letter, spec)`` of ``panels``,
     ``config.runs`` Gaussian attacks identified on the grid of N (Definition def:error), with
     ``gamma(N)`` of eq:sic2 and, with ``bound``, eq:bound (:func:`panel_table`).
@@ -295,36 +306,56 @@ def figure_table(
 
     grid = config.grid(4, 4)
     errors_all = sweep_gaussian_attack(
-        [spec for _, spec in panels], sample_sizes=grid, runs=config.runs, seed=figure_seed(seed, number),
-        n_jobs=n_jobs, scheduler=scheduler, progress=progress, desc=f"Figure {number}",
+        [spec for _, spec in panels],
+        sample_sizes=grid,
+        runs=config.runs,
+        seed=figure_seed(seed, number),
+        n_jobs=n_jobs,
+        scheduler=scheduler,
+        progress=progress,
+        desc=f"Figure {number}",
     )
-    return Table.concat([panel_table(figure, letter, spec, grid, errors, bound=bound) for (letter, spec), errors in zip(panels, errors_all)])
+    return Table.concat(
+        [panel_table(figure, letter, spec, grid, errors, bound=bound) for (letter, spec), errors in zip(panels, errors_all)]
+    )
 
 
-def panel_table(figure: str, panel: str, spec: Any, grid: np.ndarray, errors: np.ndarray, *, bound: bool = False) -> "Table":
+def panel_table(figure: str, panel: str, spec: Any, grid: np.ndarray, errors: np.ndarray, *, bound: bool = False) -> Table:
     """The rows of one panel of Figure 1 or 2: the errors of its runs with ``gamma(N)`` of eq:sic2,
     ``psi_u`` (the scalar of ``Psi_u = psi_u I`` computed from ``(A, B)``) and, with ``bound``,
     the upper bound eq:bound ``(m+n) / ((N-1) m R_sigma)``."""
-    from encctl_gym.security.complexity import (
-        input_upper_bound,
-        sample_identifying_complexity_asymptotic,
-    )
+    from encctl_gym.security.complexity import input_upper_bound, sample_identifying_complexity_asymptotic
     from encctl_gym.security.gramians import controllability_gramian
 
     n, m = spec.B.shape
     r_sigma = spec.sigma_u2 / spec.sigma_w2
     gamma = sample_identifying_complexity_asymptotic(grid, spec.A, spec.B, r_sigma=r_sigma)
     psi_u = float(np.trace(controllability_gramian(spec.A, spec.B))) / n
-    extra = {"bound": input_upper_bound(grid, m, n, r_sigma)} if bound else {}
+    extra = {"bound": np.asarray(input_upper_bound(grid, m, n, r_sigma))} if bound else {}
     return Table.from_errors(
-        figure=figure, panel=panel, grid=grid, errors=errors, gamma=gamma,
-        sigma_w2=spec.sigma_w2, sigma_u2=spec.sigma_u2, psi_u=psi_u, **extra,
+        figure=figure,
+        panel=panel,
+        grid=grid,
+        errors=errors,
+        gamma=np.asarray(gamma),
+        sigma_w2=spec.sigma_w2,
+        sigma_u2=spec.sigma_u2,
+        psi_u=psi_u,
+        **extra,
     )
 
 
 def panel_figure(
-    table: "Table", panels: Sequence[str], shape: tuple[int, int], figsize: tuple[float, float], title: Callable[[dict[str, Any]], str],
-    suptitle: str, path: str | Path, *, bound: bool = False, rect: tuple[float, float, float, float] = (0, 0.05, 1, 0.95),
+    table: Table,
+    panels: Sequence[str],
+    shape: tuple[int, int],
+    figsize: tuple[float, float],
+    title: Callable[[dict[str, Any]], str],
+    suptitle: str,
+    path: str | Path,
+    *,
+    bound: bool = False,
+    rect: tuple[float, float, float, float] = (0, 0.05, 1, 0.95),
 ) -> Path:
     """A grid of :func:`plot_panel` panels, one per label of ``panels`` (``title(summary)`` each),
     with a shared legend below and ``suptitle`` above, saved as a PNG at ``path``."""
@@ -346,17 +377,18 @@ def panel_figure(
     fig.suptitle(suptitle, fontsize=10)
     fig.tight_layout(rect=rect)
     path = Path(path)
-    fig.savefig(path, dpi=130)
+    save_figure(fig, path, dpi=130)
     plt.close(fig)
     return path
 
 
-def run_figure(args: argparse.Namespace, compute: Callable[..., "Table"], plot: Callable[..., Path], stem: str, label: str) -> int:
+def run_figure(args: argparse.Namespace, compute: Callable[..., Table], plot: Callable[..., Path], stem: str, label: str) -> int:
     """Compute a figure's table, save ``<stem>.csv`` and ``<stem>.png`` under ``args.out``, print the paths."""
     out = ensure_out_dir(args.out)
     t0 = time.perf_counter()
-    table = compute(grid_config(args.quick), seed=args.seed, n_jobs=args.n_jobs,
-                    scheduler=args.scheduler, progress=not args.no_progress)
+    table = compute(
+        grid_config(args.quick), seed=args.seed, n_jobs=args.n_jobs, scheduler=args.scheduler, progress=not args.no_progress
+    )
     elapsed = time.perf_counter() - t0
     csv_path = table.to_csv(out / f"{stem}.csv")
     png_path = plot(table, out / f"{stem}.png")
@@ -367,8 +399,7 @@ def run_figure(args: argparse.Namespace, compute: Callable[..., "Table"], plot: 
 
 
 def entry_point(
-    name: str, doc: str | None, add_arguments: Callable[[argparse.ArgumentParser], None],
-    run: Callable[[argparse.Namespace], int],
+    name: str, doc: str | None, add_arguments: Callable[[argparse.ArgumentParser], None], run: Callable[[argparse.Namespace], int]
 ) -> Callable[..., int]:
     """The ``main(argv=None) -> int`` of the experiment script ``experiments/<name>.py``
     (:func:`script_main` over its options and its run)."""
@@ -381,7 +412,7 @@ def entry_point(
 
 
 def figure_entry_points(
-    stem: str, label: str, compute: Callable[..., "Table"], plot: Callable[..., Path], doc: str | None
+    stem: str, label: str, compute: Callable[..., Table], plot: Callable[..., Path], doc: str | None
 ) -> tuple[Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int], Callable[..., int]]:
     """``add_arguments``, ``run`` and ``main`` of a figure script: the common options, then
     :func:`run_figure` (``<stem>.csv`` and ``<stem>.png`` under ``--out``)."""

@@ -58,8 +58,9 @@ import csv
 import dataclasses
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -67,12 +68,13 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 import numpy as np
 
 from encctl_gym.cryptanalysis import get_breaker, pari_available
-from encctl_gym.cryptanalysis.cli import key_sequence
+from encctl_gym.cryptanalysis.keys import key_sequence
 from encctl_gym.cryptanalysis.sequence import break_sequence
 from encctl_gym.crypto import arith
 from encctl_gym.crypto.group import generate_safe_prime_group
 from encctl_gym.errors import BreakerError, ParameterError
 from encctl_gym.parallel import child_seeds, run_tasks
+from encctl_gym.plotting import save_figure
 from experiments.common import add_common_arguments, ensure_out_dir, entry_point
 
 __all__ = [
@@ -347,12 +349,12 @@ def plot(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
     ax.legend(fontsize=8, ncol=4, frameon=False)
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path
 
 
-def model_curves(bits: Sequence[int], n: Sequence[int], *, model_bits: int) -> dict[str, dict[str, np.ndarray]]:
+def model_curves(bits: Sequence[int] | np.ndarray, n: Sequence[int] | np.ndarray, *, model_bits: int) -> dict[str, dict[str, np.ndarray]]:
     """What each deciphering-cost model of :mod:`encctl_gym.security.cost_models` predicts, in the
     units the measurements can be compared with (ratios: the models count abstract operations):
 
@@ -430,14 +432,14 @@ def plot_models(rows: Sequence[dict[str, Any]], path: str | Path, *, model_bits:
     ax2.legend(fontsize=7, ncol=3, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.14))
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path
 
 
 def format_table(fits: Sequence[dict[str, Any]]) -> str:
     """The measured table: bits, breaker, T_first, T_1, T_1 / T_first, and each breaker's largest size."""
-    largest = {}
+    largest: dict[str, int] = {}
     for f in fits:
         largest[f["breaker"]] = max(largest.get(f["breaker"], 0), f["bits"])
     lines = [f"{'bits':>5}  {'breaker':<15} {'T_first (s)':>12} {'T_1 (s)':>12} {'T_1/T_first':>12} {'N_max':>6} "

@@ -24,8 +24,9 @@ import argparse
 import csv
 import math
 import sys
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -33,7 +34,8 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 from encctl_gym.presets import PAPER_DESIGN_PARAMETERS, PAPER_REPORTED, get_preset
 from encctl_gym.security.cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION
 from encctl_gym.security.design import SecurityDesign, design_security_parameter, paper_design_example
-from encctl_gym.security.key_length import KeyLengthDesign, KeyValue, design_key_length, key_length_value
+from encctl_gym.security.key_length import KeyLengthDesign, KeyValue, build_model, design_key_length, key_length_value
+from encctl_gym.security.threat import ThreatModel
 from experiments.common import add_common_arguments, ensure_out_dir, entry_point
 
 __all__ = [
@@ -56,6 +58,11 @@ PAPER_VALUES = PAPER_REPORTED
 DYNAMIC_KEY_SAMPLES = (13159, 10**5, 10**6, 10**7, 10**8, 10**10)
 
 
+def _threat(cost_model: Any) -> ThreatModel:
+    """The design example's defense period and adversary under ``cost_model``."""
+    return ThreatModel(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"], cost_model=cost_model)
+
+
 def compute() -> list[tuple[str, SecurityDesign]]:
     """The design example by the security module, three ways.
 
@@ -66,10 +73,7 @@ def compute() -> list[tuple[str, SecurityDesign]]:
         and ``("plant paper-example, eq:sic2", ...)``.
     """
     p = get_preset("paper-example")
-    plant = design_security_parameter(
-        p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, sigma_x2=p.sigma_x2,
-        gamma_c=p.gamma_c, tau_c=p.tau_c, upsilon=p.upsilon,
-    )
+    plant = design_security_parameter(p.plant(), p.threat())
     return [
         ("traces, eq:sic2 (paper)", paper_design_example("asymptotic")),
         ("traces, eq:sic", paper_design_example("exact")),
@@ -81,13 +85,12 @@ def cost_model_designs(N_star: int | None = None) -> list[KeyLengthDesign]:
     """``k*`` of the design example under every model, without and with the 11.91-bit GNFS correction
     (the generic model has no GNFS term and appears once)."""
     N = paper_design_example().N_star if N_star is None else N_star
-    kw = dict(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"])
     rows = []
     for correction in (0.0, GUILLEVIC_CORRECTION):
         for name in DECIPHERING_MODELS:
             if name == "generic" and correction:
                 continue
-            rows.append(design_key_length(name, N, gnfs_correction=correction, **kw))
+            rows.append(design_key_length(N, _threat(build_model(name, correction))))
     return rows
 
 
@@ -95,17 +98,15 @@ def key_values(key_length: int | None = None) -> list[KeyValue]:
     """What the paper's ``k*`` (or ``key_length``) is worth under every model (no correction)."""
     d = paper_design_example()
     k = d.k_star if key_length is None else key_length
-    kw = dict(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"])
-    return [key_length_value(name, k, N_star=d.N_star, **kw) for name in DECIPHERING_MODELS]
+    return [key_length_value(k, _threat(name), N_star=d.N_star) for name in DECIPHERING_MODELS]
 
 
 def dynamic_key_bits(samples: Sequence[int] = DYNAMIC_KEY_SAMPLES) -> list[tuple[int, float, int, float]]:
     """For each sample size ``N``: ``log2 N`` (what the dynamic keys add under the paper's cost), the
     precomputation model's ``k*`` for ``N`` and the bits the dynamic keys add there."""
-    kw = dict(tau_c=PAPER_DESIGN_PARAMETERS["tau_c"], upsilon=PAPER_DESIGN_PARAMETERS["upsilon"])
     out = []
     for N in samples:
-        d = design_key_length("precomputation", N, **kw)
+        d = design_key_length(N, _threat("precomputation"))
         out.append((N, math.log2(N), d.k_star, d.dynamic_key_bits))
     return out
 
@@ -114,18 +115,15 @@ def format_table(rows: Sequence[tuple[str, SecurityDesign]]) -> str:
     """A plain-text table of ``N*``, ``lambda*``, ``k*`` next to the paper's values."""
     head = f"{'computation':32s} {'N*':>7s} {'lambda*':>8s} {'k*':>6s} {'gamma(N*)':>11s} {'log2 Omega(k*)':>15s}"
     lines = [head, "-" * len(head)]
-    lines.append(
-        f"{'paper':32s} {PAPER_VALUES['N_star']:7d} {PAPER_VALUES['lam_star']:8d} {PAPER_VALUES['k_star']:6d}"
-    )
+    lines.append(f"{'paper':32s} {PAPER_VALUES['N_star']:7d} {PAPER_VALUES['lam_star']:8d} {PAPER_VALUES['k_star']:6d}")
     for label, d in rows:
-        lines.append(
-            f"{label:32s} {d.N_star:7d} {d.lam_star:8d} {d.k_star:6d} {d.gamma_at_N_star:11.4e} {d.bit_security:15.2f}"
-        )
+        lines.append(f"{label:32s} {d.N_star:7d} {d.lam_star:8d} {d.k_star:6d} {d.gamma_at_N_star:11.4e} {d.bit_security:15.2f}")
     return "\n".join(lines)
 
 
-def format_cost_models(designs: Sequence[KeyLengthDesign], values: Sequence[KeyValue],
-                       dynamic: Sequence[tuple[int, float, int, float]]) -> str:
+def format_cost_models(
+    designs: Sequence[KeyLengthDesign], values: Sequence[KeyValue], dynamic: Sequence[tuple[int, float, int, float]]
+) -> str:
     """The three cost-model tables as text."""
     lines = [
         f"budget Upsilon tau_c = 2^{designs[0].budget_bits:.3f} operations",
@@ -139,12 +137,16 @@ def format_cost_models(designs: Sequence[KeyLengthDesign], values: Sequence[KeyV
             f"{d.first_key_bits:9.3f} {d.next_key_bits:9.3f} {d.dynamic_key_bits:9.3f} {nist:>7s}"
         )
     k = values[0].key_length
-    lines += ["", f"a {k}-bit key (no correction): {'model':16s} {'first key':>9s} {'next key':>9s} "
-                  f"{'log2 N in tau_c':>15s} {'secure':>6s}"]
+    lines += [
+        "",
+        f"a {k}-bit key (no correction): {'model':16s} {'first key':>9s} {'next key':>9s} "
+        f"{'log2 N in tau_c':>15s} {'secure':>6s}",
+    ]
     for v in values:
         n = "-inf" if v.log2_affordable_samples == -math.inf else f"{v.log2_affordable_samples:.3f}"
-        lines.append(f"{'':30s}{v.model:16s} {v.first_key_bits:9.3f} {v.next_key_bits:9.3f} {n:>15s} "
-                     f"{'yes' if v.secure else 'no':>6s}")
+        lines.append(
+            f"{'':30s}{v.model:16s} {v.first_key_bits:9.3f} {v.next_key_bits:9.3f} {n:>15s} {'yes' if v.secure else 'no':>6s}"
+        )
     lines += ["", f"{'N':>12s} {'log2 N':>7s} {'precomputation k*':>18s} {'dyn. keys there':>16s}"]
     for N, log_n, k_star, dyn in dynamic:
         lines.append(f"{N:12d} {log_n:7.3f} {k_star:18d} {dyn:16.3f}")
@@ -166,8 +168,20 @@ def run(args: argparse.Namespace) -> int:
     path = out / "design_example.csv"
     with path.open("w", newline="") as fh:
         w = csv.writer(fh)
-        fields: list[Any] = ["computation", "N_star", "lam_star", "k_star", "gamma_at_N_star", "bit_security",
-                             "tr_psi_u", "tr_psi_w", "r_sigma", "gamma_c", "tau_c", "upsilon"]
+        fields: list[Any] = [
+            "computation",
+            "N_star",
+            "lam_star",
+            "k_star",
+            "gamma_at_N_star",
+            "bit_security",
+            "tr_psi_u",
+            "tr_psi_w",
+            "r_sigma",
+            "gamma_c",
+            "tau_c",
+            "upsilon",
+        ]
         w.writerow(fields)
         w.writerow(["paper", PAPER_VALUES["N_star"], PAPER_VALUES["lam_star"], PAPER_VALUES["k_star"]] + [""] * 8)
         for label, d in rows:
@@ -182,8 +196,8 @@ def run(args: argparse.Namespace) -> int:
         w = csv.writer(fh)
         fields = list(designs[0].to_dict())
         w.writerow(fields)
-        for d in designs:
-            dd = d.to_dict()
+        for kd in designs:
+            dd = kd.to_dict()
             w.writerow([repr(dd[f]) if isinstance(dd[f], float) else dd[f] for f in fields])
     print(f"  wrote {path}")
     return 0

@@ -66,11 +66,17 @@ def plot(table: Table, path: str | Path) -> Path:
     """
     runs = int(table.columns["run"].max()) + 1
     return panel_figure(
-        table, PANELS, (3, 3), (11, 9.5),
-        lambda s: f"({s['panel']}) $R_\\sigma={s['r_sigma']:g}$, $\\sigma_w^2={s['sigma_w2']:g}$, $\\sigma_u^2={s['sigma_u2']:g}$",
+        table,
+        PANELS,
+        (3, 3),
+        (11, 9.5),
+        lambda s: (
+            f"({s['panel']}) $R_\\sigma={s['r_sigma']:g}$, $\\sigma_w^2={s['sigma_w2']:g}$, $\\sigma_u^2={s['sigma_u2']:g}$"
+        ),
         "Figure 1: estimation error vs. sample identifying complexity "
         f"($A=0.7071I$, $B=I$, $\\Psi_w\\approx\\Psi_u\\approx 2I$, $n=m=4$, $\\sigma_x^2=1$, {runs} runs per $N$)",
-        path, rect=(0, 0.04, 1, 0.97),
+        path,
+        rect=(0, 0.04, 1, 0.97),
     )
 
 

@@ -59,12 +59,17 @@ def plot(table: Table, path: str | Path) -> Path:
     s0 = table.summary(PANELS[0])
     runs = s0["errors"].shape[0]
     return panel_figure(
-        table, PANELS, (2, 3), (11, 7), lambda s: f"({s['panel']}) $\\Psi_u = {s['psi_u']:.3g}I$",
+        table,
+        PANELS,
+        (2, 3),
+        (11, 7),
+        lambda s: f"({s['panel']}) $\\Psi_u = {s['psi_u']:.3g}I$",
         "Figure 2: varying $\\Psi_u$ with $\\Psi_w = 2I$, $R_\\sigma = 100$ "
         f"($\\sigma_w^2={s0['sigma_w2']:g}$, $\\sigma_u^2={s0['sigma_u2']:g}$, {runs} runs per $N$)\n"
         "realised by $A = I/\\sqrt{2}$, $B = bI$, $b = \\sqrt{\\psi_u(1-1/2)}$, "
         "i.e. $\\Psi_u = b^2/(1-a^2)\\,I$",
-        path, bound=True,
+        path,
+        bound=True,
     )
 
 

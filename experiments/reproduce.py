@@ -38,8 +38,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options: ``--out --quick --seed --n-jobs --scheduler --no-progress --only``."""
     add_common_arguments(parser)
     parser.add_argument(
-        "--only", action="append", choices=[name for name, _ in STEPS],
-        help="run only this part (repeatable; default: all)",
+        "--only", action="append", choices=[name for name, _ in STEPS], help="run only this part (repeatable; default: all)"
     )
 
 

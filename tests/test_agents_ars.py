@@ -6,9 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import torch as th
 
-pytest.importorskip("sb3_contrib")
+pytest.importorskip("sb3_contrib")  # the rl extra; torch comes with it
+
+import torch as th  # noqa: E402
 
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.vec_env import VecNormalize

@@ -13,7 +13,6 @@ from agents import (
     Attacker,
     ColoredGaussianAttacker,
     GaussianAttacker,
-    ObsLayout,
     OptimalDesignAttacker,
     PRBSAttacker,
     observation_indices,
@@ -22,6 +21,7 @@ from agents import (
 from agents.evaluate import budget_config
 from encctl_gym.envs import ENV_ID, EncryptedLTIAttackEnv
 from encctl_gym.envs.config import resolve_params
+from encctl_gym.envs.layout import ObservationLayout
 from encctl_gym.errors import ParameterError
 from encctl_gym.security.attack_design import gaussian_attack_design, optimal_attack_design
 
@@ -30,9 +30,7 @@ BASELINES = (GaussianAttacker, PRBSAttacker, ColoredGaussianAttacker)
 
 
 def all_attackers(params):
-    return [cls(params) for cls in BASELINES] + [
-        OptimalDesignAttacker(params, feedback=params.decipher_delay is not None)
-    ]
+    return [cls(params) for cls in BASELINES] + [OptimalDesignAttacker(params, feedback=params.decipher_delay is not None)]
 
 
 @pytest.mark.parametrize("delay", [0, 2, "end"])
@@ -81,7 +79,7 @@ def test_batched_act_matches_the_vector_env():
 
 def test_attacker_seed_reproduces_and_different_seeds_differ():
     params = resolve_params(SMALL)
-    obs = np.zeros(ObsLayout.of(params).dim, dtype=np.float32)
+    obs = np.zeros(ObservationLayout.of(params).dim, dtype=np.float32)
     for cls in BASELINES:
         a, b = cls(params), cls(params)
         a.reset(seed=11)
@@ -110,7 +108,7 @@ def test_bad_inputs_raise():
 
 def test_observation_modes_select_the_documented_columns():
     params = resolve_params(SMALL)
-    lay = ObsLayout.of(params)
+    lay = ObservationLayout.of(params)
     assert lay.dim == EncryptedLTIAttackEnv(config=SMALL).observation_space.shape[0]
     assert observation_indices(params, "full").tolist() == list(range(lay.dim))
     assert observation_indices(params, "no_budget").tolist() == list(range(lay.dim - 2))
@@ -125,7 +123,7 @@ def test_baseline_input_power_is_sigma_u2(cls):
     params = resolve_params({"preset": "paper-example", "gamma_opt": False})
     att = cls(params)
     att.reset(seed=0)
-    obs = np.zeros((64, ObsLayout.of(params).dim), dtype=np.float32)
+    obs = np.zeros((64, ObservationLayout.of(params).dim), dtype=np.float32)
     u = np.concatenate([att.act(obs) for _ in range(300)]) * params.u_max  # 64 * 300 * m draws
     power = float(np.mean(u**2))
     tol = 1e-6 if cls is PRBSAttacker else 0.03  # binary: exactly sigma_u^2 (float32 rounding)
@@ -137,7 +135,7 @@ def test_colored_attacker_has_the_requested_lag_one_correlation():
     params = resolve_params({"preset": "paper-example", "gamma_opt": False})
     att = ColoredGaussianAttacker(params, rho=0.7)
     att.reset(seed=2)
-    obs = np.zeros((32, ObsLayout.of(params).dim), dtype=np.float32)
+    obs = np.zeros((32, ObservationLayout.of(params).dim), dtype=np.float32)
     u = np.stack([att.act(obs) for _ in range(2000)])  # (T, K, m)
     c = np.mean(u[1:] * u[:-1]) / np.mean(u * u)
     assert abs(c - 0.7) < 0.03
@@ -246,4 +244,4 @@ def test_design_efficiency_of_the_gaussian_attack_and_the_oracle():
     # 16 x 2047 regressors: the realised designs come within a few per cent of their closed forms
     assert design_efficiency(g.covariance, opt) == pytest.approx(best.fun / tr_inv(0.0), abs=0.02)
     assert design_efficiency(o.covariance, opt) == pytest.approx(1.0, abs=0.02)
-    assert np.allclose(np.diag(g.covariance)[p.n:], p.sigma_u2, rtol=0.05)
+    assert np.allclose(np.diag(g.covariance)[p.n :], p.sigma_u2, rtol=0.05)

@@ -58,7 +58,7 @@ def test_dither_is_standard_normal_bounded_and_reproducible(K, seed, steps):
     fs = FeatureSet(["dither"], p)
     obs = np.zeros((K, 3))
     out = []
-    for trial in range(2):
+    for _trial in range(2):
         fs.reset(K, rng=np.random.default_rng(seed))
         out.append(np.stack([fs.append(obs, np.zeros((K, 0), np.float32)) for _ in range(steps)]))
     assert out[0].shape == (steps, K, p.m) and out[0].dtype == np.float32
@@ -82,5 +82,5 @@ def test_feature_names_are_checked():
             check_features(bad)
     cfg = load_config("ppo", "small", quick=True)
     cfg["features"] = ["nope"]
-    with pytest.raises(ConfigError, match="unknown feature 'nope' in features"):
+    with pytest.raises(ConfigError, match="features: unknown feature 'nope'; choose one of dither"):
         validate_config(cfg)

@@ -32,8 +32,24 @@ def test_every_algorithm_has_a_search_space():
 
 def test_two_trial_study_writes_a_tuned_file_and_resumes(tmp_path, capsys):
     optuna = pytest.importorskip("optuna")
-    argv = ["tune", "--algo", "ars", "--preset", "small", "--quick", "--trials", "2", "--episodes", "4",
-            "--out", str(tmp_path), "--no-progress", "--no-prune", "--set", "horizon=16"]
+    argv = [
+        "tune",
+        "--algo",
+        "ars",
+        "--preset",
+        "small",
+        "--quick",
+        "--trials",
+        "2",
+        "--episodes",
+        "4",
+        "--out",
+        str(tmp_path),
+        "--no-progress",
+        "--no-prune",
+        "--set",
+        "horizon=16",
+    ]
     assert cli.main(argv) == 0
     out = capsys.readouterr().out
     assert "2 trials; best trial" in out and "ars_small.yaml" in out
@@ -45,7 +61,9 @@ def test_two_trial_study_writes_a_tuned_file_and_resumes(tmp_path, capsys):
     cfg = {**run.env, "gamma_opt": False}
     p = resolve_params(cfg)
     which = "best" if (run.path / "best_model.zip").exists() else "final"
-    e_l = rollout(load_attacker(run.path, which=which, params=p), cfg, episodes=4, seed=OBJECTIVE_SEED, record=False).final_epsilon
+    e_l = rollout(
+        load_attacker(run.path, which=which, params=p), cfg, episodes=4, seed=OBJECTIVE_SEED, record=False
+    ).final_epsilon
     e_o = rollout(OptimalDesignAttacker(p), cfg, episodes=4, seed=OBJECTIVE_SEED, record=False).final_epsilon
     assert best.value == pytest.approx(float(np.exp(np.mean(np.log(e_l) - np.log(e_o)))), rel=1e-9)
     assert objective_ratio(run.path, episodes=4)[0] == pytest.approx(best.value, rel=1e-9)
@@ -66,11 +84,18 @@ def test_tune_errors_are_one_line(tmp_path, capsys, monkeypatch):
     for argv, needle in (
         (["tune", "--algo", "ars", "--trials", "0", "--out", str(tmp_path)], "--trials must be >= 1"),
         (["tune", "--algo", "ars", "--save-config", "--out", str(tmp_path)], "needs --preset"),
-        (["tune", "--algo", "ars", "--preset", "small", "--quick", "--set", "hyperparams.n_delta=0", "--out", str(tmp_path)],
-         "hyperparams.n_delta must be >= 1"),
-        (["tune", "--algo", "ars", "--preset", "small", "--quick", "--seed", "-1", "--out", str(tmp_path)], "seed must be >= 0, got -1"),
-        (["tune", "--algo", "ars", "--preset", "small", "--quick", "--seed", str(2**32), "--out", str(tmp_path)],
-         "seed must be <= 4294967295, got 4294967296"),
+        (
+            ["tune", "--algo", "ars", "--preset", "small", "--quick", "--set", "hyperparams.n_delta=0", "--out", str(tmp_path)],
+            "hyperparams.n_delta must be >= 1",
+        ),
+        (
+            ["tune", "--algo", "ars", "--preset", "small", "--quick", "--seed", "-1", "--out", str(tmp_path)],
+            "seed must be >= 0, got -1",
+        ),
+        (
+            ["tune", "--algo", "ars", "--preset", "small", "--quick", "--seed", str(2**32), "--out", str(tmp_path)],
+            "seed must be <= 4294967295, got 4294967296",
+        ),
     ):
         assert cli.main(argv) == 2
         err = capsys.readouterr().err.strip().splitlines()

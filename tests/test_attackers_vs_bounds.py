@@ -4,10 +4,8 @@ registry, the security table, and a --quick run end to end checked against direc
 from __future__ import annotations
 
 import csv
-import importlib
 import json
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -109,8 +107,16 @@ def test_registry_builds_every_attacker_and_rejects_unknown_names():
 def test_oracle_beats_gaussian_where_the_theory_says_so():
     """Design example, states in time: the optimal design's rate is 0.77 of the Gaussian one
     (gamma_opt); at N = 400 the paired ratio on 24 episodes must lie significantly below 1."""
-    res = cmp.compute(["paper-example"], delays=(0,), episodes=24, seed=5, cap=400, points=1,
-                      attackers=("gaussian", "optimal"), elgamal_episodes=0)
+    res = cmp.compute(
+        ["paper-example"],
+        delays=(0,),
+        episodes=24,
+        seed=5,
+        cap=400,
+        points=1,
+        attackers=("gaussian", "optimal"),
+        elgamal_episodes=0,
+    )
     rows = {r["attacker"]: r for r in res.security}
     s = res.settings[0]
     assert s.design.rate / s.gauss.rate < 0.8
@@ -131,7 +137,9 @@ def _fake_run(root: Path, algo: str, observation: str) -> Path:
     d = root / f"{algo}_{observation}"
     d.mkdir(parents=True)
     model.save(str(d / "model.zip"))
-    (d / "run.json").write_text(json.dumps({"algo": algo, "observation": observation, "env": env_cfg, "config": {"quick": False}}))
+    (d / "run.json").write_text(
+        json.dumps({"algo": algo, "observation": observation, "env": env_cfg, "config": {"quick": False}})
+    )
     return d
 
 
@@ -194,10 +202,16 @@ def test_compare_quick_numbers_equal_direct_rollouts_on_the_same_seeds(quick_run
         finals = [float(e["final_error"]) for e in eps if (e["delay"], e["attacker"]) == ("0", name)]
         assert finals == list(r.final_epsilon), name  # every digit (repr in the CSV)
         assert float(sec[("0", name)]["mean_error_at_horizon"]) == pytest.approx(r.mean_final(), rel=1e-15)
-    curves = [r for r in _rows(quick_run / "curves.csv") if r["protocol"] == "fresh" and r["delay"] == "0" and r["attacker"] == "gaussian"]
+    curves = [
+        r
+        for r in _rows(quick_run / "curves.csv")
+        if r["protocol"] == "fresh" and r["delay"] == "0" and r["attacker"] == "gaussian"
+    ]
     grid = cmp.length_grid(s.params, 4)
     assert [int(r["N"]) for r in curves] == list(grid)
-    r_small = rollout(GaussianAttacker(s.params), budget_config(s.config, int(grid[0])), episodes=QUICK_EPISODES, seed=3, record=False)
+    r_small = rollout(
+        GaussianAttacker(s.params), budget_config(s.config, int(grid[0])), episodes=QUICK_EPISODES, seed=3, record=False
+    )
     assert float(curves[0]["mean_error"]) == pytest.approx(r_small.mean_final(), rel=1e-15)
     for (delay, name), row in sec.items():
         mine = np.array([float(e["final_error"]) for e in eps if (e["delay"], e["attacker"]) == (delay, name)])
@@ -230,32 +244,32 @@ def test_compare_quick_elgamal_episodes_match_the_ideal_backend(quick_run):
 
 
 def test_compare_bad_options_are_one_line_errors(tmp_path, capsys):
-    for argv, needle in ((["--delays", "abc"], "decipher delay 'abc'"), (["--episodes", "0"], "--episodes must be >= 1"),
-                         (["--points", "0"], "--points must be >= 1"), (["--attackers", "gaussian,dqn"], "unknown attacker 'dqn'"),
-                         (["--runs", str(tmp_path / "none")], "does not exist"), (["--systems", ","], "no systems")):
+    for argv, needle in (
+        (["--delays", "abc"], "decipher delay 'abc'"),
+        (["--episodes", "0"], "--episodes must be >= 1"),
+        (["--points", "0"], "--points must be >= 1"),
+        (["--attackers", "gaussian,dqn"], "unknown attacker 'dqn'"),
+        (["--runs", str(tmp_path / "none")], "does not exist"),
+        (["--systems", ","], "no systems"),
+    ):
         assert cli.main(["compare", "--quick", "--no-progress", "--out", str(tmp_path), *argv]) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and needle in err[0], (argv, err)
-
-
-def test_the_old_module_path_still_imports():
-    sys.modules.pop("experiments.attackers_vs_bounds", None)
-    with pytest.warns(DeprecationWarning, match="experiments.compare"):
-        avb = importlib.import_module("experiments.attackers_vs_bounds")
-    assert avb.compute is cmp.compute and avb.fit_rate is cmp.fit_rate and avb.Setting is cmp.Setting
-    assert cli.SUBCOMMANDS["compare"][0] == "experiments.compare.cli"
 
 
 # ------------------------------------------------------------------ hardening
 def test_compare_refuses_empty_lists_huge_counts_and_a_file_as_out(tmp_path, capsys):
     afile = tmp_path / "afile"
     afile.write_text("x")
-    for argv, needle in ((["--delays", ""], "decipher delay ''"), (["--systems", ""], "no systems in ''"),
-                         (["--attackers", ""], "no attackers in ''"),
-                         (["--max-samples", "9" * 401], "--max-samples must be <= 9223372036854775807, got <integer of 1333 bits"),
-                         (["--points", "100000000"], "--points must be <= 60, got 100000000"),
-                         (["--episodes", "1000000000000"], "episodes = 1000000000000"),
-                         (["--out", str(afile)], "exists and is not a directory")):
+    for argv, needle in (
+        (["--delays", ""], "decipher delay ''"),
+        (["--systems", ""], "no systems in ''"),
+        (["--attackers", ""], "no attackers in ''"),
+        (["--max-samples", "9" * 401], "--max-samples must be <= 9223372036854775807, got <integer of 1333 bits"),
+        (["--points", "100000000"], "--points must be <= 60, got 100000000"),
+        (["--episodes", "1000000000000"], "episodes = 1000000000000"),
+        (["--out", str(afile)], "exists and is not a directory"),
+    ):
         args = ["compare", "--quick", "--no-progress", "--elgamal-episodes", "0", "--out", str(tmp_path / "c"), *argv]
         assert cli.main(args) == 2
         err = capsys.readouterr().err.strip().splitlines()

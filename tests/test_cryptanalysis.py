@@ -31,7 +31,7 @@ from encctl_gym.cryptanalysis import (
 )
 from encctl_gym.cryptanalysis import pari as pari_mod
 from encctl_gym.cryptanalysis.base import Deadline, format_seconds
-from encctl_gym.cryptanalysis.cli import key_sequence
+from encctl_gym.cryptanalysis.keys import key_sequence
 from encctl_gym.errors import (
     BreakerError,
     BreakerLimitError,
@@ -208,7 +208,7 @@ def test_index_calculus_with_multiprecision_linear_algebra() -> None:
 def test_token_chain_derives_every_later_key_like_recover_next_secret_key() -> None:
     grp = group(40)
     hs, secrets, tokens = sequence(40, 6)
-    chain = TokenChain("index-calculus", rng=1)
+    chain = TokenChain(rng=1)  # the default inner breaker: index calculus
     report = break_sequence(chain, grp, hs, tokens=tokens)
     assert report.secrets == list(secrets)
     assert report.keys[0].method == "index-calculus"
@@ -222,7 +222,7 @@ def test_token_chain_derives_every_later_key_like_recover_next_secret_key() -> N
 def test_token_chain_accepts_pairs_and_falls_back_to_the_inner_breaker() -> None:
     grp = group(32)
     hs, secrets, tokens = sequence(32, 4)
-    pre = TokenChain("rho", rng=1).precompute(grp)
+    pre = get_breaker("token-chain", inner="rho", rng=1).precompute(grp)
     pre.add_tokens([(tokens[1].h, tokens[1].d)])  # only sigma_1: keys 0 and 1 need the inner breaker
     methods = [pre.break_key(h).method for h in hs]
     assert methods == ["rho", "rho", "token", "rho"]
@@ -233,7 +233,11 @@ def test_token_chain_accepts_pairs_and_falls_back_to_the_inner_breaker() -> None
     with pytest.raises(ParameterError, match="token"):
         pre.add_tokens([object()])
     with pytest.raises(ParameterError, match="itself"):
-        TokenChain("token-chain")
+        get_breaker("token-chain", inner="token-chain")
+    with pytest.raises(ParameterError, match="itself"):
+        TokenChain(TokenChain())
+    with pytest.raises(ParameterError, match="Breaker instance"):
+        TokenChain("rho")  # type: ignore[arg-type]
 
 
 def test_tokens_for_another_breaker_are_refused() -> None:
@@ -281,7 +285,7 @@ def test_too_large_groups_are_refused_before_any_work(monkeypatch: pytest.Monkey
     with pytest.raises(BreakerLimitError, match="max_table"):
         BREAKERS["bsgs"](max_table=100).check_feasible(group(24))
     with pytest.raises(BreakerLimitError):
-        TokenChain("rho", max_bits=20).precompute(group(24))
+        get_breaker("token-chain", inner="rho", max_bits=20).precompute(group(24))
     assert issubclass(BreakerLimitError, ParameterError)
 
 
@@ -328,7 +332,7 @@ def test_missing_cypari_is_one_line_naming_the_extra(monkeypatch: pytest.MonkeyP
 
 
 def test_unknown_breaker_and_bad_options() -> None:
-    with pytest.raises(ParameterError, match="registered"):
+    with pytest.raises(ParameterError, match="unknown breaker 'nfs'; choose one of bsgs, rho"):
         get_breaker("nfs")
     with pytest.raises(ParameterError):
         get_breaker("rho", max_bits=1)

@@ -251,7 +251,7 @@ def test_crack_refuses_unbounded_work_in_one_line(capsys: pytest.CaptureFixture,
 
 
 def test_crack_keys_limit_and_its_memory_estimate() -> None:
-    from encctl_gym.cryptanalysis.cli import MAX_KEYS, check_keys
+    from encctl_gym.cryptanalysis.keys import MAX_KEYS, check_keys
     from encctl_gym.errors import ResourceLimitError
 
     assert check_keys(MAX_KEYS) == MAX_KEYS and check_keys(1) == 1

@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from encctl_gym._validation import format_value
 from encctl_gym.crypto import arith
 from encctl_gym.crypto.arith import (
     MAX_PRIMALITY_REPS,
@@ -47,7 +48,6 @@ from encctl_gym.crypto.group import (
     shipped_group,
     sieve_window,
 )
-from encctl_gym._validation import format_value
 from encctl_gym.errors import ConfigError, EncctlError, GroupError, ParameterError, ResourceLimitError
 
 # Toy group used for known answers (hand-checked):
@@ -128,10 +128,24 @@ NON_INTEGERS = [2.5, 3.0, "7", None, [7], True, 2 + 0j, np.float64(3.0)]
 
 
 @pytest.mark.parametrize("bad", NON_INTEGERS, ids=repr)
-@pytest.mark.parametrize("call, position", [
-    (powmod, 0), (powmod, 1), (powmod, 2), (mulmod, 0), (mulmod, 1), (mulmod, 2), (invert, 0), (invert, 1),
-    (jacobi, 0), (jacobi, 1), (legendre, 0), (legendre, 1),
-], ids=lambda v: getattr(v, "__name__", str(v)))
+@pytest.mark.parametrize(
+    "call, position",
+    [
+        (powmod, 0),
+        (powmod, 1),
+        (powmod, 2),
+        (mulmod, 0),
+        (mulmod, 1),
+        (mulmod, 2),
+        (invert, 0),
+        (invert, 1),
+        (jacobi, 0),
+        (jacobi, 1),
+        (legendre, 0),
+        (legendre, 1),
+    ],
+    ids=lambda v: getattr(v, "__name__", str(v)),
+)
 def test_arith_refuses_non_integers_naming_the_value(call, position, bad):
     args = {powmod: [3, 5, 7], mulmod: [3, 5, 7], invert: [3, 7], jacobi: [3, 7], legendre: [3, 7]}[call]
     args[position] = bad
@@ -338,14 +352,18 @@ def test_group_files_that_cannot_be_read_are_config_errors(tmp_path):
             grp.save(target)
 
 
-@pytest.mark.parametrize("text, match", [
-    (None, "must be a str or bytes, got None"),
-    (42, "must be a str or bytes, got 42"),
-    (["{}"], "must be a str or bytes"),
-    ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
-    ('{"p": ' + "9" * 5000 + ', "q": 11, "g": 4}', "invalid group JSON"),
-    (b"\xff\xfe", "invalid group JSON"),
-], ids=["None", "int", "list", "deep", "digits", "bad-bytes"])
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        (None, "must be a str or bytes, got None"),
+        (42, "must be a str or bytes, got 42"),
+        (["{}"], "must be a str or bytes"),
+        ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
+        ('{"p": ' + "9" * 5000 + ', "q": 11, "g": 4}', "invalid group JSON"),
+        (b"\xff\xfe", "invalid group JSON"),
+    ],
+    ids=["None", "int", "list", "deep", "digits", "bad-bytes"],
+)
 def test_from_json_refuses_non_text_and_deep_nesting(text, match):
     with pytest.raises(GroupError, match=match):
         GroupParams.from_json(text)
@@ -464,19 +482,23 @@ def test_sieve_strikes_exactly_the_candidates_with_small_factors():
         assert (k in kept) == (not has_small), k
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"n_cand": -1}, "n_cand must be >= 0"),
-    ({"n_cand": MAX_SIEVE_WINDOW + 1}, f"n_cand must be <= {MAX_SIEVE_WINDOW}"),
-    ({"n_cand": 10**12}, f"n_cand must be <= {MAX_SIEVE_WINDOW}"),
-    ({"n_cand": 2.5}, "n_cand must be an integer, got 2.5"),
-    ({"limit": 2}, "limit must be >= 3"),
-    ({"limit": MAX_SIEVE_LIMIT + 1}, f"limit must be <= {MAX_SIEVE_LIMIT}"),
-    ({"limit": "a"}, "limit must be an integer, got 'a'"),
-    ({"q0": -5}, "q0 must be odd and >= limit = 1000.*got -5"),
-    ({"q0": 10**6}, "q0 must be odd.*got 1000000"),
-    ({"q0": 999}, "q0 must be odd and >= limit = 1000.*got 999"),
-    ({"q0": 2.5}, "q0 must be an integer.*got 2.5"),
-], ids=lambda v: str(v))
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"n_cand": -1}, "n_cand must be >= 0"),
+        ({"n_cand": MAX_SIEVE_WINDOW + 1}, f"n_cand must be <= {MAX_SIEVE_WINDOW}"),
+        ({"n_cand": 10**12}, f"n_cand must be <= {MAX_SIEVE_WINDOW}"),
+        ({"n_cand": 2.5}, "n_cand must be an integer, got 2.5"),
+        ({"limit": 2}, "limit must be >= 3"),
+        ({"limit": MAX_SIEVE_LIMIT + 1}, f"limit must be <= {MAX_SIEVE_LIMIT}"),
+        ({"limit": "a"}, "limit must be an integer, got 'a'"),
+        ({"q0": -5}, "q0 must be odd and >= limit = 1000.*got -5"),
+        ({"q0": 10**6}, "q0 must be odd.*got 1000000"),
+        ({"q0": 999}, "q0 must be odd and >= limit = 1000.*got 999"),
+        ({"q0": 2.5}, "q0 must be an integer.*got 2.5"),
+    ],
+    ids=lambda v: str(v),
+)
 def test_sieve_window_is_bounded_and_checks_its_arguments(kwargs, match):
     args = {"q0": 10**6 + 1, "n_cand": 100, "limit": 1000, **kwargs}
     with pytest.raises(ParameterError, match=match):

@@ -13,29 +13,22 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from encctl_gym.crypto.arith import PowmodCounter, RandomSource, seeded_random
 from encctl_gym.attacks.forgery import forge, forge_injection, forge_injection_token, injection_value
+from encctl_gym.crypto.arith import PowmodCounter, RandomSource, seeded_random
 from encctl_gym.crypto.controller import EncryptedLinearController
-from encctl_gym.crypto.plant_side import PlantParty, StaticPlant
-from encctl_gym.crypto.quantized import QuantizedLinearController
-from encctl_gym.crypto.schemes import SCHEMES
-from encctl_gym.crypto.servers import ControllerServer, StaticControllerServer, TokenControllerServer
-from encctl_gym.crypto.dyn_elgamal import UpdateToken, key_update, recover_next_secret_key
-from encctl_gym.crypto.elgamal import Ciphertext, SecretKey, decrypt, encrypt, keygen
+from encctl_gym.crypto.dyn_elgamal import UpdateToken, recover_next_secret_key
+from encctl_gym.crypto.elgamal import Ciphertext, SecretKey, decrypt, keygen
 from encctl_gym.crypto.encoding import Encoder
 from encctl_gym.crypto.group import shipped_group
 from encctl_gym.crypto.modified import ModifiedCiphertext, modified_decrypt, modified_eval
-from encctl_gym.errors import (
-    CiphertextError,
-    EncodingOverflowError,
-    KeyMismatchError,
-    ParameterError,
-)
+from encctl_gym.crypto.plant_side import PlantParty, StaticPlant
+from encctl_gym.crypto.quantized import QuantizedLinearController
+from encctl_gym.crypto.schemes import SCHEMES
+from encctl_gym.crypto.servers import ControllerServer, StaticControllerServer
+from encctl_gym.errors import CiphertextError, EncodingOverflowError, KeyMismatchError, ParameterError
 
 G64, G128 = shipped_group(64), shipped_group(128)
-PHI = np.array(
-    [[0.5, -1.2, 0.3, 0.0], [1.0, 2.0, -3.0, 0.25], [0.1, 0.2, 0.3, 0.4], [-1.0, -1.0, -1.0, -1.0]]
-)
+PHI = np.array([[0.5, -1.2, 0.3, 0.0], [1.0, 2.0, -3.0, 0.25], [0.1, 0.2, 0.3, 0.4], [-1.0, -1.0, -1.0, -1.0]])
 
 
 def _x(seed: int, n: int = 4, bound: float = 10.0) -> np.ndarray:
@@ -45,8 +38,7 @@ def _x(seed: int, n: int = 4, bound: float = 10.0) -> np.ndarray:
 # ---------------------------------------------------------------------------- correctness
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
-    phi=hnp.arrays(np.float64, st.tuples(st.integers(1, 3), st.integers(1, 4)),
-                   elements=st.floats(-5, 5, allow_nan=False)),
+    phi=hnp.arrays(np.float64, st.tuples(st.integers(1, 3), st.integers(1, 4)), elements=st.floats(-5, 5, allow_nan=False)),
     seed=st.integers(0, 2**32),
     log_delta=st.integers(4, 16),
     scheme=st.sampled_from(["modified", "token"]),
@@ -117,8 +109,9 @@ def test_keys_advance_and_eavesdropper_view():
         ctrl.step(_x(t))
         pks.append(ctrl.pk)
         assert [c.t for c in ctrl.last_state_ciphertexts] == [t] * 4
-        assert all(isinstance(c, ModifiedCiphertext) and (c.t1, c.t2) == (0, t)
-                   for row in ctrl.last_output_ciphertexts for c in row)
+        assert all(
+            isinstance(c, ModifiedCiphertext) and (c.t1, c.t2) == (0, t) for row in ctrl.last_output_ciphertexts for c in row
+        )
     assert [pk.t for pk in pks] == [0, 1, 2, 3] and len({pk.h for pk in pks}) == 4
     assert ctrl.server.pk0 == ctrl.pk0  # the server never sees later keys
 
@@ -132,8 +125,9 @@ def _reachable(root):
     seen, stack, out = set(), [root], []
     while stack:
         obj = stack.pop()
-        if id(obj) in seen or isinstance(obj, (type, types.ModuleType, types.FunctionType,
-                                                types.BuiltinFunctionType, types.CodeType)):
+        if id(obj) in seen or isinstance(
+            obj, (type, types.ModuleType, types.FunctionType, types.BuiltinFunctionType, types.CodeType)
+        ):
             continue
         seen.add(id(obj))
         out.append(obj)
@@ -222,13 +216,16 @@ def test_overflow_check_is_tight_enough_to_matter():
     assert abs(sum(int(a) * int(b) for a, b in zip(w_phi[1], w_x))) > G64.half
 
 
-@pytest.mark.parametrize("x, err, match", [
-    ([1.0, 2.0, 3.0], ParameterError, "4 entries"),
-    ([1.0, 2.0, 3.0, float("nan")], ParameterError, "finite"),
-    ([1.0, 2.0, 3.0, float("inf")], ParameterError, "finite"),
-    ([1.0, 2.0, 3.0, 11.0], EncodingOverflowError, "x = 11.0 is outside"),
-    ("abcd", ParameterError, "numeric"),
-])
+@pytest.mark.parametrize(
+    "x, err, match",
+    [
+        ([1.0, 2.0, 3.0], ParameterError, "4 entries"),
+        ([1.0, 2.0, 3.0, float("nan")], ParameterError, "finite"),
+        ([1.0, 2.0, 3.0, float("inf")], ParameterError, "finite"),
+        ([1.0, 2.0, 3.0, 11.0], EncodingOverflowError, "x = 11.0 is outside"),
+        ("abcd", ParameterError, "numeric"),
+    ],
+)
 def test_step_bad_input(x, err, match):
     ctrl = EncryptedLinearController(PHI, G64, 2.0**10, 10.0, rng=7)
     with pytest.raises(err, match=match):
@@ -344,12 +341,16 @@ def test_injection_bad_input():
         ctrl.step(_x(1), inject=bad)
 
 
-@pytest.mark.parametrize("inject, match", [
-    (42, "inject must be a matrix of ModifiedCiphertext, got int"),
-    ("abcd", "inject must have shape \\(4, 4\\), got \\(4, 1\\)"),
-    ([], "inject must be a non-empty rectangular matrix"),
-    ([[None] * 4] * 4, "inject must contain ModifiedCiphertext entries, got NoneType"),
-], ids=["int", "str", "empty", "None-entries"])
+@pytest.mark.parametrize(
+    "inject, match",
+    [
+        (42, "inject must be a matrix of ModifiedCiphertext, got int"),
+        ("abcd", "inject must have shape \\(4, 4\\), got \\(4, 1\\)"),
+        ([], "inject must be a non-empty rectangular matrix"),
+        ([[None] * 4] * 4, "inject must contain ModifiedCiphertext entries, got NoneType"),
+    ],
+    ids=["int", "str", "empty", "None-entries"],
+)
 def test_injection_must_be_a_matrix_of_the_plants_ciphertexts(inject, match):
     ctrl = EncryptedLinearController(PHI, G64, 2.0**10, 10.0, rng=9)
     with pytest.raises(CiphertextError, match=match):
@@ -407,6 +408,9 @@ def test_encrypted_controller_at_712_bits(bits):
             x = _x(t, bound=100.0)
             assert np.array_equal(ctrl.step(x), ctrl.reference(x))
         a = np.array([1.5, -2.25, 0.0, 7.0])
-        forged = (forge_injection(ctrl.pk0, ctrl.pk, a, ctrl.encoder, 4, seeded_random(1)) if scheme == "modified"
-                  else forge_injection_token(ctrl.pk, a, ctrl.encoder, 4, seeded_random(1)))
+        forged = (
+            forge_injection(ctrl.pk0, ctrl.pk, a, ctrl.encoder, 4, seeded_random(1))
+            if scheme == "modified"
+            else forge_injection_token(ctrl.pk, a, ctrl.encoder, 4, seeded_random(1))
+        )
         assert np.array_equal(ctrl.step(_x(9), inject=forged), injection_value(a, ctrl.encoder, 4))

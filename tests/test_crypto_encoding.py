@@ -74,11 +74,7 @@ def test_max_shift_exceeded_raises():
 
 
 @settings(max_examples=300, deadline=None)
-@given(
-    x=st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False),
-    log_delta=st.integers(0, 30),
-    big=st.booleans(),
-)
+@given(x=st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False), log_delta=st.integers(0, 30), big=st.booleans())
 def test_roundtrip_error_bound(x, log_delta, big):
     """|Dcd(Ecd(x)) - x| <= (1/2 + s)/Delta, with s the reported shift (exact for Delta = 2^k)."""
     grp = G128 if big else G64
@@ -210,11 +206,14 @@ def test_bad_encoder_arguments():
 
 
 # ---------------------------------------------------------------------------- bad input, arrays and powers
-@pytest.mark.parametrize("x", [
-    [1.0, 2.0 + 3.0j],
-    np.array([1.0, 2.0], dtype=np.complex128),  # complex even with a zero imaginary part
-    np.array([[0.5 + 0.5j]]),
-])
+@pytest.mark.parametrize(
+    "x",
+    [
+        [1.0, 2.0 + 3.0j],
+        np.array([1.0, 2.0], dtype=np.complex128),  # complex even with a zero imaginary part
+        np.array([[0.5 + 0.5j]]),
+    ],
+)
 def test_complex_arrays_are_refused_not_truncated(x):
     enc = Encoder(G64, 2.0**10)
     with pytest.raises(ParameterError, match="complex"):
@@ -225,15 +224,18 @@ def test_complex_arrays_are_refused_not_truncated(x):
         enc.encode(2.0 + 3.0j)
 
 
-@pytest.mark.parametrize("x, match", [
-    (np.array([True, False]), "dtype bool"),
-    (["1.0", "2.0"], "dtype <U3"),
-    ([1.0, "a"], "dtype <U32"),
-    ([[1.0, 2.0], [3.0]], "numeric"),  # ragged
-    (np.array([1.0, None], dtype=object), "real numbers, got None"),
-    (np.array([1.0, True], dtype=object), "real numbers, got True"),
-    (np.array([1.0, 10**400], dtype=object), "too large for a float"),
-])
+@pytest.mark.parametrize(
+    "x, match",
+    [
+        (np.array([True, False]), "dtype bool"),
+        (["1.0", "2.0"], "dtype <U3"),
+        ([1.0, "a"], "dtype <U32"),
+        ([[1.0, 2.0], [3.0]], "numeric"),  # ragged
+        (np.array([1.0, None], dtype=object), "real numbers, got None"),
+        (np.array([1.0, True], dtype=object), "real numbers, got True"),
+        (np.array([1.0, 10**400], dtype=object), "too large for a float"),
+    ],
+)
 def test_non_numeric_arrays_are_refused(x, match):
     enc = Encoder(G64, 2.0**10)
     with pytest.raises((ParameterError, EncodingOverflowError), match=match):
@@ -299,16 +301,20 @@ def test_integer_codec_needs_a_group(group):
         decode_int(group, 4)
 
 
-@pytest.mark.parametrize("ratio, match", [
-    ((0, 1), r"delta_ratio = \(0, 1\) must have num > 0 and den > 0"),
-    ((1024, 0), r"delta_ratio = \(1024, 0\)"),
-    ((-1, 1), r"delta_ratio = \(-1, 1\)"),
-    ((1.5, 1), r"delta_ratio\[0\] must be an integer.*got 1.5"),
-    ((1, True), r"delta_ratio\[1\] must be an integer.*got True"),
-    ("ab", r"delta_ratio must be a pair \(num, den\).*got 'ab'"),
-    ((1, 2, 3), r"delta_ratio must be a pair.*got \(1, 2, 3\)"),
-    (None, r"delta_ratio must be a pair.*got None"),
-], ids=lambda v: repr(v))
+@pytest.mark.parametrize(
+    "ratio, match",
+    [
+        ((0, 1), r"delta_ratio = \(0, 1\) must have num > 0 and den > 0"),
+        ((1024, 0), r"delta_ratio = \(1024, 0\)"),
+        ((-1, 1), r"delta_ratio = \(-1, 1\)"),
+        ((1.5, 1), r"delta_ratio\[0\] must be an integer.*got 1.5"),
+        ((1, True), r"delta_ratio\[1\] must be an integer.*got True"),
+        ("ab", r"delta_ratio must be a pair \(num, den\).*got 'ab'"),
+        ((1, 2, 3), r"delta_ratio must be a pair.*got \(1, 2, 3\)"),
+        (None, r"delta_ratio must be a pair.*got None"),
+    ],
+    ids=lambda v: repr(v),
+)
 def test_decode_scaled_checks_delta_ratio(ratio, match):
     with pytest.raises(ParameterError, match=match):
         decode_scaled(5, ratio)
@@ -345,9 +351,11 @@ def test_max_abs_signed_known_answers():
         Encoder(G64, 1e300).max_abs_signed(1e300)
 
 
-@pytest.mark.parametrize("call", [
-    lambda g: nearest_member(g, 5, 64), lambda g: default_max_shift(g), lambda g: lift(g, 5),
-], ids=["nearest_member", "default_max_shift", "lift"])
+@pytest.mark.parametrize(
+    "call",
+    [lambda g: nearest_member(g, 5, 64), lambda g: default_max_shift(g), lambda g: lift(g, 5)],
+    ids=["nearest_member", "default_max_shift", "lift"],
+)
 @pytest.mark.parametrize("group", ["abc", 64, None], ids=repr)
 def test_group_functions_need_a_group(call, group):
     with pytest.raises(ParameterError, match=r"group must be a GroupParams, got " + re.escape(format_value(group))):

@@ -10,15 +10,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from encctl_gym.crypto.arith import (
-    RandomSource,
-    SecureRandom,
-    SeededRandom,
-    as_random_source,
-    as_random_stream,
-    seeded_random,
-)
 from encctl_gym.attacks.forgery import forge_injection, forge_injection_token
+from encctl_gym.crypto.arith import RandomSource, SecureRandom, SeededRandom, as_random_source, as_random_stream, seeded_random
 from encctl_gym.crypto.controller import EncryptedLinearController
 from encctl_gym.crypto.dyn_elgamal import ciphertext_update, key_update
 from encctl_gym.crypto.elgamal import decrypt, encrypt, keygen
@@ -61,8 +54,7 @@ def test_one_seed_gives_keygen_and_encryption_independent_streams():
         encrypt(pk, 4, 5)
 
 
-@pytest.mark.parametrize("call", ["encrypt", "key_update", "ciphertext_update", "forge_injection",
-                                  "forge_injection_token"])
+@pytest.mark.parametrize("call", ["encrypt", "key_update", "ciphertext_update", "forge_injection", "forge_injection_token"])
 def test_bare_int_seed_is_refused_where_each_call_needs_fresh_randomness(call):
     rng = seeded_random(1)
     pk, sk = keygen(G64, rng)

@@ -12,12 +12,7 @@ from hypothesis import strategies as st
 
 from encctl_gym.crypto.encoding import nearest_member
 from encctl_gym.crypto.group import GroupParams, shipped_group
-from encctl_gym.crypto.residue_table import (
-    DEFAULT_MAX_TABLE_BYTES,
-    ResidueTable,
-    residue_table,
-    residue_table_bytes,
-)
+from encctl_gym.crypto.residue_table import DEFAULT_MAX_TABLE_BYTES, ResidueTable, residue_table, residue_table_bytes
 from encctl_gym.errors import EncodingOverflowError, GroupError, ParameterError, ResourceLimitError
 
 G64, G128 = shipped_group(64), shipped_group(128)

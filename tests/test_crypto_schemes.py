@@ -9,29 +9,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from encctl_gym.crypto.arith import RandomSource, powmod, seeded_random
-from encctl_gym.crypto.dyn_elgamal import (
-    UpdateToken,
-    ciphertext_update,
-    key_update,
-    recover_next_secret_key,
-)
-from encctl_gym.crypto.elgamal import (
-    Ciphertext,
-    PublicKey,
-    SecretKey,
-    decrypt,
-    encrypt,
-    keygen,
-    mult,
-)
+from encctl_gym.crypto.dyn_elgamal import UpdateToken, ciphertext_update, key_update, recover_next_secret_key
+from encctl_gym.crypto.elgamal import Ciphertext, PublicKey, SecretKey, decrypt, encrypt, keygen, mult
 from encctl_gym.crypto.group import GroupParams, shipped_group
 from encctl_gym.crypto.modified import ModifiedCiphertext, modified_decrypt, modified_eval
-from encctl_gym.errors import (
-    CiphertextError,
-    KeyMismatchError,
-    ParameterError,
-    PlaintextError,
-)
+from encctl_gym.errors import CiphertextError, KeyMismatchError, ParameterError, PlaintextError
 
 TOY = GroupParams(23, 11, 4)  # G = {1, 2, 3, 4, 6, 8, 9, 12, 13, 16, 18}, see test_crypto_arith_group
 G64, G128 = shipped_group(64), shipped_group(128)
@@ -106,8 +88,7 @@ def test_modified_known_answers_toy_group():
 
 # ---------------------------------------------------------------------------- properties
 @PROP
-@given(seed=st.integers(0, 2**32), x1=st.integers(1, 2**130), x2=st.integers(1, 2**130),
-       big=st.booleans())
+@given(seed=st.integers(0, 2**32), x1=st.integers(1, 2**130), x2=st.integers(1, 2**130), big=st.booleans())
 def test_elgamal_correctness_and_homomorphism(seed, x1, x2, big):
     grp = G128 if big else G64
     rng = seeded_random(seed)
@@ -122,8 +103,7 @@ def test_elgamal_correctness_and_homomorphism(seed, x1, x2, big):
 
 
 @PROP
-@given(seed=st.integers(0, 2**32), x1=st.integers(1, 2**130), x2=st.integers(1, 2**130),
-       n_updates=st.integers(1, 25))
+@given(seed=st.integers(0, 2**32), x1=st.integers(1, 2**130), x2=st.integers(1, 2**130), n_updates=st.integers(1, 25))
 def test_dyn_elgamal_updatable_correctness_and_homomorphism(seed, x1, x2, n_updates):
     """Definition def:upd_he: Dec(sk_t, ct_t) = m and Dec(sk_t, Eval(ct_1t, ct_2t)) = m1 m2."""
     grp = G64
@@ -163,8 +143,14 @@ def test_token_attack_recovers_every_next_key(seed, n_updates, big):
 
 
 @settings(max_examples=80, deadline=None)
-@given(seed=st.integers(0, 2**32), t=st.integers(0, 5), k=st.integers(0, 50),
-       x1=st.integers(1, 2**130), x2=st.integers(1, 2**130), big=st.booleans())
+@given(
+    seed=st.integers(0, 2**32),
+    t=st.integers(0, 5),
+    k=st.integers(0, 50),
+    x1=st.integers(1, 2**130),
+    x2=st.integers(1, 2**130),
+    big=st.booleans(),
+)
 def test_modified_theorem(seed, t, k, x1, x2, big):
     """Dec_bar(sk_t, sk_{t+k}, Eval_bar(pk_t, Enc(pk_t, m1), Enc(pk_{t+k}, m2))) = m1 m2 mod p."""
     grp = G128 if big else G64
@@ -206,30 +192,36 @@ def test_modified_theorem_at_712_bits():
 
 
 # ---------------------------------------------------------------------------- bad input
-@pytest.mark.parametrize("m, match", [
-    (0, "m = 0 is not an element"),
-    (5, "m = 5 is not in the order-q subgroup"),  # 5 is a non-residue mod 23
-    (22, "m = 22 is not in the order-q subgroup"),
-    (23, "m = 23 is outside"),
-    (-4, "m = -4 is outside"),
-    (2.0, "integer"),
-    ("9", "integer"),
-    (True, "integer"),
-])
+@pytest.mark.parametrize(
+    "m, match",
+    [
+        (0, "m = 0 is not an element"),
+        (5, "m = 5 is not in the order-q subgroup"),  # 5 is a non-residue mod 23
+        (22, "m = 22 is not in the order-q subgroup"),
+        (23, "m = 23 is outside"),
+        (-4, "m = -4 is outside"),
+        (2.0, "integer"),
+        ("9", "integer"),
+        (True, "integer"),
+    ],
+)
 def test_encrypt_rejects_bad_plaintexts(m, match):
     pk, _ = keygen(TOY, 1)
     with pytest.raises(PlaintextError, match=match):
         encrypt(pk, m)
 
 
-@pytest.mark.parametrize("ct, match", [
-    (Ciphertext(TOY, 0, 4), "c1 = 0 is outside"),
-    (Ciphertext(TOY, 12, 23), "c2 = 23 is outside"),
-    (Ciphertext(TOY, 5, 4), "c1 = 5 is not in the subgroup"),
-    (Ciphertext(TOY, 12, 7), "c2 = 7 is not in the subgroup"),
-    (ModifiedCiphertext(TOY, 12, 4, 18), "expected an ElGamal Ciphertext"),
-    ((12, 4), "expected an ElGamal Ciphertext"),
-])
+@pytest.mark.parametrize(
+    "ct, match",
+    [
+        (Ciphertext(TOY, 0, 4), "c1 = 0 is outside"),
+        (Ciphertext(TOY, 12, 23), "c2 = 23 is outside"),
+        (Ciphertext(TOY, 5, 4), "c1 = 5 is not in the subgroup"),
+        (Ciphertext(TOY, 12, 7), "c2 = 7 is not in the subgroup"),
+        (ModifiedCiphertext(TOY, 12, 4, 18), "expected an ElGamal Ciphertext"),
+        ((12, 4), "expected an ElGamal Ciphertext"),
+    ],
+)
 def test_decrypt_rejects_bad_ciphertexts(ct, match):
     pk, sk = keygen(TOY, 1)
     with pytest.raises(CiphertextError, match=match):
@@ -356,8 +348,11 @@ def test_messages_survive_values_beyond_the_int_to_str_limit():
         (lambda: get_scheme(HUGER), ParameterError, "unknown scheme "),
         (lambda: seeded_random(1).spawn(HUGER), ParameterError, "purpose of a random stream must be a string, got "),
         (lambda: as_random_stream([HUGER], "encrypt"), ParameterError, "rng must be None"),
-        (lambda: TokenControllerServer(pk, [[encrypt(pk, 4, seeded_random(2))]]).receive_token(HUGER), ParameterError,
-         "token must be an UpdateToken, got "),
+        (
+            lambda: TokenControllerServer(pk, [[encrypt(pk, 4, seeded_random(2))]]).receive_token(HUGER),
+            ParameterError,
+            "token must be an UpdateToken, got ",
+        ),
         (lambda: Ciphertext(G64, 4, 4, t=-HUGER), CiphertextError, "Ciphertext.t must be a time step >= 0, got -"),
     ]
     for call, err, start in calls:

@@ -11,7 +11,9 @@ import pytest
 from encctl_gym.cli import main
 from encctl_gym.errors import ParameterError, ResourceLimitError
 from encctl_gym.security.cost_models import GUILLEVIC_CORRECTION
-from encctl_gym.security.design_cli import MAX_STATE_DIMENSION, compute, load_system, parse_duration
+from encctl_gym.security.design_cli import load_system, parse_duration
+from encctl_gym.security.report import MAX_STATE_DIMENSION, design_report
+from encctl_gym.security.threat import ThreatModel
 
 
 def _json(capsys: pytest.CaptureFixture, argv: list[str]) -> dict:
@@ -41,8 +43,27 @@ def test_paper_example_json(capsys: pytest.CaptureFixture) -> None:
 
 
 def test_options_override_preset(capsys: pytest.CaptureFixture) -> None:
-    res = _json(capsys, ["design", "--preset", "paper-example", "--json", "--tau-c", "1y", "--gamma-c", "1e-4",
-                         "--upsilon", "1e12", "--sigma-u2", "1", "--sigma-w2", "1", "--sigma-x2", "0"])
+    res = _json(
+        capsys,
+        [
+            "design",
+            "--preset",
+            "paper-example",
+            "--json",
+            "--tau-c",
+            "1y",
+            "--gamma-c",
+            "1e-4",
+            "--upsilon",
+            "1e12",
+            "--sigma-u2",
+            "1",
+            "--sigma-w2",
+            "1",
+            "--sigma-x2",
+            "0",
+        ],
+    )
     p = res["parameters"]
     assert (p["tau_c"], p["gamma_c"], p["upsilon"], p["sigma_u2"], p["sigma_x2"]) == (31536e3, 1e-4, 1e12, 1.0, 0.0)
     # sigma_x2 = 0: eq:sic equals eq:sic2
@@ -75,8 +96,16 @@ def test_system_files(tmp_path: Path, capsys: pytest.CaptureFixture, fmt: str) -
 
 @pytest.mark.parametrize(
     "text,seconds",
-    [("10y", 31536e4), ("3600s", 3600.0), ("5d", 432000.0), ("2h", 7200.0), ("30min", 1800.0), ("31536e4", 31536e4),
-     ("1.5 h", 5400.0), ("2 years", 2 * 31536e3)],
+    [
+        ("10y", 31536e4),
+        ("3600s", 3600.0),
+        ("5d", 432000.0),
+        ("2h", 7200.0),
+        ("30min", 1800.0),
+        ("31536e4", 31536e4),
+        ("1.5 h", 5400.0),
+        ("2 years", 2 * 31536e3),
+    ],
 )
 def test_parse_duration(text: str, seconds: float) -> None:
     assert parse_duration(text) == pytest.approx(seconds)
@@ -131,8 +160,11 @@ def test_bad_inputs(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
 def test_cost_model_table(capsys: pytest.CaptureFixture) -> None:
     assert main(["design", "--preset", "paper-example", "--cost-model", "all"]) == 0
     out = capsys.readouterr().out
-    rows = {line.split()[0]: line.split() for line in out.splitlines()
-            if line.strip().split(" ")[0] in ("paper", "precomputation", "generic") and len(line.split()) == 9}
+    rows = {
+        line.split()[0]: line.split()
+        for line in out.splitlines()
+        if line.strip().split(" ")[0] in ("paper", "precomputation", "generic") and len(line.split()) == 9
+    }
     assert set(rows) == {"paper", "precomputation", "generic"}
     assert rows["paper"][1:4:2] == ["13159", "712"] and rows["paper"][4] == "712"
     assert rows["precomputation"][4] == "712" and int(rows["precomputation"][3]) > 712
@@ -141,14 +173,29 @@ def test_cost_model_table(capsys: pytest.CaptureFixture) -> None:
 
 
 def test_cost_model_json_agrees_with_the_library(capsys: pytest.CaptureFixture) -> None:
+    from encctl_gym.security.cost_models import PrecomputationModel
     from encctl_gym.security.key_length import design_key_length
+    from encctl_gym.security.threat import ThreatModel
 
-    res = _json(capsys, ["design", "--preset", "paper-example", "--cost-model", "precomputation,paper",
-                         "--gnfs-correction", "guillevic", "--json"])
+    res = _json(
+        capsys,
+        [
+            "design",
+            "--preset",
+            "paper-example",
+            "--cost-model",
+            "precomputation,paper",
+            "--gnfs-correction",
+            "guillevic",
+            "--json",
+        ],
+    )
     cm = res["cost_models"]
     assert list(cm["designs"]) == ["precomputation", "paper"]
     assert cm["gnfs_correction"] == GUILLEVIC_CORRECTION
-    lib = design_key_length("precomputation", 13159, tau_c=31536e4, upsilon=442e15, gnfs_correction=GUILLEVIC_CORRECTION)
+    lib = design_key_length(
+        13159, ThreatModel(tau_c=31536e4, upsilon=442e15, cost_model=PrecomputationModel(GUILLEVIC_CORRECTION))
+    )
     assert cm["designs"]["precomputation"]["k_star"] == lib.k_star
     assert cm["designs"]["paper"]["paper_k_star"] == 712 and cm["designs"]["paper"]["k_star"] > 712
     assert cm["key_value"]["key_length"] == 712
@@ -158,8 +205,21 @@ def test_cost_model_json_agrees_with_the_library(capsys: pytest.CaptureFixture) 
 
 
 def test_cost_model_for_the_robust_n_star(capsys: pytest.CaptureFixture) -> None:
-    res = _json(capsys, ["design", "--preset", "paper-example", "--cost-model", "generic", "--complexity",
-                         "closed_loop", "--key-length", "1024", "--json"])
+    res = _json(
+        capsys,
+        [
+            "design",
+            "--preset",
+            "paper-example",
+            "--cost-model",
+            "generic",
+            "--complexity",
+            "closed_loop",
+            "--key-length",
+            "1024",
+            "--json",
+        ],
+    )
     assert res["cost_models"]["N_star"] == res["designs"]["closed_loop"]["N_star"]
     assert res["cost_models"]["key_value"]["key_length"] == 1024
 
@@ -191,8 +251,11 @@ def test_calibration_file_not_increasing_is_one_line(tmp_path: Path, capsys: pyt
     data["records"].append(dict(data["records"][1], name="dlp-600", key_length=600))
     path = tmp_path / "cal.json"
     path.write_text(json.dumps(data))
-    _fails(capsys, ["design", "--preset", "paper-example", "--cost-model", "precomputation", "--calibration", str(path)],
-           "768 followed by 600")
+    _fails(
+        capsys,
+        ["design", "--preset", "paper-example", "--cost-model", "precomputation", "--calibration", str(path)],
+        "768 followed by 600",
+    )
 
 
 # --------------------------------------------------------------------------- plant files: one schema, values used, sources told
@@ -202,8 +265,14 @@ def test_plant_file_values_are_used_and_sources_told(tmp_path: Path, capsys: pyt
     res = _json(capsys, ["design", str(path), "--json", "--upsilon", "1e15"])
     p = res["parameters"]
     assert (p["sigma_u2"], p["sigma_w2"], p["tau_c"], p["upsilon"]) == (2.0, 0.5, 5 * 31536e3, 1e15)
-    assert res["sources"] == {"sigma_u2": "file", "sigma_w2": "file", "tau_c": "file", "upsilon": "option",
-                              "sigma_x2": "default", "gamma_c": "default"}
+    assert res["sources"] == {
+        "sigma_u2": "file",
+        "sigma_w2": "file",
+        "tau_c": "file",
+        "upsilon": "option",
+        "sigma_x2": "default",
+        "gamma_c": "default",
+    }
     assert main(["design", str(path)]) == 0
     out = capsys.readouterr().out
     assert "values sigma_u2, sigma_w2, tau_c from the file" in out and "gamma_c" in out
@@ -220,8 +289,10 @@ def test_large_plants_work_or_are_refused_with_a_reason(tmp_path: Path, capsys: 
     assert main(["design", str(path)]) == 0
     assert "skipped: the A-optimal design SDP for n + m = 120" in capsys.readouterr().out
     with pytest.raises(ResourceLimitError, match=f"n = {MAX_STATE_DIMENSION + 1} states"):
-        compute(0.5 * np.eye(MAX_STATE_DIMENSION + 1), np.eye(MAX_STATE_DIMENSION + 1, 1), gamma_c=1e-6, tau_c=1e8,
-                upsilon=1e17, sigma_u2=1, sigma_w2=1)
+        design_report(
+            (0.5 * np.eye(MAX_STATE_DIMENSION + 1), np.eye(MAX_STATE_DIMENSION + 1, 1)),
+            ThreatModel(gamma_c=1e-6, tau_c=1e8, upsilon=1e17, sigma_u2=1, sigma_w2=1),
+        )
 
 
 @pytest.mark.parametrize(

@@ -49,13 +49,15 @@ def random_actions(rng, n_steps, m, scale=0.3):
 )
 def test_checkers_pass_without_warning(overrides):
     from gymnasium.utils.env_checker import check_env
-    from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
     cfg = {**SMALL, **overrides}
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(gym.make(ENV_ID, config=cfg).unwrapped)  # with a spec: also checks render modes
-        sb3_check_env(EncryptedLTIAttackEnv(config=cfg), warn=True)
+    sb3_checker = pytest.importorskip("stable_baselines3.common.env_checker")  # the rl extra
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sb3_checker.check_env(EncryptedLTIAttackEnv(config=cfg), warn=True)
 
 
 def test_make_and_make_vec():
@@ -265,7 +267,7 @@ def test_a_constant_input_gets_the_minimum_norm_estimate_every_step():
             assert info["epsilon"] == pytest.approx(np.sum((th - theta) ** 2) / theta.size, rel=1e-6)
         if te or tr:
             break
-    assert not core.ready.any()
+    assert not core.kernels.ready.any()
     assert np.isfinite(info["epsilon"]) and info["epsilon"] > 0
 
 
@@ -701,10 +703,35 @@ def test_a_subnormal_a_optimality_regularization_gives_finite_rewards_that_teles
         if term or trunc:
             break
     assert all(math.isfinite(r) for r in rewards)
+    # The constant action makes G exactly singular, so whether its smallest eigenvalue comes out as
+    # 0, -2e-32 or 1e-17 is the machine's rounding: the reference takes the same eigenvalues as the
+    # environment and never exponentiates 1 / (0 + delta) (which overflows float64), so it holds
+    # whatever the BLAS returns.
     lam = np.clip(np.linalg.eigvalsh(env.episode.G[0]), 0.0, None)
-    # log(d / delta) and log sum 1 / (lam + delta), each computed with Python's exact-range logs
-    expected = (math.log(4) - math.log(delta)) - math.log(math.fsum(math.exp(-math.log(v + delta)) for v in lam))
+    expected = (math.log(4) - math.log(delta)) - _log_sum_of_inverses(lam, delta)
     assert math.isclose(sum(rewards), expected, rel_tol=1e-9)
+
+
+def _log_sum_of_inverses(lam, delta):
+    """log sum_i 1 / (lam_i + delta) by a max-shifted sum of Python floats (no overflow)."""
+    logs = [-math.log(float(v) + delta) for v in lam]
+    top = max(logs)
+    return top + math.log(math.fsum(math.exp(x - top) for x in logs))
+
+
+@pytest.mark.parametrize("delta", [0.5, 1e-300, 1e-320, 5e-324])
+def test_a_optimality_measure_of_an_exactly_singular_gram_matrix(delta):
+    """A diagonal G has exact eigenvalues (no rounding): two exact zeros and 1, 2 give
+    log(2 / delta + 1 / (1 + delta) + 1 / (2 + delta)), finite although 1 / delta overflows."""
+    from types import SimpleNamespace
+
+    from encctl_gym.envs.rewards import AOptimalityReward
+
+    reward = AOptimalityReward(SimpleNamespace(n=2, m=2, logdet_regularization=delta), num_envs=1)
+    G = np.diag([0.0, 1.0, 0.0, 2.0])[None]
+    # exact reference: log(2 / delta) + log(1 + delta / 2 (1 / (1 + delta) + 1 / (2 + delta)))
+    expected = math.log(2) - math.log(delta) + math.log1p(delta / 2 * (1 / (1 + delta) + 1 / (2 + delta)))
+    assert math.isclose(float(reward.measure(G)[0]), expected, rel_tol=1e-12)
 
 
 def test_bad_vector_flags_are_refused_before_a_helper_thread_starts():

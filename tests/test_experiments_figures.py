@@ -143,8 +143,13 @@ def test_reproduce_quick_through_the_cli(tmp_path: Path, capsys: pytest.CaptureF
     rc = cli.main(["reproduce", "--quick", "--n-jobs", "1", "--no-progress", "--out", str(tmp_path), "--seed", "3"])
     assert rc == 0
     out = capsys.readouterr().out
-    for name in ("fig1_variance_ratio.png", "fig1_variance_ratio.csv", "fig2_gramian.png",
-                 "fig2_gramian.csv", "design_example.csv"):
+    for name in (
+        "fig1_variance_ratio.png",
+        "fig1_variance_ratio.csv",
+        "fig2_gramian.png",
+        "fig2_gramian.csv",
+        "design_example.csv",
+    ):
         assert (tmp_path / name).stat().st_size > 0
         assert name in out
     assert (tmp_path / "fig1_variance_ratio.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -181,13 +186,19 @@ def test_reproduce_module_and_script_entry_points(tmp_path: Path) -> None:
     # `python -m experiments.reproduce` and `python experiments/<script>.py` both work.
     r = subprocess.run(
         [sys.executable, "-m", "experiments.reproduce", "--only", "design", "--out", str(tmp_path)],
-        cwd=REPO, capture_output=True, text=True, timeout=120,
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert r.returncode == 0, r.stderr
     assert "13159" in r.stdout
     r = subprocess.run(
         [sys.executable, str(REPO / "experiments" / "design_example.py"), "--out", str(tmp_path / "x")],
-        cwd=tmp_path, capture_output=True, text=True, timeout=120,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "x" / "design_example.csv").exists()

@@ -9,12 +9,12 @@ from hypothesis import strategies as st
 
 from encctl_gym.errors import EncctlError, ParameterError, ResourceLimitError, ShapeError
 from encctl_gym.ident.error import estimation_error
+from encctl_gym.ident.grid import identification_errors
 from encctl_gym.ident.least_squares import (
     GRAM_COND_LIMIT,
     RecursiveLeastSquares,
     check_sample_sizes,
     data_matrices,
-    identification_errors,
     least_squares,
     prefix_estimates,
 )

@@ -62,7 +62,9 @@ def test_security_rows_refuse_to_extrapolate_a_curve_that_does_not_fall_like_one
     flat = strat.Curve("gaussian", False, "forgetting(0.5)", N, np.tile(0.5 / (N - 1.0) + 0.01, (3, 1)))
     res = strat.Result([s], [], {"small": [falling, flat]}, {"small": 0.0}, {"small": strat.table_sizes(s, 40)}, 0.0)
     by = {r["estimator"]: r for r in strat.security_rows(res)}
-    assert by["ls"]["N_to_gamma_c"] == 502 and by["ls"]["N_how"] == "fit, extrapolated 3.14x beyond N = 160"  # floor(0.5 / 1e-3) + 2 (gamma_c = 1e-3)
+    assert (
+        by["ls"]["N_to_gamma_c"] == 502 and by["ls"]["N_how"] == "fit, extrapolated 3.14x beyond N = 160"
+    )  # floor(0.5 / 1e-3) + 2 (gamma_c = 1e-3)
     assert by["ls"]["first_below"] is None  # 0.5 / 159 > 1e-3 at N = 160
     assert by["ls"]["lambda_needed"] is not None and by["ls"]["slope"] == pytest.approx(-1.0)
     r = by["forgetting(0.5)"]  # the error levels off: no extrapolation

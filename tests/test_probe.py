@@ -15,7 +15,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from probe.catalogue import KNOWN_FAILURES, all_cases
 from probe.harness import CLASSES, OUTCOMES, Case, Result, fork_available, run_cases
 
@@ -74,14 +73,14 @@ def test_catalogue_covers_every_class_and_layer() -> None:
 def test_the_harness_classifies_each_outcome() -> None:
     # one case per outcome: the classifier itself is tested against known answers
     import numpy as np
+    from probe.harness import NotApplicable, SecurityFinding
 
     from encctl_gym.errors import ParameterError
-
-    from probe.harness import NotApplicable, SecurityFinding
 
     def raise_(exc: BaseException):  # noqa: ANN202
         def run(_: Path) -> None:
             raise exc
+
         return run
 
     def grow(_: Path) -> None:
@@ -99,13 +98,27 @@ def test_the_harness_classifies_each_outcome() -> None:
         Case("t/memory", "t", "hang", grow),
         Case("t/hang", "t", "hang", lambda _: __import__("time").sleep(60), timeout=2),
         Case("t/after a hang", "t", "silent", lambda _: 1, expect="result", check=lambda v: None),
-        Case("t/wrong result", "t", "silent", lambda _: 1, expect="result", check=lambda v: (_ for _ in ()).throw(AssertionError(v))),
+        Case(
+            "t/wrong result",
+            "t",
+            "silent",
+            lambda _: 1,
+            expect="result",
+            check=lambda v: (_ for _ in ()).throw(AssertionError(v)),
+        ),
     ]
     res = run_cases(cases)
     got = {name: r.outcome for name, r in res.items()}
     assert got == {
-        "t/ok": "ok", "t/silent": "silent", "t/traceback": "traceback", "t/multi-line message": "traceback",
-        "t/security": "security", "t/n/a": "n/a", "t/memory": "hang", "t/hang": "hang", "t/after a hang": "ok",
+        "t/ok": "ok",
+        "t/silent": "silent",
+        "t/traceback": "traceback",
+        "t/multi-line message": "traceback",
+        "t/security": "security",
+        "t/n/a": "n/a",
+        "t/memory": "hang",
+        "t/hang": "hang",
+        "t/after a hang": "ok",
         "t/wrong result": "silent",
     }
     assert set(got.values()) <= set(OUTCOMES)
@@ -124,6 +137,10 @@ def test_a_broken_pipe_is_not_a_traceback() -> None:
     repo = Path(__file__).resolve().parents[1]
     proc = subprocess.run(
         f"{sys.executable} -m encctl_gym.cli design --preset small | head -1",
-        shell=True, cwd=repo, capture_output=True, text=True, timeout=120,
+        shell=True,
+        cwd=repo,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert proc.stdout.startswith("System:") and "Traceback" not in proc.stderr and "Error" not in proc.stderr, proc.stderr

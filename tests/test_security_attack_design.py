@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -12,12 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from encctl_gym._validation import format_value
-from encctl_gym.errors import (
-    ParameterError,
-    ResourceLimitError,
-    SolverError,
-    UnstableSystemError,
-)
+from encctl_gym.errors import ParameterError, ResourceLimitError, SolverError, UnstableSystemError
+from encctl_gym.plant import Plant
 from encctl_gym.security.attack_design import (
     gamma_opt,
     gaussian_attack_design,
@@ -28,6 +25,7 @@ from encctl_gym.security.attack_design import (
 from encctl_gym.security.complexity import sic_asymptotic_from_traces
 from encctl_gym.security.design import paper_design_example, sample_size_for_rate
 from encctl_gym.security.gramians import noise_gramian
+from encctl_gym.security.threat import ThreatModel
 
 SCALAR_CASES = [(0.5, 1.0, 1.0, 1.0), (0.9, 0.2, 1.0, 1.0), (-0.8, 1.0, 0.1, 1.0), (0.3, 2.0, 5.0, 0.5), (0.0, 1.0, 2.0, 0.3)]
 
@@ -54,10 +52,17 @@ def _scalar_min(a: float, b: float, su: float, sw: float, open_loop: bool) -> fl
     vals = value(q, c)
     i = np.unravel_index(np.argmin(vals), vals.shape)
     res = scipy.optimize.minimize(
-        lambda z: float(value(np.asarray(z[0]), np.asarray(z[1]))), [q[i], c[i]], method="Nelder-Mead",
+        lambda z: float(value(np.asarray(z[0]), np.asarray(z[1]))),
+        [q[i], c[i]],
+        method="Nelder-Mead",
         options={"xatol": 1e-12, "fatol": 1e-14, "maxiter": 5000},
     )
     return float(min(vals[i], res.fun))
+
+
+def _robust(A: Any, B: Any, *, kind: str = "closed_loop", design: Any = None, **threat: Any) -> Any:
+    """robust_security_design on the value objects built from the plant and threat values."""
+    return robust_security_design(Plant(A, B), ThreatModel(**threat), kind=kind, design=design)
 
 
 @pytest.mark.parametrize("a,b,su,sw", SCALAR_CASES)
@@ -93,8 +98,12 @@ def _stable_system(seed: int, n: int, m: int, rho: float) -> tuple[np.ndarray, n
 
 @settings(max_examples=12, deadline=None, derandomize=True)
 @given(
-    st.integers(0, 10**6), st.integers(1, 3), st.integers(1, 2), st.floats(0.05, 0.95),
-    st.floats(0.05, 20.0), st.floats(0.05, 20.0),
+    st.integers(0, 10**6),
+    st.integers(1, 3),
+    st.integers(1, 2),
+    st.floats(0.05, 0.95),
+    st.floats(0.05, 20.0),
+    st.floats(0.05, 20.0),
 )
 def test_ordering_constraints_and_policy(seed: int, n: int, m: int, rho: float, su: float, sw: float) -> None:
     A, B = _stable_system(seed, n, m, rho)
@@ -137,9 +146,12 @@ def test_ordering_constraints_and_policy(seed: int, n: int, m: int, rho: float, 
 def test_paper_example_values() -> None:
     A, B = np.sqrt(0.5) * np.eye(4), 0.5 * np.eye(4)
     cl = optimal_attack_design(A, B, sigma_u2=10, sigma_w2=0.1)
+
     # decoupled channels: each is the scalar problem a = sqrt(1/2), b = 1/2, q = 10:
     # p = sqrt(2) c + 5.2, minimise (p + 10) / (10 p - c^2) over c.
-    f = lambda c: (np.sqrt(2) * c + 15.2) / (10 * (np.sqrt(2) * c + 5.2) - c * c)
+    def f(c):
+        return (np.sqrt(2) * c + 15.2) / (10 * (np.sqrt(2) * c + 5.2) - c * c)
+
     res = scipy.optimize.minimize_scalar(f, bounds=(0, 10), method="bounded", options={"xatol": 1e-12})
     assert cl.trace_inv == pytest.approx(4 * res.fun, rel=1e-7)
     np.testing.assert_allclose(cl.K, res.x / (np.sqrt(2) * res.x + 5.2) * np.eye(4), atol=1e-5)
@@ -173,8 +185,8 @@ def test_monte_carlo_matches_gamma_opt() -> None:
 def test_robust_design_paper_example() -> None:
     A, B = np.sqrt(0.5) * np.eye(4), 0.5 * np.eye(4)
     kw = dict(sigma_u2=10, sigma_w2=0.1, gamma_c=1e-6, tau_c=31536e4, upsilon=442e15)
-    cl = robust_security_design(A, B, **kw)
-    ga = robust_security_design(A, B, kind="gaussian", **kw)
+    cl = _robust(A, B, **kw)
+    ga = _robust(A, B, kind="gaussian", **kw)
     paper = paper_design_example()
     d = optimal_attack_design(A, B, sigma_u2=10, sigma_w2=0.1)
     assert cl.N_star == sample_size_for_rate(d.rate, 1e-6)
@@ -198,9 +210,18 @@ def test_gamma_opt_and_errors() -> None:
     with pytest.raises(SolverError, match="NOSUCHSOLVER"):
         optimal_attack_design(A, B, sigma_u2=1, sigma_w2=1, solver="NOSUCHSOLVER")
     with pytest.raises(ParameterError, match="kind"):
-        robust_security_design(A, B, sigma_u2=1, sigma_w2=1, gamma_c=0.1, tau_c=1, upsilon=1, kind="psychic")
+        _robust(A, B, sigma_u2=1, sigma_w2=1, gamma_c=0.1, tau_c=1, upsilon=1, kind="psychic")
     with pytest.raises(ParameterError, match="gaussian"):
-        robust_security_design(A, B, sigma_u2=1, sigma_w2=1, gamma_c=0.1, tau_c=1, upsilon=1, design=gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1))
+        _robust(
+            A,
+            B,
+            sigma_u2=1,
+            sigma_w2=1,
+            gamma_c=0.1,
+            tau_c=1,
+            upsilon=1,
+            design=gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1),
+        )
 
 
 def test_scs_fallback_solver_agrees() -> None:
@@ -242,18 +263,18 @@ def test_robust_design_refuses_a_design_made_for_other_values() -> None:
     kw = dict(gamma_c=1e-3, tau_c=1e6, upsilon=1e12)
     for kind, feedback in (("closed_loop", True), ("open_loop", False)):
         made = optimal_attack_design(A, B, sigma_u2=1, sigma_w2=1, feedback=feedback)
-        assert robust_security_design(A, B, sigma_u2=1, sigma_w2=1, kind=kind, design=made, **kw).method == kind
+        assert _robust(A, B, sigma_u2=1, sigma_w2=1, kind=kind, design=made, **kw).method == kind
         with pytest.raises(ParameterError, match="sigma_u2 = 1.0, not sigma_u2 = 2.0"):
-            robust_security_design(A, B, sigma_u2=2, sigma_w2=1, kind=kind, design=made, **kw)
+            _robust(A, B, sigma_u2=2, sigma_w2=1, kind=kind, design=made, **kw)
         with pytest.raises(ParameterError, match="sigma_w2"):
-            robust_security_design(A, B, sigma_u2=1, sigma_w2=0.5, kind=kind, design=made, **kw)
+            _robust(A, B, sigma_u2=1, sigma_w2=0.5, kind=kind, design=made, **kw)
         with pytest.raises(ParameterError, match="does not fit this plant"):
-            robust_security_design(0.5 * A, B, sigma_u2=1, sigma_w2=1, kind=kind, design=made, **kw)
+            _robust(0.5 * A, B, sigma_u2=1, sigma_w2=1, kind=kind, design=made, **kw)
     g = gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1)
     with pytest.raises(ParameterError, match="does not fit this plant"):
-        robust_security_design(A, 2 * B, sigma_u2=1, sigma_w2=1, kind="gaussian", design=g, **kw)
+        _robust(A, 2 * B, sigma_u2=1, sigma_w2=1, kind="gaussian", design=g, **kw)
     with pytest.raises(ParameterError, match="AttackDesign"):
-        robust_security_design(A, B, sigma_u2=1, sigma_w2=1, kind="gaussian", design="gaussian", **kw)
+        _robust(A, B, sigma_u2=1, sigma_w2=1, kind="gaussian", design="gaussian", **kw)
 
 
 def test_large_sdp_refused_before_solving_with_an_estimate() -> None:
@@ -271,8 +292,10 @@ def test_large_sdp_refused_before_solving_with_an_estimate() -> None:
     assert gaussian_attack_design(A, B, sigma_u2=1, sigma_w2=1).Sigma.shape == (60, 60)
 
 
-@pytest.mark.parametrize("bad,match", [(10**400, "<= 9007199254740992, got <integer of 1329 bits"), (2**53 + 1, "<= 9007199254740992"),
-                                       (1, ">= 2"), ("a", "'a'")])
+@pytest.mark.parametrize(
+    "bad,match",
+    [(10**400, "<= 9007199254740992, got <integer of 1329 bits"), (2**53 + 1, "<= 9007199254740992"), (1, ">= 2"), ("a", "'a'")],
+)
 def test_sdp_estimate_is_bounded(bad: object, match: str) -> None:
     with pytest.raises(ParameterError, match=f"^dimension must be .*{match}"):
         sdp_estimate(bad)  # type: ignore[arg-type]

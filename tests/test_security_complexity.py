@@ -50,13 +50,9 @@ def test_sic_closed_form_scaled_identity() -> None:
     su, sw, sx = 2.0, 0.5, 0.7
     for N in (2, 10, 1000):
         expected = (m + n) * sw / (sx * tr_w + (N - 1) * (su * (tr_u + m) + sw * tr_w))
-        assert sample_identifying_complexity(N, A, B, sigma_u2=su, sigma_w2=sw, sigma_x2=sx) == pytest.approx(
-            expected, rel=1e-12
-        )
+        assert sample_identifying_complexity(N, A, B, sigma_u2=su, sigma_w2=sw, sigma_x2=sx) == pytest.approx(expected, rel=1e-12)
         expected2 = (m + n) / ((N - 1) * (su / sw * (tr_u + m) + tr_w))
-        assert sample_identifying_complexity_asymptotic(N, A, B, r_sigma=su / sw) == pytest.approx(
-            expected2, rel=1e-12
-        )
+        assert sample_identifying_complexity_asymptotic(N, A, B, r_sigma=su / sw) == pytest.approx(expected2, rel=1e-12)
 
 
 def test_paper_example_value() -> None:

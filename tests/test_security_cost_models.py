@@ -24,7 +24,7 @@ from encctl_gym.security.cost_models import (
     DECIPHERING_MODELS,
     GNFS_MIN_KEY_LENGTH,
     GUILLEVIC_CORRECTION,
-    DecipheringModel,
+    CostModel,
     GenericModel,
     PaperModel,
     PrecomputationModel,
@@ -38,6 +38,7 @@ from encctl_gym.security.design import is_secure, paper_design_example
 from encctl_gym.security.key_length import defense_budget, design_key_length, key_length_value
 from encctl_gym.security.records import DATA_FILE, default_records, load_records, nist_key_length, nist_strength
 from encctl_gym.security.sample_size import exact_sic_asymptotic_function
+from encctl_gym.security.threat import ThreatModel
 
 N_STAR = 13159  # the design example's N*, recomputed by paper_design_example() in test_design_example_n_star
 TAU_C, UPSILON = PAPER_DESIGN_EXAMPLE["tau_c"], PAPER_DESIGN_EXAMPLE["upsilon"]
@@ -59,7 +60,7 @@ def test_design_example_n_star() -> None:
 
 # --------------------------------------------------------------------------- the paper model keeps the paper's numbers
 def test_paper_model_reproduces_the_paper() -> None:
-    d = design_key_length("paper", N_STAR, tau_c=TAU_C, upsilon=UPSILON)
+    d = design_key_length(N_STAR, ThreatModel(tau_c=TAU_C, upsilon=UPSILON))
     assert (d.lam_star, d.k_star, d.paper_k_star) == (74, 712, 712)
     assert d.work_bits == pytest.approx(math.log2(N_STAR) + omega_bits(712), abs=1e-9)
     assert d.dynamic_key_bits == pytest.approx(math.log2(N_STAR), abs=1e-9)
@@ -86,7 +87,7 @@ def test_precomputation_k_star_by_hand(correction: float) -> None:
 
     k_hand = _smallest(lambda k: work_bits(k) > target)
     assert work_bits(k_hand) - target > 1e-6 and target - work_bits(k_hand - 1) > 1e-6  # no tie to round
-    d = design_key_length("precomputation", N_STAR, tau_c=TAU_C, upsilon=UPSILON, gnfs_correction=correction)
+    d = design_key_length(N_STAR, ThreatModel(tau_c=TAU_C, upsilon=UPSILON, cost_model=PrecomputationModel(correction)))
     assert d.k_star == k_hand
     assert d.work_bits == pytest.approx(work_bits(k_hand), abs=1e-9)
     # the precomputation alone must already exceed Upsilon tau_c: the per-key term adds ~0.02 bit
@@ -100,19 +101,22 @@ def test_generic_k_star_by_hand() -> None:
     k = 16
     while not 0.5 * (k - 2 + math.log2(math.pi / 2)) + math.log2(N_STAR) > target:
         k += 1
-    assert design_key_length("generic", N_STAR, tau_c=TAU_C, upsilon=UPSILON).k_star == k
+    assert design_key_length(N_STAR, ThreatModel(tau_c=TAU_C, upsilon=UPSILON, cost_model="generic")).k_star == k
 
 
 @settings(max_examples=25, deadline=None)
 @given(
-    st.sampled_from(list(DECIPHERING_MODELS)), st.integers(2, 10**7),
-    st.floats(1e3, 1e12), st.floats(1e9, 1e20), st.sampled_from([0.0, 5.0, GUILLEVIC_CORRECTION]),
+    st.sampled_from(list(DECIPHERING_MODELS)),
+    st.integers(2, 10**7),
+    st.floats(1e3, 1e12),
+    st.floats(1e9, 1e20),
+    st.sampled_from([0.0, 5.0, GUILLEVIC_CORRECTION]),
 )
 def test_k_star_is_the_smallest_secure_key(model: str, N_star: int, tau_c: float, upsilon: float, c: float) -> None:
     """Definition def:security itself: secure at k*, and (but for the paper model's integer lam) not at k* - 1."""
     kw = {} if model == "generic" else {"gnfs_correction": c}
     try:
-        d = design_key_length(model, N_star, tau_c=tau_c, upsilon=upsilon, **kw)
+        d = design_key_length(N_star, ThreatModel(tau_c=tau_c, upsilon=upsilon, cost_model=deciphering_model(model, **kw)))
     except ModelRangeError:
         return  # the budget is below what the smallest key of the range already defeats
     gamma = exact_sic_asymptotic_function(0, 1, 1, 1, r_sigma=1)  # K = 2: gamma(N) = 1 / (N - 1)
@@ -147,8 +151,9 @@ def test_nist_lookups() -> None:
     assert nist_strength(712) is None and nist_strength(1024) == 80 and nist_strength(3000) == 112
 
 
-
-@pytest.mark.parametrize("bad,match", [(math.nan, "finite"), (-1.0, ">= 0"), ("a", "'a'"), (None, "None"), (10**400, "1329 bits"), (2 + 1j, "2")])
+@pytest.mark.parametrize(
+    "bad,match", [(math.nan, "finite"), (-1.0, ">= 0"), ("a", "'a'"), (None, "None"), (10**400, "1329 bits"), (2 + 1j, "2")]
+)
 def test_nist_key_length_checks_its_strength(bad: object, match: str) -> None:
     with pytest.raises(ParameterError, match=f"^bits .*{match}"):
         nist_key_length(bad)  # type: ignore[arg-type]
@@ -186,12 +191,12 @@ def test_gnfs_range_is_where_the_formula_beats_rho() -> None:
         GenericModel().break_cost(15)
 
 
-# --------------------------------------------------------------------------- registry, protocol, errors
-def test_registry_and_protocol() -> None:
+# --------------------------------------------------------------------------- registry, base class, errors
+def test_registry_and_base_class() -> None:
     assert set(DECIPHERING_MODELS) == {"paper", "precomputation", "generic"}
     for name in DECIPHERING_MODELS:
         m = deciphering_model(name)
-        assert isinstance(m, DecipheringModel) and m.name == name
+        assert isinstance(m, CostModel) and m.name == name
         assert m.describe()["name"] == name
     with pytest.raises(ParameterError, match="'rho'") as info:
         deciphering_model("rho")
@@ -206,9 +211,9 @@ def test_registry_and_protocol() -> None:
 
 def test_design_outside_the_key_length_range() -> None:
     with pytest.raises(ModelRangeError, match="below 40 bits"):
-        design_key_length("precomputation", 2, tau_c=1.0, upsilon=1.0)
+        design_key_length(2, ThreatModel(tau_c=1.0, upsilon=1.0, cost_model="precomputation"))
     with pytest.raises(ModelRangeError, match="65536"):
-        design_key_length("generic", 2, tau_c=1e300, upsilon=1e300)
+        design_key_length(2, ThreatModel(tau_c=1e300, upsilon=1e300, cost_model="generic"))
 
 
 # --------------------------------------------------------------------------- calibration
@@ -302,19 +307,21 @@ def test_records_files(tmp_path: Path) -> None:
 # --------------------------------------------------------------------------- what a key is worth
 def test_what_a_712_bit_key_is_worth() -> None:
     assert defense_budget(TAU_C, UPSILON) == 442 * 10**15 * 31536 * 10**4
-    paper = key_length_value("paper", 712, N_star=N_STAR, tau_c=TAU_C, upsilon=UPSILON)
+    paper = key_length_value(712, ThreatModel(tau_c=TAU_C, upsilon=UPSILON, cost_model="paper"), N_star=N_STAR)
     assert paper.secure and paper.dynamic_key_bits == pytest.approx(math.log2(N_STAR), abs=1e-9)
     assert paper.affordable_samples == math.floor(442e15 * 31536e4 / 2 ** omega_bits(712))  # 7357.x, no tie
-    pre = key_length_value("precomputation", 712, N_star=N_STAR, tau_c=TAU_C, upsilon=UPSILON)
+    pre = key_length_value(712, ThreatModel(tau_c=TAU_C, upsilon=UPSILON, cost_model="precomputation"), N_star=N_STAR)
     assert not pre.secure and pre.affordable_samples > 10**9
     r = math.log2(5300 * 365 / 2)
     # N = 1 + (B - C_pre - C_key) / C_key = B / C_key - 2^r
     assert pre.log2_affordable_samples == pytest.approx(math.log2(2 ** (budget_bits() - omega_bits(712) + r) - 2**r), abs=1e-6)
-    generic = key_length_value("generic", 712, N_star=N_STAR, tau_c=TAU_C, upsilon=UPSILON)
+    generic = key_length_value(712, ThreatModel(tau_c=TAU_C, upsilon=UPSILON, cost_model="generic"), N_star=N_STAR)
     assert generic.secure and generic.affordable_samples == 0 and generic.first_key_bits > 355
 
 
-@pytest.mark.parametrize("year,match", [(-1, ">= 0"), (10**400, "<= 9999, got <integer of 1329 bits"), (2015.5, "2015.5"), ("2015", "'2015'")])
+@pytest.mark.parametrize(
+    "year,match", [(-1, ">= 0"), (10**400, "<= 9999, got <integer of 1329 bits"), (2015.5, "2015.5"), ("2015", "'2015'")]
+)
 def test_record_years_are_bounded(tmp_path: Path, year: object, match: str) -> None:
     def mutate(d: dict) -> None:
         d["records"][0]["year"] = year

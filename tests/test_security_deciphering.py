@@ -94,13 +94,7 @@ def test_exact_number_reads_decimal() -> None:
         exact_number("x", -1.0)
 
 
-@pytest.mark.parametrize(
-    "kwargs,match",
-    [
-        ({"scheme": "rotating"}, "rotating"),
-        ({"adversary": "alice"}, "alice"),
-    ],
-)
+@pytest.mark.parametrize("kwargs,match", [({"scheme": "rotating"}, "rotating"), ({"adversary": "alice"}, "alice")])
 def test_unknown_names(kwargs: dict, match: str) -> None:
     with pytest.raises(ParameterError, match=match):
         sample_deciphering_time(2, 10, 1.0, **kwargs)
@@ -159,7 +153,10 @@ def test_precomputation_first_sample_carries_the_precomputation() -> None:
 
 @settings(max_examples=60, deadline=None)
 @given(
-    st.integers(1, 10**6), st.integers(1, 10**4), st.integers(1, 10**7), st.integers(1, 10**5),
+    st.integers(1, 10**6),
+    st.integers(1, 10**4),
+    st.integers(1, 10**7),
+    st.integers(1, 10**5),
     st.sampled_from([("modified", "eavesdropper"), ("token", "server"), ("static", "eavesdropper")]),
 )
 def test_max_affordable_samples_is_the_largest_affordable_N(first_extra: int, nxt: int, tau: int, ups: int, sa) -> None:

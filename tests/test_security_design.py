@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from encctl_gym._validation import format_value
 from encctl_gym.errors import ModelRangeError, ParameterError
+from encctl_gym.plant import Plant
 from encctl_gym.security.complexity import sic_asymptotic_from_traces, sic_from_traces
 from encctl_gym.security.deciphering import sample_deciphering_time_exact
 from encctl_gym.security.design import (
@@ -34,6 +35,7 @@ from encctl_gym.security.design import (
     paper_design_example,
     sample_size_for_rate,
 )
+from encctl_gym.security.threat import ThreatModel
 
 EX = PAPER_EXAMPLE
 
@@ -45,9 +47,9 @@ def test_paper_design_example() -> None:
     assert d.gamma_at_N_star < 1e-6 <= d.gamma_before_N_star
     assert d.bit_security >= 74
     # the same from the plant matrices A = sqrt(1/2) I, B = 0.5 I
-    d2 = design_security_parameter(
-        np.sqrt(0.5) * np.eye(4), 0.5 * np.eye(4), sigma_u2=10, sigma_w2=0.1, gamma_c=1e-6, tau_c=31536e4, upsilon=442e15
-    )
+    threat = ThreatModel(sigma_u2=10, sigma_w2=0.1, gamma_c=1e-6, tau_c=31536e4, upsilon=442e15)
+    d2 = design_security_parameter(Plant(np.sqrt(0.5) * np.eye(4), 0.5 * np.eye(4)), threat)
+    assert design_security_parameter((np.sqrt(0.5) * np.eye(4), 0.5 * np.eye(4)), threat) == d2  # a pair works too
     assert (d2.N_star, d2.lam_star, d2.k_star) == (13159, 74, 712)
     assert d2.tr_psi_w == pytest.approx(8) and d2.tr_psi_u == pytest.approx(2)
 
@@ -117,7 +119,9 @@ def test_is_secure_against_brute_force() -> None:
     rng = np.random.default_rng(5)
     outcomes = []
     for _ in range(40):
-        g = exact_sic_asymptotic_function(float(rng.uniform(0, 3)), float(rng.uniform(1, 4)), 1, 2, r_sigma=float(rng.uniform(0.1, 10)))
+        g = exact_sic_asymptotic_function(
+            float(rng.uniform(0, 3)), float(rng.uniform(1, 4)), 1, 2, r_sigma=float(rng.uniform(0.1, 10))
+        )
         g_c = float(rng.uniform(0.001, 0.2))
         lam = int(rng.integers(1, 8))
         ups, tau = float(rng.uniform(1, 50)), float(rng.uniform(1, 50))
@@ -138,7 +142,9 @@ def test_is_secure_consistent_with_theorem() -> None:
     assert not is_secure(d.lam_star - 1, **kw)
     assert is_secure(d.lam_star + 10, **kw)
     # float-valued gamma works too
-    assert is_secure(74, gamma=lambda N: sic_asymptotic_from_traces(N, 2, 8, 4, 4, 100), gamma_c=1e-6, tau_c=31536e4, upsilon=442e15)
+    assert is_secure(
+        74, gamma=lambda N: sic_asymptotic_from_traces(N, 2, 8, 4, 4, 100), gamma_c=1e-6, tau_c=31536e4, upsilon=442e15
+    )
     # a static key or a token leaked to the server: one break suffices, never secure at 74 bits
     assert not is_secure(74, scheme="static", **kw)
     assert not is_secure(74, scheme="token", adversary="server", **kw)
@@ -149,8 +155,14 @@ def test_is_secure_consistent_with_theorem() -> None:
 
 @settings(max_examples=40, deadline=None)
 @given(
-    st.floats(0, 10), st.floats(1, 20), st.integers(1, 5), st.integers(1, 5), st.floats(0.01, 100),
-    st.floats(1e-7, 1e-2), st.floats(1, 1e9), st.floats(1e3, 1e18),
+    st.floats(0, 10),
+    st.floats(1, 20),
+    st.integers(1, 5),
+    st.integers(1, 5),
+    st.floats(0.01, 100),
+    st.floats(1e-7, 1e-2),
+    st.floats(1, 1e9),
+    st.floats(1e3, 1e18),
 )
 def test_theorem_is_minimal(tr_u, tr_w, m, n, r, g_c, tau, ups) -> None:
     N = optimal_sample_size(tr_u, tr_w, m, n, r_sigma=r, gamma_c=g_c)
@@ -208,14 +220,15 @@ def test_tiny_defense_period_is_an_error_not_a_two_bit_key() -> None:
 def test_design_for_sample_size_is_the_last_step_of_every_design() -> None:
     d = paper_design_example()
     g = exact_sic_asymptotic_function(2, 8, 4, 4, r_sigma=100)
-    again = design_for_sample_size(
-        "asymptotic", d.N_star, g, m=4, n=4, sigma_u2=10, sigma_w2=0.1, sigma_x2=1, tr_psi_u=2, tr_psi_w=8,
-        gamma_c=1e-6, tau_c=31536e4, upsilon=442e15,
-    )
+    threat = ThreatModel(sigma_u2=10, sigma_w2=0.1, sigma_x2=1, gamma_c=1e-6, tau_c=31536e4, upsilon=442e15)
+    again = design_for_sample_size("asymptotic", d.N_star, g, threat, m=4, n=4, tr_psi_u=2, tr_psi_w=8)
     assert again == d
     with pytest.raises(ParameterError, match="'magic'"):
-        design_for_sample_size("magic", 10, g, m=4, n=4, sigma_u2=10, sigma_w2=0.1, sigma_x2=1, tr_psi_u=2,
-                               tr_psi_w=8, gamma_c=1e-6, tau_c=1, upsilon=1)
+        design_for_sample_size("magic", 10, g, threat, m=4, n=4, tr_psi_u=2, tr_psi_w=8)
+    with pytest.raises(ParameterError, match="needs gamma_c"):
+        design_for_sample_size(
+            "asymptotic", 10, g, ThreatModel(sigma_u2=10, sigma_w2=0.1, tau_c=1, upsilon=1), m=4, n=4, tr_psi_u=2, tr_psi_w=8
+        )
 
 
 def test_bad_inputs() -> None:
@@ -292,6 +305,15 @@ def test_huge_sample_sizes_in_messages_are_shown_by_size() -> None:
         minimum_sample_size(lambda N: 1.0, 0.5, n_max=10**5000)
     # gamma_c = 1e-300 gives N* of 299 digits and lam* = 1, below the GNFS range: one short line
     with pytest.raises(ModelRangeError, match=r"N\* = <integer of 991 bits, about 299 digits>") as info:
-        design_from_traces(EX["tr_psi_u"], EX["tr_psi_w"], EX["m"], EX["n"], sigma_u2=EX["sigma_u2"], sigma_w2=EX["sigma_w2"],
-                           gamma_c=1e-300, tau_c=EX["tau_c"], upsilon=EX["upsilon"])
+        design_from_traces(
+            EX["tr_psi_u"],
+            EX["tr_psi_w"],
+            EX["m"],
+            EX["n"],
+            sigma_u2=EX["sigma_u2"],
+            sigma_w2=EX["sigma_w2"],
+            gamma_c=1e-300,
+            tau_c=EX["tau_c"],
+            upsilon=EX["upsilon"],
+        )
     assert "\n" not in str(info.value) and len(str(info.value)) < 600

@@ -37,15 +37,17 @@ from encctl_gym.units import SECONDS_PER_UNIT, parse_duration
 
 # --------------------------------------------------------------------------- messages can always be built
 @settings(max_examples=60, deadline=None)
-@given(st.one_of(
-    st.integers(min_value=-(10**6000), max_value=10**6000),
-    st.text(max_size=5000),
-    st.lists(st.integers(min_value=-(10**5000), max_value=10**5000), max_size=50),
-    st.floats(allow_nan=True, allow_infinity=True),
-    st.fractions(),
-    st.complex_numbers(),
-    st.dictionaries(st.text(max_size=20), st.integers(), max_size=20),
-))
+@given(
+    st.one_of(
+        st.integers(min_value=-(10**6000), max_value=10**6000),
+        st.text(max_size=5000),
+        st.lists(st.integers(min_value=-(10**5000), max_value=10**5000), max_size=50),
+        st.floats(allow_nan=True, allow_infinity=True),
+        st.fractions(),
+        st.complex_numbers(),
+        st.dictionaries(st.text(max_size=20), st.integers(), max_size=20),
+    )
+)
 def test_format_value_never_fails_and_stays_short(value: object) -> None:
     text = format_value(value)
     assert isinstance(text, str) and len(text) <= 400
@@ -59,15 +61,18 @@ def test_format_value_of_huge_integers() -> None:
     assert format_value(np.zeros((1000, 1000))).startswith("<array of shape (1000, 1000), dtype float64")
 
 
-@pytest.mark.parametrize("call", [
-    lambda: check_int("N", -(10**5000), 0),
-    lambda: check_int("N", 10**5000, 0, 100),
-    lambda: check_positive("sigma_u2", 10**5000),
-    lambda: check_positive("sigma_u2", -(10**5000)),
-    lambda: check_nonnegative("sigma_x2", 10**400),
-    lambda: decimal_fraction("upsilon", 10**400),
-    lambda: parse_number("upsilon", "1" + "0" * 5000),
-])
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: check_int("N", -(10**5000), 0),
+        lambda: check_int("N", 10**5000, 0, 100),
+        lambda: check_positive("sigma_u2", 10**5000),
+        lambda: check_positive("sigma_u2", -(10**5000)),
+        lambda: check_nonnegative("sigma_x2", 10**400),
+        lambda: decimal_fraction("upsilon", 10**400),
+        lambda: parse_number("upsilon", "1" + "0" * 5000),
+    ],
+)
 def test_huge_integers_give_a_one_line_error(call) -> None:
     with pytest.raises(ParameterError) as info:
         call()
@@ -77,22 +82,30 @@ def test_huge_integers_give_a_one_line_error(call) -> None:
 
 # --------------------------------------------------------------------------- complex, boolean, string data
 @settings(max_examples=40, deadline=None)
-@given(hnp.arrays(np.complex128, hnp.array_shapes(min_dims=1, max_dims=2, max_side=4),
-                  elements=st.complex_numbers(max_magnitude=10, allow_nan=False)))
+@given(
+    hnp.arrays(
+        np.complex128,
+        hnp.array_shapes(min_dims=1, max_dims=2, max_side=4),
+        elements=st.complex_numbers(max_magnitude=10, allow_nan=False),
+    )
+)
 def test_complex_arrays_are_refused_not_truncated(arr: np.ndarray) -> None:
     with pytest.raises(ParameterError, match="A must be real, got a complex array"):
         as_finite_array("A", arr)
 
 
-@pytest.mark.parametrize("value,match", [
-    ([1 + 2j, 3.0], "complex"),
-    ([[0.5 + 0j]], "complex"),  # a zero imaginary part is still a complex input
-    (np.array([True, False]), "boolean"),
-    (["1.5", "2"], "numeric"),
-    ([[10**400]], "float64 range"),
-    ([1, None], "numeric"),
-    ([[1, 2], [3]], "numeric"),
-])
+@pytest.mark.parametrize(
+    "value,match",
+    [
+        ([1 + 2j, 3.0], "complex"),
+        ([[0.5 + 0j]], "complex"),  # a zero imaginary part is still a complex input
+        (np.array([True, False]), "boolean"),
+        (["1.5", "2"], "numeric"),
+        ([[10**400]], "float64 range"),
+        ([1, None], "numeric"),
+        ([[1, 2], [3]], "numeric"),
+    ],
+)
 def test_bad_arrays(value: object, match: str) -> None:
     with pytest.raises(ParameterError, match=match):
         as_finite_array("x", value)
@@ -110,10 +123,25 @@ def test_booleans_must_be_booleans(bad: object) -> None:
 
 # --------------------------------------------------------------------------- durations: one parser
 @settings(max_examples=60, deadline=None)
-@given(st.floats(1e-3, 1e6), st.sampled_from([("s", "s"), ("sec", "s"), ("min", "min"), ("minutes", "min"),
-                                               ("h", "h"), ("hours", "h"), ("d", "d"), ("days", "d"),
-                                               ("y", "y"), ("yr", "y"), ("years", "y")]),
-       st.sampled_from(["", " "]))
+@given(
+    st.floats(1e-3, 1e6),
+    st.sampled_from(
+        [
+            ("s", "s"),
+            ("sec", "s"),
+            ("min", "min"),
+            ("minutes", "min"),
+            ("h", "h"),
+            ("hours", "h"),
+            ("d", "d"),
+            ("days", "d"),
+            ("y", "y"),
+            ("yr", "y"),
+            ("years", "y"),
+        ]
+    ),
+    st.sampled_from(["", " "]),
+)
 def test_parse_duration_units(value: float, unit: tuple, space: str) -> None:
     text = f"{value!r}{space}{unit[0]}"
     assert parse_duration(text) == pytest.approx(value * SECONDS_PER_UNIT[unit[1]], rel=1e-15)
@@ -124,8 +152,9 @@ def test_parse_duration_values() -> None:
     assert parse_duration("5y", "tau_c") == 5 * 365 * 86400
 
 
-@pytest.mark.parametrize("bad", ["10m", "abc", "-5s", "0y", "1e400", "1e308y", "5 fortnights", "", True, None, [5],
-                                 10**400, math.inf, "9" * 10000])
+@pytest.mark.parametrize(
+    "bad", ["10m", "abc", "-5s", "0y", "1e400", "1e308y", "5 fortnights", "", True, None, [5], 10**400, math.inf, "9" * 10000]
+)
 def test_parse_duration_rejects(bad: object) -> None:
     with pytest.raises(ParameterError, match="tau_c") as info:
         parse_duration(bad)
@@ -166,8 +195,17 @@ def test_decimal_and_binary_rules() -> None:
     assert pow2(5000.25) == Fraction(2.0**0.25) * 2**5000  # beyond the float range, still exact
 
 
-@pytest.mark.parametrize("bad,match", [(1.5, "exact number.*1.5"), ("a", "exact number.*'a'"), (None, "exact number.*None"),
-                                       (True, "exact number.*True"), (0, "positive.*0"), (Fraction(-1, 2), r"positive.*Fraction\(-1, 2\)")])
+@pytest.mark.parametrize(
+    "bad,match",
+    [
+        (1.5, "exact number.*1.5"),
+        ("a", "exact number.*'a'"),
+        (None, "exact number.*None"),
+        (True, "exact number.*True"),
+        (0, "positive.*0"),
+        (Fraction(-1, 2), r"positive.*Fraction\(-1, 2\)"),
+    ],
+)
 def test_exact_logarithms_take_exact_positive_numbers(bad: object, match: str) -> None:
     # a float is refused: whether 1.5 stands for its decimal or its binary value is the caller's rule
     for fn in (floor_log2, log2_fraction):
@@ -234,9 +272,16 @@ def test_plant_file_bounds(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> N
 
 
 def test_every_plant_file_error_is_a_package_error(tmp_path: Path) -> None:
-    cases = ['{"A": [[0.5]], "B": [[1]], "gamma_c": [1]}', '{"A": 5, "B": [[1]]}', '{"A": [[0.5]]}',
-             '{"A": [[0.5]], "B": [[1]], "upsilon": 1e999}', '{"A": [[1e999]], "B": [[1]]}', "not json",
-             '{"A": [[0.5, 1]], "B": [[1]]}', '{"A": [[0.5]], "B": [[1]], "sigma_x2": -0.1}']
+    cases = [
+        '{"A": [[0.5]], "B": [[1]], "gamma_c": [1]}',
+        '{"A": 5, "B": [[1]]}',
+        '{"A": [[0.5]]}',
+        '{"A": [[0.5]], "B": [[1]], "upsilon": 1e999}',
+        '{"A": [[1e999]], "B": [[1]]}',
+        "not json",
+        '{"A": [[0.5, 1]], "B": [[1]]}',
+        '{"A": [[0.5]], "B": [[1]], "sigma_x2": -0.1}',
+    ]
     for i, text in enumerate(cases):
         path = tmp_path / f"c{i}.json"
         path.write_text(text)
@@ -246,11 +291,14 @@ def test_every_plant_file_error_is_a_package_error(tmp_path: Path) -> None:
 
 
 # --------------------------------------------------------------------------- plant files: entries, YAML floats, duplicates
-@pytest.mark.parametrize("text,match", [
-    ('{"A": [[0.5, 0], [0, NaN]], "B": [[1], [0]]}', r"A must hold finite numbers, got nan at A\[1\]\[1\]"),
-    ('{"A": [[0.5, Infinity], [0, 0.3]], "B": [[1], [0]]}', r"A must hold finite numbers, got inf at A\[0\]\[1\]"),
-    ('{"A": [[0.5, 0], [0, 0.3]], "B": [[1], ["x"]]}', r"B must hold real numbers, got 'x' at B\[1\]\[0\]"),
-])
+@pytest.mark.parametrize(
+    "text,match",
+    [
+        ('{"A": [[0.5, 0], [0, NaN]], "B": [[1], [0]]}', r"A must hold finite numbers, got nan at A\[1\]\[1\]"),
+        ('{"A": [[0.5, Infinity], [0, 0.3]], "B": [[1], [0]]}', r"A must hold finite numbers, got inf at A\[0\]\[1\]"),
+        ('{"A": [[0.5, 0], [0, 0.3]], "B": [[1], ["x"]]}', r"B must hold real numbers, got 'x' at B\[1\]\[0\]"),
+    ],
+)
 def test_plant_file_names_the_bad_entry(tmp_path: Path, text: str, match: str) -> None:
     path = tmp_path / "p.json"
     path.write_text(text)
@@ -285,8 +333,9 @@ def test_plant_file_yaml_reads_exponents_as_numbers(tmp_path: Path) -> None:
     assert (spec.preset.sigma_w2, spec.preset.upsilon, spec.preset.gamma_c) == (1e-6, 442e15, 1.5e-3)
 
 
-@pytest.mark.parametrize("name,text", [("p.json", '{"A": [[0.5]], "B": [[1]], "A": [[0.9]]}'),
-                                       ("p.yaml", "A: [[0.5]]\nB: [[1]]\nA: [[0.9]]\n")])
+@pytest.mark.parametrize(
+    "name,text", [("p.json", '{"A": [[0.5]], "B": [[1]], "A": [[0.9]]}'), ("p.yaml", "A: [[0.5]]\nB: [[1]]\nA: [[0.9]]\n")]
+)
 def test_plant_file_refuses_a_field_given_twice(tmp_path: Path, name: str, text: str) -> None:
     # the readers would keep the last A silently
     path = tmp_path / name
@@ -295,8 +344,14 @@ def test_plant_file_refuses_a_field_given_twice(tmp_path: Path, name: str, text:
         load_plant_file(path)
 
 
-@pytest.mark.parametrize("bad,match", [(42, "defaults must be a mapping.*got 42"), ("abc", "defaults must be a mapping.*got 'abc'"),
-                                       ({"bogus": 1}, r"defaults has unknown field\(s\) \['bogus'\]")])
+@pytest.mark.parametrize(
+    "bad,match",
+    [
+        (42, "defaults must be a mapping.*got 42"),
+        ("abc", "defaults must be a mapping.*got 'abc'"),
+        ({"bogus": 1}, r"defaults has unknown field\(s\) \['bogus'\]"),
+    ],
+)
 def test_plant_file_defaults_are_checked(tmp_path: Path, bad: object, match: str) -> None:
     path = _write(tmp_path, "p.json", {"A": [[0.5]], "B": [[1.0]]})
     with pytest.raises(ParameterError, match=match):
@@ -305,8 +360,16 @@ def test_plant_file_defaults_are_checked(tmp_path: Path, bad: object, match: str
 
 def test_plant_file_reports_every_missing_field_at_once(tmp_path: Path) -> None:
     path = _write(tmp_path, "p.json", {"A": [[0.5]], "B": [[1.0]], "sigma_u2": 2.0})
-    with pytest.raises(ConfigError, match="sigma_w2, sigma_x2, gamma_c, tau_c, upsilon are neither in the file nor in the defaults"):
+    with pytest.raises(
+        ConfigError, match="sigma_w2, sigma_x2, gamma_c, tau_c, upsilon are neither in the file nor in the defaults"
+    ):
         load_plant_file(path, defaults={})
     spec = load_plant_file(path, defaults={"sigma_w2": 0.5, "sigma_x2": 0, "gamma_c": 0.1, "tau_c": "2h", "upsilon": 1e9})
     assert spec.values() == {"sigma_u2": 2.0, "sigma_w2": 0.5, "sigma_x2": 0.0, "gamma_c": 0.1, "tau_c": 7200.0, "upsilon": 1e9}
-    assert spec.from_file == ("A", "B", "sigma_u2") and spec.from_defaults == ("sigma_w2", "sigma_x2", "gamma_c", "tau_c", "upsilon")
+    assert spec.from_file == ("A", "B", "sigma_u2") and spec.from_defaults == (
+        "sigma_w2",
+        "sigma_x2",
+        "gamma_c",
+        "tau_c",
+        "upsilon",
+    )

@@ -1,4 +1,4 @@
-"""Tests of encctl_gym.sim.parallel and sim.montecarlo: seeded tasks on joblib and Dask."""
+"""Tests of encctl_gym.parallel and sim.montecarlo: seeded tasks on joblib and Dask."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from encctl_gym.errors import ConfigError, EncctlError, ParameterError, ShapeError
-from encctl_gym.sim.montecarlo import AttackSpec, gaussian_attack_errors, log_grid, sweep_gaussian_attack
 from encctl_gym.parallel import child_seeds, run_tasks
+from encctl_gym.sim.montecarlo import AttackSpec, gaussian_attack_errors, log_grid, sweep_gaussian_attack
 from encctl_gym.sim.plant import LinearPlant
 
 
@@ -61,8 +61,7 @@ def test_task_result_does_not_depend_on_the_other_tasks() -> None:
 
 
 @pytest.mark.parametrize(
-    "kwargs",
-    [{"n_jobs": 0}, {"n_jobs": -2}, {"backend": "ray"}, {"scheduler": "nonsense"}, {"scheduler": 5}],
+    "kwargs", [{"n_jobs": 0}, {"n_jobs": -2}, {"backend": "ray"}, {"scheduler": "nonsense"}, {"scheduler": 5}]
 )
 def test_run_tasks_rejects_bad_options(kwargs) -> None:  # type: ignore[no-untyped-def]
     with pytest.raises(ParameterError):
@@ -89,7 +88,7 @@ def test_missing_dask_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
 
 def test_unreachable_scheduler_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
     pytest.importorskip("distributed")
-    import encctl_gym.sim.parallel as parallel
+    import encctl_gym.parallel as parallel
 
     monkeypatch.setattr(parallel, "CONNECT_TIMEOUT", "1s")
     with pytest.raises(ConfigError, match="cannot connect"):
@@ -116,7 +115,10 @@ def test_sweep_local_equals_serial_bit_for_bit() -> None:
     s = SYSTEMS[2]
     direct = gaussian_attack_errors(
         LinearPlant(s.A, s.B, sigma_w2=s.sigma_w2, sigma_x2=s.sigma_x2),
-        sample_sizes=GRID, runs=5, sigma_u2=s.sigma_u2, seed=seeds[2],
+        sample_sizes=GRID,
+        runs=5,
+        sigma_u2=s.sigma_u2,
+        seed=seeds[2],
     )
     np.testing.assert_array_equal(serial[2], direct)
 
@@ -125,7 +127,11 @@ def test_sweep_on_local_dask_cluster_equals_local_bit_for_bit() -> None:
     pytest.importorskip("distributed")
     local = sweep_gaussian_attack(SYSTEMS, sample_sizes=GRID, runs=5, seed=17, n_jobs=1)
     dask = sweep_gaussian_attack(
-        SYSTEMS, sample_sizes=GRID, runs=5, seed=17, scheduler="local",
+        SYSTEMS,
+        sample_sizes=GRID,
+        runs=5,
+        seed=17,
+        scheduler="local",
         cluster_kwargs={"processes": False, "n_workers": 1, "threads_per_worker": 2},
     )
     np.testing.assert_array_equal(local, dask)
@@ -134,8 +140,10 @@ def test_sweep_on_local_dask_cluster_equals_local_bit_for_bit() -> None:
 def test_sweep_on_existing_dask_client() -> None:
     distributed = pytest.importorskip("distributed")
     local = run_tasks(draw, range(4), seed=2, n_jobs=1)
-    with distributed.LocalCluster(processes=False, n_workers=1, threads_per_worker=2,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+    with (
+        distributed.LocalCluster(processes=False, n_workers=1, threads_per_worker=2, dashboard_address=None) as cluster,
+        distributed.Client(cluster) as client,
+    ):
         remote = run_tasks(draw, range(4), seed=2, scheduler=client)
         with pytest.raises(ParameterError):
             run_tasks(draw, range(2), seed=0, scheduler=client.scheduler.address, cluster_kwargs={"x": 1})
@@ -184,9 +192,15 @@ def test_child_seeds_refuses_a_count_beyond_memory() -> None:
         child_seeds(0, 10**12)
 
 
-@pytest.mark.parametrize(("kwargs", "text"), [({"func": "abc"}, "func must be a function"), ({"tasks": None}, "tasks must be a sequence"),
-                                              ({"tasks": 3}, "tasks must be a sequence of task descriptions, got 3"),
-                                              ({"scheduler": "bogus"}, "got 'bogus'")])
+@pytest.mark.parametrize(
+    ("kwargs", "text"),
+    [
+        ({"func": "abc"}, "func must be a function"),
+        ({"tasks": None}, "tasks must be a sequence"),
+        ({"tasks": 3}, "tasks must be a sequence of task descriptions, got 3"),
+        ({"scheduler": "bogus"}, "got 'bogus'"),
+    ],
+)
 def test_run_tasks_refuses_what_it_cannot_run(kwargs, text) -> None:  # type: ignore[no-untyped-def]
     args = {"func": lambda t, s: t, "tasks": [1, 2], "seed": 0, "n_jobs": 1, **kwargs}
     with pytest.raises(ParameterError, match=text):

@@ -10,7 +10,7 @@ from encctl_gym.security.gramians import controllability_gramian, noise_gramian
 from encctl_gym.sim.plant import LinearPlant, simulate, simulate_gaussian_attack
 
 A2 = np.array([[0.6, 0.2], [-0.1, 0.5]])
-B2 = np.array([[1.0, 0.0], [0.3, 0.8], ])
+B2 = np.array([[1.0, 0.0], [0.3, 0.8]])
 
 
 def test_plant_attributes_and_repr() -> None:

@@ -311,6 +311,9 @@ class Breaker(abc.ABC):
     DEFAULT_MAX_BITS: ClassVar[int] = 0
     #: Set by breakers that need a process's main thread (PARI).
     MAIN_THREAD_ONLY: ClassVar[bool] = False
+    #: The constructor option that takes another breaker (the token chain's ``inner``): the
+    #: registry builds a breaker given there by name before it builds this one.
+    WRAPS_OPTION: ClassVar[str | None] = None
 
     def __init__(self, *, max_bits: int | None = None, rng: RngLike = None) -> None:
         self.max_bits = check_int("max_bits", self.DEFAULT_MAX_BITS if max_bits is None else max_bits, minimum=2)

@@ -15,7 +15,7 @@ runs once; the table lists each key's wall time, CPU time and operation counts, 
 ``T_first`` (precomputation + first key), the mean wall time of a later key and their ratio. Every recovered key
 is checked (g^s = h) and compared with the sequence's secret key.
 
-Work that cannot finish is refused in one line before it starts: more than :data:`MAX_KEYS`
+Work that cannot finish is refused in one line before it starts: more than :data:`~.keys.MAX_KEYS`
 keys, a group beyond the breaker's ``--max-bits``, and a first key that the breaker's cost
 model expects to take more than a year whatever ``--max-bits`` says
 (:data:`~encctl_gym.cryptanalysis.base.MAX_EXPECTED_SECONDS`).
@@ -33,72 +33,16 @@ import math
 import sys
 from typing import Any
 
-from .._validation import check_int, check_positive, format_value
+from .._validation import check_int, check_positive
 from ..crypto import arith
 from ..crypto.group import SHIPPED_BITS, GroupParams, generate_safe_prime_group, shipped_group
-from ..errors import BreakerError, ParameterError, ResourceLimitError
-from .base import format_bytes, format_seconds
+from ..errors import BreakerError, ParameterError
+from .base import format_seconds
+from .keys import MAX_KEYS, check_keys, key_sequence
 from .registry import BREAKERS, get_breaker
 from .sequence import BreakReport, break_sequence
 
-__all__ = ["add_arguments", "run", "key_sequence", "crack_group", "check_keys", "MAX_KEYS"]
-
-#: Largest number of keys of ``encctl-gym crack``: the sequence, its tokens, the report and its
-#: JSON are held in memory, about 3 KB per key (measured: 55 MB more for 20000 keys than for 1000,
-#: 64-bit group, ``--json``), so 10^5 keys take about 0.3 GB (the paper's N* = 13159 fits).
-MAX_KEYS = 100_000
-_BYTES_PER_KEY = 3000
-
-
-def check_keys(n: object, name: str = "keys") -> int:
-    """Return the number of keys ``n`` after checking ``1 <= n <=`` :data:`MAX_KEYS`; ``name``
-    is the name of the value in the error message.
-
-    Raises
-    ------
-    ParameterError
-        If ``n`` is not an integer >= 1.
-    ResourceLimitError
-        If ``n`` exceeds :data:`MAX_KEYS` (the message names the memory it would take).
-    """
-    n = check_int(name, n, minimum=1)
-    if n > MAX_KEYS:
-        raise ResourceLimitError(
-            f"{name} = {format_value(n)} would hold about {format_bytes(n * _BYTES_PER_KEY)} of keys, tokens and "
-            f"report in memory; the limit is {MAX_KEYS} keys (MAX_KEYS)"
-        )
-    return n
-
-
-def key_sequence(group: GroupParams, n: int, rng: arith.RngLike) -> tuple[list[int], list[int], list[Any]]:
-    """One dynamic-key sequence (Example ex:dyn_elgamal): KeyGen, then KeyUpd ``n - 1`` times.
-
-    Parameters
-    ----------
-    group : GroupParams
-    n : int
-        Number of keys, ``1 <= n <=`` :data:`MAX_KEYS`.
-    rng : None, int, RandomSource or numpy.random.Generator
-        Randomness of KeyGen and KeyUpd (a seed is reproducible and unsafe for deployment).
-
-    Returns
-    -------
-    (list of int, list of int, list of UpdateToken)
-        The public-key elements h_0..h_{n-1}, the secret exponents, and the n - 1 tokens.
-    """
-    from ..crypto.dyn_elgamal import key_update
-    from ..crypto.elgamal import keygen
-
-    n = check_keys(n)
-    src = arith.as_random_source(rng)
-    pk, sk = keygen(group, rng=src)
-    hs, secrets, tokens = [pk.h], [sk.s], []
-    for _ in range(n - 1):
-        pk, sk, token = key_update(pk, sk, rng=src)
-        hs.append(pk.h)
-        secrets.append(sk.s)
-        tokens.append(token)
-    return hs, secrets, tokens
+__all__ = ["add_arguments", "run", "crack_group"]
 
 
 def crack_group(bits: int, source: str, seed: int) -> tuple[GroupParams, str]:

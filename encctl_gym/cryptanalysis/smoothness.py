@@ -18,19 +18,11 @@ from functools import lru_cache
 import gmpy2
 import numpy as np
 
-from .._validation import check_int, check_nonnegative, check_positive, format_value
-from ..crypto.group import _small_primes
+from .._validation import check_int, check_nonnegative, format_value
+from ..crypto.group.sieve import _small_primes
 from ..errors import ParameterError, ResourceLimitError
 
-__all__ = [
-    "primes_up_to",
-    "check_bound",
-    "FactorBase",
-    "rational_reconstruction",
-    "dickman_rho",
-    "smooth_probability",
-    "MAX_BOUND",
-]
+__all__ = ["primes_up_to", "check_bound", "FactorBase", "rational_reconstruction", "dickman_rho", "MAX_BOUND"]
 
 #: Largest smoothness bound B of a factor base: 2^24, 1077871 primes, built in about 4 s with a
 #: peak of about 260 MB (sieve, Python integers, tuple and index). The index calculus's own choice
@@ -267,13 +259,3 @@ def dickman_rho(u: float) -> float:
     for coef in reversed(c):  # Horner
         value = value * xi + coef
     return value
-
-
-def smooth_probability(bits: float, bound: float) -> float:
-    """Probability that a random integer of ``bits`` bits is ``bound``-smooth: ``rho(u)`` with
-    ``u = bits ln 2 / ln bound``."""
-    bits = check_positive("bits", bits)
-    bound = check_positive("bound", bound)
-    if bound < 2:
-        raise ParameterError(f"bound must be >= 2, got {bound}")
-    return dickman_rho(bits * math.log(2) / math.log(bound))

@@ -25,6 +25,7 @@ from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import KeyMismatchError, ParameterError
 from .base import Breaker, Deadline, Precomputation, RecoveredKey, as_list, check_element
+from .index_calculus import IndexCalculus
 
 __all__ = ["TokenChain", "TokenChainState", "as_token"]
 
@@ -118,32 +119,37 @@ class TokenChain(Breaker):
 
     Parameters
     ----------
-    inner : str or Breaker, default "index-calculus"
-        The breaker of the first key (a registry name, built with ``rng`` and ``max_bits``, or
-        an instance).
+    inner : Breaker, optional
+        The breaker of the first key (default: :class:`~.index_calculus.IndexCalculus` built
+        with ``max_bits`` and ``rng``). By name through the registry:
+        ``get_breaker("token-chain", inner="rho")``.
     max_bits : int, optional
-        Passed to the inner breaker when it is built here (its limit is the limit); refused with
-        an instance, whose own ``max_bits`` holds.
+        Passed to the default inner breaker (its limit is the limit); refused with an
+        instance, whose own ``max_bits`` holds.
     rng
         See :class:`~encctl_gym.cryptanalysis.base.Breaker`.
     """
 
     name: ClassVar[str] = "token-chain"
     DEFAULT_MAX_BITS: ClassVar[int] = 2048
+    WRAPS_OPTION: ClassVar[str | None] = "inner"
 
-    def __init__(self, inner: str | Breaker = "index-calculus", *, max_bits: int | None = None, rng: RngLike = None) -> None:
-        from .registry import get_breaker
-
+    def __init__(self, inner: Breaker | None = None, *, max_bits: int | None = None, rng: RngLike = None) -> None:
         if isinstance(inner, Breaker):
             if max_bits is not None:
                 raise ParameterError(
                     f"max_bits applies to an inner breaker built by name; set it on the instance {format_value(inner)} instead"
                 )
-            self.inner = inner
-        else:
-            if inner == self.name:
+            if isinstance(inner, TokenChain):
                 raise ParameterError("the token chain cannot wrap itself")
-            self.inner = get_breaker(inner, max_bits=max_bits, rng=rng)
+            self.inner = inner
+        elif inner is None:
+            self.inner = IndexCalculus(max_bits=max_bits, rng=rng)
+        else:
+            raise ParameterError(
+                f"inner must be a Breaker instance, got {format_value(inner)}; "
+                "to name it, build the chain with get_breaker('token-chain', inner=NAME)"
+            )
         super().__init__(max_bits=self.inner.max_bits, rng=rng)
 
     def __repr__(self) -> str:

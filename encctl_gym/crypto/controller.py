@@ -6,16 +6,12 @@
 ciphertexts only). :class:`~.quantized.QuantizedLinearController` computes the *same* numbers
 without ciphertexts, bit for bit.
 
-The parts that lived here before they had homes of their own keep their import path for one
-version: the parties and the quantised twin are re-exported; ``PlantCryptoSide(quantization,
-scheme, rng)`` builds the plant party of a scheme; the forging of injected inputs moved to
-:mod:`encctl_gym.attacks.forgery` (``forge_injection``, ``forge_injection_token`` and
-``injection_value`` are found there from here too, with a DeprecationWarning).
+The plant party of a scheme by name is ``get_scheme(name).plant(quantization, rng)``
+(:mod:`.schemes`); forging injected inputs is the adversary's (:mod:`encctl_gym.attacks.forgery`).
 """
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -27,42 +23,10 @@ from .checks import check_ciphertext_matrix
 from .elgamal import Ciphertext, PublicKey
 from .encoding import Encoder
 from .group import GroupParams, as_group
-from .plant_side import ModifiedPlant, PlantParty, StaticPlant, TokenPlant
 from .quantized import QuantizedLinearController
-from .schemes import SCHEMES, get_scheme
-from .servers import ControllerServer, StaticControllerServer, TokenControllerServer
+from .schemes import get_scheme
 
-__all__ = [
-    "EncryptedLinearController",
-    "QuantizedLinearController",
-    "ControllerServer",
-    "StaticControllerServer",
-    "TokenControllerServer",
-    "PlantParty",
-    "ModifiedPlant",
-    "TokenPlant",
-    "StaticPlant",
-    "PlantCryptoSide",
-    "SCHEMES",
-]
-
-_MOVED_TO_ATTACKS = ("forge_injection", "forge_injection_token", "injection_value")
-
-
-def PlantCryptoSide(quantization: QuantizedLinearController, scheme: str = "modified", rng: RngLike = None) -> PlantParty:  # noqa: N802 - the former class name
-    """The plant party of ``scheme`` (:data:`~.schemes.SCHEMES`), under its former name."""
-    return get_scheme(scheme).plant(quantization, rng)
-
-
-def __getattr__(name: str) -> Any:
-    if name in _MOVED_TO_ATTACKS:
-        warnings.warn(
-            f"encctl_gym.crypto.controller.{name} moved to encctl_gym.attacks.forgery", DeprecationWarning, stacklevel=2
-        )
-        from ..attacks import forgery
-
-        return getattr(forgery, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__all__ = ["EncryptedLinearController"]
 
 
 class EncryptedLinearController:

@@ -19,6 +19,7 @@ from .._validation import check_bool, check_int, check_nonnegative, check_positi
 from ..errors import BudgetError, ConfigError, ParameterError
 from ..ident.registry import make_estimator
 from ..loop import BACKENDS as _LOOP_BACKENDS
+from ..loop.defender import make_defender
 from ..presets import get_preset
 from ..security.complexity import sic_from_traces
 from ..security.cost_models import (
@@ -121,6 +122,9 @@ def default_config() -> dict[str, Any]:
     ``input_history``             number of own past inputs in the observation (at most 64)
     ``gamma_opt``                 compute gamma_opt(N) of the optimal attack design for info
     ``crypto_seed``               seed of the crypto randomness (``None``: secure source)
+    ``defender``                  the plant side's policy (:mod:`encctl_gym.loop.defender`): a
+                                  name of ``DEFENDERS`` (``"fixed"``: the paper's fixed defender)
+                                  or an object implementing ``DefenderPolicy``
     ============================  ==============================================================
     """
     return {
@@ -155,6 +159,7 @@ def default_config() -> dict[str, Any]:
         "input_history": 2,
         "gamma_opt": True,
         "crypto_seed": None,
+        "defender": "fixed",
     }
 
 
@@ -201,6 +206,7 @@ class AttackParams:
     tr_psi_u: float
     tr_psi_w: float
     sources: dict[str, str] = field(default_factory=dict)  # where A, B, the variances and design values came from
+    defender: Any = "fixed"  # the defender policy specification (a name or a policy object), checked
 
     @property
     def n(self) -> int:
@@ -454,6 +460,8 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     crypto_seed = cfg["crypto_seed"]
     if crypto_seed is not None:
         crypto_seed = check_int("crypto_seed", crypto_seed, minimum=0)
+    defender = cfg["defender"]
+    make_defender(defender)  # an unknown name or an object that is no policy fails here
     return AttackParams(
         A=A,
         B=B,
@@ -493,4 +501,5 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         tr_psi_u=tr_psi_u,
         tr_psi_w=tr_psi_w,
         sources=sources,
+        defender=defender,
     )

@@ -14,14 +14,20 @@ Per sampling period ``k`` of the attack (Definition def:adversary):
    seconds, Definition def:sdt, when the scheme gives every sample its own key);
 2. samples whose delay has passed are delivered: state ``x_j`` with the input ``u_{j-1}``;
    each delivered state adds the regression column ``([x_{j-1}; u_{j-1}], x_j)`` of eq:data
-   to recursive least squares (Sherman-Morrison), which is re-anchored to the exact solve of
-   eq:estimate from the running Gram matrices every ``schedule.refresh`` columns and at the end;
-3. the agent acts; its input is held to the energy budget, forged into the input ciphertext,
-   decrypted by the plant (``u_k``) and applied: ``x_{k+1} = A x_k + B u_k + w_k``.
+   to the attacker's estimator (least squares: recursive, by Sherman-Morrison, re-anchored to
+   the exact solve of eq:estimate from the running Gram matrices every ``schedule.refresh``
+   columns and at the end);
+3. the defender (:mod:`encctl_gym.loop.defender`) decides on what the plant side knows: noise
+   ``v_k`` on the input it applies, or the end of the attack (the default does neither);
+4. the agent acts; its input is held to the energy budget, forged into the input ciphertext,
+   decrypted by the plant (``u_k``) and applied: ``x_{k+1} = A x_k + B (u_k + v_k) + w_k``.
 
-When the loop backend exposes its arithmetic (:attr:`~encctl_gym.loop.backend.LoopBackend.quantization`,
-the ideal backend), the steady state of a ``fused`` reward runs as one compiled call per step;
-otherwise the backend is called period by period.
+How a step runs is chosen once, when the episode is built (:mod:`encctl_gym.envs.steps`): the
+backend called period by period; the period in one compiled call when the backend exposes its
+arithmetic (:attr:`~encctl_gym.loop.backend.LoopBackend.quantization`, the ideal backend); and,
+when the reward and the estimator have compiled forms too (a ``fused`` reward; an estimator
+whose :meth:`online_kernels` are fused, :mod:`encctl_gym.ident.compiled`), the steady state in
+one compiled call per step. An estimator without kernels is updated column by column.
 
 Work that no step waits for can run on a :class:`~encctl_gym.envs.helper.HelperThread` (the
 compiled kernels release the GIL): drawing the next ``schedule.chunk`` periods of noise, and
@@ -42,15 +48,17 @@ import numpy as np
 
 from .._validation import as_finite_array, check_int, check_positive, format_value
 from ..errors import EncodingOverflowError, ParameterError, ShapeError
-from ..ident.ordinary import OrdinaryLeastSquares
+from ..ident.compiled import OnlineKernels, ProvidesKernels
 from ..ident.registry import make_estimator
 from ..loop import LoopBackend
+from ..loop.defender import DefenderPolicy, DefenderStreams, PlantView, check_defender_action, make_defender
 from ..resources import check_memory
 from . import _kernels as kern
 from .config import AttackParams
 from .helper import HelperThread
 from .layout import ObservationLayout, info_dict
 from .rewards import REWARDS
+from .steps import EpisodeArrays, KernelConstants, StepStrategy, choose_step
 
 __all__ = ["EpisodeCore", "EpisodeSchedule", "attack_design_for", "episode_bytes", "check_episode_memory"]
 
@@ -132,25 +140,6 @@ def check_episode_memory(
     )
 
 
-def _condition(Gs: np.ndarray) -> np.ndarray:
-    """2-norm condition numbers of symmetric positive semidefinite matrices (..., d, d), from
-    their eigenvalues (``inf`` where singular)."""
-    lam = np.linalg.eigvalsh(Gs)
-    lo, hi = lam[..., 0], lam[..., -1]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(lo > 0.0, hi / np.where(lo > 0.0, lo, 1.0), np.inf)
-
-
-def _pinv_psd(G: np.ndarray) -> np.ndarray:
-    """Moore-Penrose pseudo-inverses of symmetric positive semidefinite matrices (..., d, d),
-    from their eigendecompositions; eigenvalues below ``d * eps * max`` count as zero (NumPy's
-    default cut-off for ``pinv``)."""
-    lam, V = np.linalg.eigh(G)
-    keep = lam > G.shape[-1] * np.finfo(float).eps * lam[..., -1:]
-    inv = np.where(keep, 1.0 / np.where(keep, lam, 1.0), 0.0)
-    return (V * inv[..., None, :]) @ np.swapaxes(V, -1, -2)
-
-
 def attack_design_for(p: AttackParams) -> Any:
     """The optimal attack design behind ``info["gamma_opt"]`` (security.attack_design): closed
     loop when states are delivered in time (``decipher_delay = 0``), open loop otherwise."""
@@ -182,6 +171,9 @@ class EpisodeCore:
     memory_limit : int, optional
         Refuse, before allocating anything, an episode whose :func:`episode_bytes` exceed this
         many bytes (default :data:`encctl_gym.resources.MEMORY_LIMIT`).
+    defender : DefenderPolicy, optional
+        The plant side's policy (:mod:`encctl_gym.loop.defender`), called before every attack
+        step; default: the one ``params.defender`` names (the fixed defender unless configured).
 
     Public state (for training, evaluation and tests; privileged where it involves the true
     plant or undelivered data): :attr:`done`, :attr:`collected`, :attr:`delivered`,
@@ -204,6 +196,7 @@ class EpisodeCore:
         helper: HelperThread | None = None,
         schedule: EpisodeSchedule | None = None,
         memory_limit: int | None = None,
+        defender: DefenderPolicy | None = None,
     ) -> None:
         p = self.p = params
         self.loop = loop
@@ -237,32 +230,31 @@ class EpisodeCore:
         # the same tables as Python floats, for the per-step info scalars
         self._gamma_list, self._time_list = self.gamma_table.tolist(), self.time_table.tolist()
         self._gamma_opt_list = self.gamma_opt_table.tolist()
-        # per-copy data: collected (deciphered) states and applied inputs
-        # time-major: the data of all copies for one period are contiguous
-        self.X = np.zeros((N, K, n))  # collected (deciphered) states x_0 .. x_{N-1}
-        self.U = np.zeros((N, K, m))  # applied inputs u_0 .. u_{N-1}
+        # the per-copy arrays the kernels write, by name (steps.EpisodeArrays): collected
+        # (deciphered) states X and applied inputs U, time-major (the data of all copies for one
+        # period are contiguous); the recursive least squares [P | Theta_hat^T] in Q, P by its
+        # upper triangle, copies innermost: entry (a, b) of every copy is row a (d + n) + b
+        s = self.state = EpisodeArrays.allocate(K, n, m, N, p.input_history)
+        self.X, self.U, self.Q, self.eps = s.X, s.U, s.Q, s.eps
+        s.eps[:] = self._eps0
         # regressor Gram matrix G of the delivered data and cross term C = sum z x_next^T, kept
         # as [G | C] with the copies innermost (see _kernels); G and C are views of it, (K, d, .)
         self._GC = np.zeros((self.d * (self.d + n), K))
         gc = self._GC.reshape(self.d, self.d + n, K).transpose(2, 0, 1)
         self.G, self.C = gc[:, :, : self.d], gc[:, :, self.d :]
         self._gram_scratch = np.zeros((self.d + n, K))  # add_gram's, apart from the step's (the helper runs it)
-        # recursive least squares [P | Theta_hat^T], P by its upper triangle; copies innermost:
-        # entry (a, b) of every copy is row a (d + n) + b (see _kernels)
-        self.Q = np.zeros((self.d * (self.d + n), K))
-        self.ready = np.zeros(K, dtype=bool)  # recursion started (well-conditioned Gram matrix)
         self._gram_upto = 1  # G and C hold the columns j < _gram_upto (the fused step lets them lag)
-        self._since_refresh = 0
-        self.x = np.zeros((K, n))
-        self.hist = np.zeros((K, p.input_history * m))
         self._dims = kern.dims(n, m, p.input_history * m)  # the sizes, as the kernels take them
-        self.energy = np.zeros(K)
-        self.eps = np.full(K, self._eps0)
         self.reward = REWARDS[p.reward](p, K)
-        # the attacker's estimator: least squares runs in the compiled kernels; any other is
-        # updated column by column (encctl_gym.ident)
+        # the attacker's estimator: one that provides kernels (least squares) runs compiled on the
+        # episode's arrays; any other is updated column by column (encctl_gym.ident)
         est = make_estimator(p.estimator)
-        self.estimator = None if isinstance(est, OrdinaryLeastSquares) else est
+        self.kernels: OnlineKernels | None = (
+            est.online_kernels(K, self._A, self._B, s.Q, sch.refresh, sch.cond_limit)
+            if isinstance(est, ProvidesKernels)
+            else None
+        )
+        self.estimator = est if self.kernels is None else None
         self.collected = 0  # samples collected and paid for
         self.expired = False  # the measured deciphering time passed tau_c (deciphering_clock="measured")
         self.delivered = 0  # samples delivered to the agent
@@ -272,31 +264,19 @@ class EpisodeCore:
         self._act = np.zeros((K, m))  # the actions of the current step, float64
         self._obs_shape = (K, self.layout.dim)
         self._obs_at = self.layout.offsets
-        self._reward_out = np.zeros(K)
-        self._step_fused = kern.step_fused_parallel if parallel else kern.step_fused
-        self._budget = p.energy_budget
-        self._all_ready = False
-        # what the compiled kernels take (see _kernels): built once, the arrays are never rebound
-        self._consts = (self._A, self._B, np.ascontiguousarray(self._theta_true.T), float(self._c), p.u_max, self._budget)
-        self._arrays = (
-            self.x,
-            self.energy,
-            self.X,
-            self.U,
-            self.hist,
-            self.Q,
-            self.eps,
-            self._reward_out,
-            np.zeros((K, m)),
-            np.zeros((K, m), dtype=np.int64),
-            np.zeros((K, n), dtype=np.int64),
-            np.zeros((2 * self.d + n + 2, K)),
+        self.consts = KernelConstants(
+            self._A, self._B, np.ascontiguousarray(self._theta_true.T), float(self._c), p.u_max, p.energy_budget
         )
-        self._a = self._arrays[8]  # the energy-limited input of the current step (a_buf)
-        # the ideal backend's steady-state step is one compiled call, on the loop's arithmetic
+        # what the compiled kernels take (see _kernels): built once, the arrays are never rebound
+        self._consts, self._arrays = self.consts.kernel_tuple(), s.kernel_tuple()
+        # how a step runs, chosen once: the ideal backend's steady state is one compiled call
         q = loop.quantization
-        self._quant = tuple(q) if q is not None else None
-        self._fused = self._quant is not None and self.reward.fused and self.estimator is None
+        fused = q is not None and self.reward.fused and self.kernels is not None and self.kernels.fused
+        self.stepper: StepStrategy = choose_step(self, q, fused, parallel)
+        # the other party: the plant side's decisions, each step, on what the plant knows
+        self.defender = make_defender(p.defender) if defender is None else make_defender(defender)
+        self.plant_view = PlantView(s.x, s.U, self._attack_step)
+        self.stopped = False  # the defender ended the attack
         C = sch.chunk
         self._noise_draws = np.zeros((K, C, n))  # each copy's chunk, as its generator draws it
         self._noise = np.zeros((C, K, n))  # period-major, like X: one period's noise is contiguous
@@ -413,30 +393,31 @@ class EpisodeCore:
         self._obs_out = None
         for i, g in enumerate(rngs):
             draw = g.standard_normal(self.n) * self._sx
-            self.x[i] = draw if x0_arr is None else x0_arr[i]
+            self.state.x[i] = draw if x0_arr is None else x0_arr[i]
         self._noise_pos = self.schedule.chunk
         self._noise_ahead = False
         self._chunks = 0
         self.loop.start_episode()
         for _ in range(self.p.warmup_steps):  # normal operation under the encrypted controller (eq:ec)
-            kern.plant_step(self._dims, self.x, self.loop.control(self.x), self._draw_noise(), self._A, self._B)
+            kern.plant_step(self._dims, self.state.x, self.loop.control(self.state.x), self._draw_noise(), self._A, self._B)
         self.X[:] = 0.0
         self.U[:] = 0.0
         self._GC[:] = 0.0
-        self.ready[:] = False
         self._gram_upto = 1
-        self._all_ready = False
-        self._since_refresh = 0
-        self.hist[:] = 0.0
-        self.energy[:] = 0.0
+        if self.kernels is not None:
+            self.kernels.reset()
+        self.state.hist[:] = 0.0
+        self.state.energy[:] = 0.0
         self.eps[:] = self._eps0
         if self.estimator is not None:
             self.estimator.start(self.K, self.n, self.m)
         self.reward.reset(self)
         self.collected = self.delivered = 0
         self.expired = False
+        self.stopped = False
         self.done = False
         self.history = []
+        self.defender.reset(self.K, self.n, self.m, DefenderStreams(rngs))
         self._collect()
         self.new = self._deliver(final=False)
         return self.observation()
@@ -464,7 +445,7 @@ class EpisodeCore:
         sample whose break ends past ``tau_c`` came too late: it is not counted, and the episode
         has :attr:`expired`.
         """
-        self.X[self.collected] = self.loop.collect_state(self.x)
+        self.X[self.collected] = self.loop.collect_state(self.state.x)
         if self._measured:
             spent = self.loop.deciphering_seconds
             if spent > self.p.tau_c:
@@ -498,7 +479,7 @@ class EpisodeCore:
 
     def _overflow(self) -> None:
         raise EncodingOverflowError(
-            f"state {self.x.tolist()} leaves the encoder's declared range |x| <= {self.p.x_bound} (x_bound)"
+            f"state {self.state.x.tolist()} leaves the encoder's declared range |x| <= {self.p.x_bound} (x_bound)"
         )
 
     def _target(self, collected: int) -> int:
@@ -514,41 +495,35 @@ class EpisodeCore:
         if target <= self.delivered:
             return False
         first = max(self.delivered, 1)
+        kernels = self.kernels
         if (
-            self._all_ready
+            kernels is not None
+            and kernels.all_ready
             and not final
             and not self.reward.needs_gram
-            and self._since_refresh + target - first < self.schedule.refresh
-        ):  # steady state: columns, recursive least squares and error in one compiled call
+            and kernels.since_refresh + target - first < kernels.refresh
+        ):  # steady state: columns, the compiled estimate and its error
             self._sync_gram(first)
-            kern.add_columns(self._dims, self.X, self.U, first, target, self._GC, self.Q, self.ready)
+            kernels.add_columns(self._dims, self.X, self.U, first, target, self._GC)
             self._gram_upto = target
-            kern.estimation_error(self._dims, self.Q, self._consts[2], self._consts[3], self.ready, self.eps)
-            self._since_refresh += target - first
+            kernels.steady_error(self._dims, self.eps)
+            kernels.since_refresh += target - first
             self.delivered = target
             self.history.append((target, float(self.eps[0])))
             return True
         self._sync_gram(first)
         if target > first:
-            kern.add_columns(self._dims, self.X, self.U, first, target, self._GC, self.Q, self.ready)
+            if kernels is not None:
+                kernels.add_columns(self._dims, self.X, self.U, first, target, self._GC)
+            else:  # the Gram matrices alone (the rewards read them), as the columns would add them
+                kern.add_gram(self._dims, self.X, self.U, first, target, self._GC, self._gram_scratch)
             self._gram_upto = target
         self.delivered = target
         if self.estimator is not None:
             self._estimate(first, target)
         self.reward.on_delivery(self)
-        if self.estimator is None and self.delivered - 1 >= self.d:
-            self._since_refresh += target - first
-            if final or self._since_refresh >= self.schedule.refresh:  # exact solve: bounds drift; final = eq:estimate
-                stale = np.ones(self.K, dtype=bool)
-                self._since_refresh = 0
-            else:
-                stale = ~self.ready
-            if stale.any():
-                rows = np.nonzero(stale)[0]
-                theta_hat_T = self._refresh(rows)
-                self.eps[rows] = ((theta_hat_T - self._consts[2]) ** 2).sum(axis=(1, 2)) / self._c
-            kern.estimation_error(self._dims, self.Q, self._consts[2], self._consts[3], self.ready & ~stale, self.eps)
-            self._all_ready = bool(self.ready.all())
+        if kernels is not None:
+            kernels.settle(self._dims, self.G, self.C, target - first, self.delivered, final, self.eps)
         self.history.append((self.delivered, float(self.eps[0])))
         return True
 
@@ -571,42 +546,6 @@ class EpisodeCore:
                 )
             ok = np.isfinite(err)
             self.eps[ok] = err[ok]
-
-    def _refresh(self, rows: np.ndarray) -> np.ndarray:
-        """Exact least squares (eq:estimate) for the copies ``rows`` from the running Gram matrices.
-
-        A copy whose Jacobi-scaled Gram matrix is well conditioned (condition number below
-        ``schedule.cond_limit``) solves ``G [P | Theta_hat^T] = [I | C]`` and (re)starts its
-        recursion from the solution; any other copy gets the minimum-norm least-squares solution
-        ``pinv(G) C`` of eq:estimate and stays non-recursive. A started recursion is re-anchored
-        without a new check: G only grows, by positive semidefinite terms, so its smallest
-        eigenvalue never falls. Called for copies that are not yet recursive, and for every copy
-        each ``schedule.refresh`` columns to bound rounding drift. Returns Theta_hat^T of those
-        copies, shape (len(rows), n + m, n).
-        """
-        d = self.d
-        G, C = self.G[rows], self.C[rows]
-        ok = self.ready[rows]  # a copy: the ones already recursive stay so
-        if not ok.all():
-            fresh = ~ok
-            g = G[fresh]
-            s = 1.0 / np.sqrt(np.maximum(np.einsum("kii->ki", g), 1e-300))
-            ok[fresh] = _condition(g * s[:, :, None] * s[:, None, :]) < self.schedule.cond_limit
-        sol = np.zeros((len(rows), d, d + self.n))
-        if ok.any():
-            g, c = G[ok], C[ok]
-            s = 1.0 / np.sqrt(np.einsum("kii->ki", g))  # Jacobi scaling
-            rhs = np.concatenate((np.broadcast_to(np.eye(d), g.shape) * s[:, :, None], c * s[:, :, None]), axis=2)
-            try:
-                sol[ok] = np.linalg.solve(g * s[:, :, None] * s[:, None, :], rhs) * s[:, :, None]
-            except np.linalg.LinAlgError:  # cannot happen to a well-conditioned matrix; never crash on it
-                ok[:] = False
-        if not ok.all():
-            bad = ~ok
-            sol[bad, :, d:] = _pinv_psd(G[bad]) @ C[bad]
-        self.Q[:, rows[ok]] = sol[ok].reshape(-1, d * (d + self.n)).T
-        self.ready[rows] = ok
-        return sol[:, :, d:]
 
     def check_actions(self, action: Any) -> np.ndarray:
         """Validate actions: shape (K, m) (or (m,) for K = 1), finite, inside [-1, 1]. Returns
@@ -637,73 +576,31 @@ class EpisodeCore:
             raise ParameterError("step() called before reset(); call reset() first")
         if self.done:
             raise ParameterError("step() called after the episode ended; call reset() first")
-        p = self.p
         act = self.check_actions(action)
         w = self._draw_noise()
-        ended = self.collected >= p.horizon or self.expired
-        if self._fused and self._all_ready and not ended:
-            # steady state of the ideal backend: period, delivery, recursive LS, error, reward,
-            # observation and info in one compiled call
-            first = max(self.delivered, 1)
-            target = self._target(self.collected + 1)
-            if self._since_refresh + target - first < self.schedule.refresh:
-                new = target > self.delivered
-                obs = np.empty(self._obs_shape, dtype=np.float32)
-                N, collected = (target if new else self.delivered), self.collected + 1
-                status = self._step_fused(
-                    self._dims,
-                    self._consts,
-                    self._arrays,
-                    self._quant,
-                    act,
-                    w,
-                    self.collected - 1,
-                    self.collected,
-                    first,
-                    target,
-                    obs,
-                    self._obs_at,
-                    N - 1,
-                    float(new),
-                    float(self._time_frac[collected]),
-                )
-                if status == kern.STATE_OVERFLOW:
-                    self._overflow()
-                self.collected += 1
-                self.new = new
-                if new:
-                    self._since_refresh += target - first
-                    self.delivered = target
-                    self.history.append((target, float(self.eps[0])))
-                    if self.helper is not None and target - self._gram_upto >= self.schedule.gram_batch:
-                        self._gram_behind(target)
-                self._obs_out = obs
-                return self._reward_out.copy(), False, False
-        self._obs_out = None
-        if self._quant is not None:  # ideal backend: the period in one compiled call
-            status = kern.step_ideal(
-                self._dims, self._consts, self._arrays, self._quant, act, w, self.collected - 1, -1 if ended else self.collected
-            )
-            if status == kern.STATE_OVERFLOW:
-                self._overflow()
-            if not ended:
-                self.collected += 1
-        else:
-            kern.energy_budget(self._dims, act, p.u_max, self.energy, self._budget, self._a)
-            u = self.loop.inject(self._a)
-            self.U[self.collected - 1] = u
-            kern.plant_step(self._dims, self.x, u, w, self._A, self._B)
-            if p.input_history:
-                kern.shift_history(self._dims, self.hist, act)
-            self.loop.tick()
-            if not ended:
-                self._collect()
-                ended = self.expired  # the measured clock passed tau_c: the attack is over now
+        ended = self.collected >= self.p.horizon or self.expired
+        decision = self.defender.act(self.plant_view)
+        if decision is not None:
+            noise, stop = check_defender_action(decision, self.K, self.m)
+            if noise is not None:  # u + v applied, u recorded: to the attacker, process noise B v
+                w = w + noise @ self.consts.B.T
+            if stop:
+                self.stopped = ended = True
+        return self.stepper.step(act, w, ended)
+
+    def _attack_step(self) -> int:
+        """The attack step about to run (0 at the first): its input goes to ``U[collected - 1]``."""
+        return self.collected - 1
+
+    def finish_step(self, ended: bool) -> tuple[np.ndarray, bool, bool]:
+        """What follows the period of a step on every path: the delivery (all paid samples if
+        the attack has ``ended``), the estimate and the reward. Returns (rewards (K,),
+        terminated, truncated)."""
         self.reward.begin(self)
         self.new = self._deliver(final=ended)
         reward = self.reward.end(self)
         self.done = ended
-        out_of_time = p.budget_limited or self.expired
+        out_of_time = self.p.budget_limited or self.expired or self.stopped
         return reward, ended and out_of_time, ended and not out_of_time
 
     # ----------------------------------------------------------------- observation and info
@@ -722,10 +619,10 @@ class EpisodeCore:
                 self.U,
                 self.delivered - 1,
                 float(self.new),
-                self.hist,
+                self.state.hist,
                 float(self._time_frac[self.collected]),
-                self.energy,
-                self._budget,
+                self.state.energy,
+                self.consts.budget,
             )
         return obs
 
@@ -743,7 +640,7 @@ class EpisodeCore:
 
     def info_arrays(self) -> dict[str, np.ndarray]:
         """Info of every copy as new arrays of shape (K,) (:func:`~encctl_gym.envs.layout.info_dict`)."""
-        return info_dict(self.eps.copy(), self.energy.copy(), self._shared_info(), self.has_gamma_opt, self.K)
+        return info_dict(self.eps.copy(), self.state.energy.copy(), self._shared_info(), self.has_gamma_opt, self.K)
 
     def info(self) -> dict[str, Any]:
         """Info of copy 0 as Python scalars (single environment).
@@ -751,4 +648,4 @@ class EpisodeCore:
         ``epsilon`` is the error (Definition def:error) of the attacker's current estimate: the
         least squares estimate once ``n + m`` columns are delivered, ``[A B] = 0`` before.
         """
-        return info_dict(float(self.eps[0]), float(self.energy[0]), self._shared_info(), self.has_gamma_opt)
+        return info_dict(float(self.eps[0]), float(self.state.energy[0]), self._shared_info(), self.has_gamma_opt)

@@ -18,6 +18,8 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import ConfigError
+from ..registry import Registry
 from . import _kernels as kern
 
 __all__ = ["Reward", "GramReward", "LogErrorReward", "LogDetReward", "AOptimalityReward", "REWARDS"]
@@ -151,4 +153,4 @@ class AOptimalityReward(GramReward):
 
 
 #: Rewards by the name the ``reward`` configuration key gives.
-REWARDS: dict[str, type[Reward]] = {cls.name: cls for cls in (LogErrorReward, LogDetReward, AOptimalityReward)}
+REWARDS: Registry[type[Reward]] = Registry("reward", [LogErrorReward, LogDetReward, AOptimalityReward], error=ConfigError)

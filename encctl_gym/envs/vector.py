@@ -20,7 +20,7 @@ from gymnasium.vector.utils import batch_space
 
 from .._validation import check_int, format_value
 from ..errors import ParameterError
-from ..loop import make_loop
+from ..loop import make_defender, make_loop
 from .config import AttackParams, resolve_params
 from .encrypted_lti_attack import check_seed, reset_options
 from .episode import EpisodeCore, EpisodeSchedule, attack_design_for, check_episode_memory
@@ -91,7 +91,8 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
             raise ParameterError(f"parallel must be a bool, got {format_value(parallel)}")
         if not isinstance(helper_thread, (bool, np.bool_, HelperThread)):
             raise ParameterError(f"helper_thread must be a bool or a HelperThread, got {format_value(helper_thread)}")
-        loop = make_loop(p)  # refuses a loop it cannot build (the quantisation table) before the spaces are sized
+        defender = make_defender(p.defender)
+        loop = make_loop(p, defender)  # refuses a loop it cannot build (the quantisation table) before the spaces are sized
         self.single_action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
         self.single_observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
@@ -110,6 +111,7 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
             helper=self.helper,
             schedule=schedule,
             memory_limit=memory_limit,
+            defender=defender,
         )
         self._rngs: list[np.random.Generator] | None = None
         self._needs_reset = False

@@ -9,6 +9,11 @@
   least squares, Bayesian least squares (Gaussian prior, ridge posterior mean), exponential
   forgetting, instrumental variables.
 * :mod:`.registry` -- estimators by name (``make_estimator("bayes")``).
+* :mod:`.grid` -- the error on a grid of ``N`` for least squares or any estimator by name.
+* :mod:`.subspace` -- identification from outputs ``y = C x + D u + v``: N4SID, PO-MOESP and
+  ARX on batches of runs, and the basis-free Markov-parameter error.
+* :mod:`.tails` -- when the error's mean and variance exist (the tail rule), the Hill
+  estimator, and summaries that report medians and flag a mean that does not exist.
 
 Pure numerical code (numpy): it imports only the package's base modules. The sample
 identifying complexities of :mod:`encctl_gym.security` bound the expected error of these
@@ -23,16 +28,31 @@ from .bayes import *  # noqa: F403
 from .error import *  # noqa: F403
 from .estimator import *  # noqa: F403
 from .forgetting import *  # noqa: F403
+from .grid import *  # noqa: F403
 from .instrumental import *  # noqa: F403
 from .least_squares import *  # noqa: F403
 from .ordinary import *  # noqa: F403
 from .registry import *  # noqa: F403
+from .subspace import *  # noqa: F403
+from .tails import *  # noqa: F403
 
 #: The public names of the modules above, in their order (each module's ``__all__``).
 __all__ = list(
     dict.fromkeys(
         name
-        for module in ("error", "least_squares", "estimator", "ordinary", "bayes", "forgetting", "instrumental", "registry")
+        for module in (
+            "error",
+            "least_squares",
+            "estimator",
+            "ordinary",
+            "bayes",
+            "forgetting",
+            "instrumental",
+            "registry",
+            "grid",
+            "subspace",
+            "tails",
+        )
         for name in sys.modules[f"{__name__}.{module}"].__all__
     )
 )

@@ -69,6 +69,8 @@ class BayesianLeastSquares(MomentEstimator):
     noise_variance : float, optional
         ``sigma_w2`` assumed by the posterior. Needs ``prior_variance``.
 
+    Notes
+    -----
     With neither (the default), the isotropic scale is chosen by empirical Bayes (see the
     module docstring): the attacker needs neither ``(A, B)`` nor ``sigma_w2``.
 

@@ -34,6 +34,8 @@ class ForgettingLeastSquares(MomentEstimator):
     forgetting_factor : float in (0, 1], default 0.999
         ``lambda``: the weight of a column one step older.
 
+    Notes
+    -----
     Costs: as :class:`~encctl_gym.ident.ordinary.OrdinaryLeastSquares` (the weights are applied
     to the rows of each segment and to the moments between segments); the same Jacobi-scaled
     Cholesky solve, with the minimum-norm solution where the weighted Gram matrix is singular.

@@ -45,6 +45,8 @@ class InstrumentalVariables(MomentEstimator):
         ``1 <= L <= MAX_LAGS``: instruments ``u_j, u_{j-1}, ..., u_{j-L}``. Default ``ceil(n / m)``, the
         fewest that give at least ``n + m`` instruments.
 
+    Notes
+    -----
     Needs ``N >= L + (L + 1) m + 1`` samples (``(L + 1) m`` usable columns for the instrument
     Gram matrix). Where the instruments do not determine ``[A B]`` numerically (e.g. inputs
     that do not excite the states within ``L`` steps) the estimate is NaN.

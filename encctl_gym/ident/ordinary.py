@@ -5,7 +5,8 @@ grid estimates are those of :mod:`encctl_gym.ident.least_squares` (the same numb
 :func:`~encctl_gym.ident.least_squares.least_squares` and
 :func:`~encctl_gym.ident.least_squares.prefix_estimates`), and the online estimate of each copy
 is that of :class:`~encctl_gym.ident.least_squares.RecursiveLeastSquares` fed the same columns,
-bit for bit (same buffer, same fold, same Jacobi-scaled Cholesky solve).
+bit for bit (same buffer, same fold, same Jacobi-scaled Cholesky solve). It provides kernels
+(:meth:`OrdinaryLeastSquares.online_kernels`): the compiled recursion the environment runs.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from typing import Any, Literal
 import numpy as np
 
 from ..errors import ParameterError
+from .compiled import RecursiveLeastSquaresKernels
 from .estimator import MomentEstimator
 from .least_squares import _solve_normal_equations, least_squares, prefix_estimates
 
@@ -46,6 +48,8 @@ class OrdinaryLeastSquares(MomentEstimator):
     method : {"auto", "gram", "qr"}
         Solver of the grid estimates (:func:`~encctl_gym.ident.least_squares.prefix_estimates`).
 
+    Notes
+    -----
     Costs: :meth:`fit` one batched pseudo-inverse; :meth:`prefix_estimates` one pass over the
     data plus one batched ``d x d`` solve per (run, N); online, ``O(K (2n + m)^2)`` per update
     and one Cholesky solve per copy per estimate (``O(K d^3)``, ``d = n + m``).
@@ -79,3 +83,11 @@ class OrdinaryLeastSquares(MomentEstimator):
     def solve(self, M: np.ndarray, columns: int, n: int, m: int) -> np.ndarray:
         """Online: the normal equations of eq:estimate (see :func:`gram_solve`)."""
         return gram_solve(M, n, m)
+
+    def online_kernels(
+        self, K: int, A: np.ndarray, B: np.ndarray, Q: np.ndarray, refresh: int, cond_limit: float
+    ) -> RecursiveLeastSquaresKernels:
+        """The compiled online form the attack episode runs
+        (:class:`~encctl_gym.ident.compiled.RecursiveLeastSquaresKernels`: recursive least squares,
+        re-anchored to the exact solve of eq:estimate)."""
+        return RecursiveLeastSquaresKernels(K, A, B, Q, refresh, cond_limit)

@@ -24,11 +24,11 @@ they mean nothing for this full-state problem.
 
 from __future__ import annotations
 
-import inspect
 from collections.abc import Mapping
 from typing import Any
 
 from ..errors import ParameterError
+from ..registry import Registry
 from .bayes import BayesianLeastSquares
 from .estimator import Estimator, MomentEstimator
 from .forgetting import ForgettingLeastSquares
@@ -37,13 +37,10 @@ from .ordinary import OrdinaryLeastSquares
 
 __all__ = ["ESTIMATORS", "DEFAULT_ESTIMATOR", "estimator_names", "make_estimator", "estimator_spec"]
 
-#: name -> class; each class validates its own parameters.
-ESTIMATORS: dict[str, type[MomentEstimator]] = {
-    "ls": OrdinaryLeastSquares,
-    "bayes": BayesianLeastSquares,
-    "forgetting": ForgettingLeastSquares,
-    "iv": InstrumentalVariables,
-}
+#: name -> class (:class:`~encctl_gym.registry.Registry`); each class validates its own parameters.
+ESTIMATORS: Registry[type[MomentEstimator]] = Registry(
+    "estimator", [OrdinaryLeastSquares, BayesianLeastSquares, ForgettingLeastSquares, InstrumentalVariables]
+)
 
 #: The paper's estimator (eq:estimate).
 DEFAULT_ESTIMATOR = "ls"
@@ -51,11 +48,7 @@ DEFAULT_ESTIMATOR = "ls"
 
 def estimator_names() -> list[str]:
     """The registered names."""
-    return list(ESTIMATORS)
-
-
-def _parameters(cls: type) -> list[str]:
-    return list(inspect.signature(cls).parameters)
+    return ESTIMATORS.names()
 
 
 def make_estimator(spec: Any = None, **params: Any) -> Estimator:
@@ -97,15 +90,8 @@ def make_estimator(spec: Any = None, **params: Any) -> Estimator:
                 raise ParameterError(f"parameters {sorted(params)} cannot be applied to an existing estimator {spec!r}")
             return spec
         raise ParameterError(f"estimator must be a name, a mapping or an Estimator, got {spec!r}")
-    try:
-        cls = ESTIMATORS[spec]
-    except KeyError:
-        raise ParameterError(f"unknown estimator {spec!r}; choose one of {', '.join(ESTIMATORS)}") from None
-    known = _parameters(cls)
-    unknown = sorted(set(params) - set(known))
-    if unknown:
-        raise ParameterError(f"unknown parameter(s) {unknown} for estimator {spec!r}; it takes {', '.join(known) or 'none'}")
-    return cls(**params)
+    est: Estimator = ESTIMATORS.build(spec, **params)
+    return est
 
 
 def estimator_spec(estimator: Estimator) -> dict[str, Any]:

@@ -19,7 +19,10 @@ records
 cost_models
     Deciphering-cost models ``paper`` (def:sdt, eq:opt_key), ``precomputation`` (index calculus:
     one precomputation per group, then a cheap descent per key) and ``generic`` (Pollard rho),
-    one protocol and one registry; the GNFS formula with its optional o(1) correction.
+    one base class and one registry; the GNFS formula with its optional o(1) correction.
+threat
+    ``ThreatModel``: variances, gamma_c, tau_c, Upsilon, adversary and cost model, checked once;
+    the design functions take one.
 deciphering
     Sample deciphering time (Definition def:sdt) for the modified, token and static schemes,
     under a security parameter or any cost model; the largest affordable sample size.
@@ -28,11 +31,19 @@ design
 key_length
     eq:opt_key generalised: the smallest safe key length under each cost model, and what a key
     is worth under each.
+defenses
+    The defences' closed forms: eq:sic with the defender's input noise, its Lyapunov price,
+    audit rates, the chi-squared detector's threshold, group rotation's precomputations.
+empirical
+    An empirical sample identifying complexity (a fitted ``c / N^a`` with bootstrap intervals)
+    for estimators without a closed form, and the design with intervals for N*, lambda*, k*.
 attack_design
     A-optimal attack inputs (closed and open loop), ``gamma_opt`` and robust designs (needs
     cvxpy; imported on use).
+report
+    ``design_report``: everything the design command reports for a plant, as a dict.
 design_cli
-    The ``encctl-gym design`` subcommand.
+    The ``encctl-gym design`` subcommand (prints :func:`.report.design_report`).
 """
 
 from __future__ import annotations
@@ -44,12 +55,15 @@ from .bayes_complexity import *  # noqa: F403
 from .complexity import *  # noqa: F403
 from .cost_models import *  # noqa: F403
 from .deciphering import *  # noqa: F403
+from .defenses import *  # noqa: F403
 from .design import *  # noqa: F403
+from .empirical import *  # noqa: F403
 from .exact import *  # noqa: F403
 from .gramians import *  # noqa: F403
 from .key_length import *  # noqa: F403
 from .records import *  # noqa: F403
 from .sample_size import *  # noqa: F403
+from .threat import *  # noqa: F403
 
 #: The public names of the modules above, in their order (each module's ``__all__``).
 __all__ = list(
@@ -63,9 +77,12 @@ __all__ = list(
             "sample_size",
             "records",
             "cost_models",
+            "threat",
             "deciphering",
             "design",
             "key_length",
+            "defenses",
+            "empirical",
             "attack_design",
         )
         for name in sys.modules[f"{__name__}.{module}"].__all__

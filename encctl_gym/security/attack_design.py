@@ -54,10 +54,12 @@ import numpy as np
 
 from .._validation import check_bool, check_int, check_positive, check_schur_stable, check_system, format_value
 from ..errors import ParameterError, ResourceLimitError, SolverError
+from ..plant import Plant, as_plant
 from .complexity import check_sample_size
 from .design import SecurityDesign, design_for_sample_size
 from .gramians import controllability_gramian, noise_gramian
 from .sample_size import sample_size_for_rate
+from .threat import IDENTIFICATION_FIELDS, ThreatModel
 
 __all__ = [
     "AttackDesign",
@@ -446,16 +448,10 @@ def _check_design_fits(design: Any, A: np.ndarray, B: np.ndarray, su: float, sw:
 
 
 def robust_security_design(
-    A: Any,
-    B: Any,
+    plant: Plant | tuple[Any, Any],
+    threat: ThreatModel,
     *,
-    sigma_u2: float,
-    sigma_w2: float,
-    gamma_c: float,
-    tau_c: float,
-    upsilon: float,
     kind: str = "closed_loop",
-    sigma_x2: float = 1.0,
     design: AttackDesign | None = None,
     solver: str | None = None,
 ) -> SecurityDesign:
@@ -468,16 +464,13 @@ def robust_security_design(
 
     Parameters
     ----------
-    A, B : array_like
+    plant : Plant or (A, B)
         Plant (``A`` Schur stable).
-    sigma_u2, sigma_w2 : float
-        Input power and noise variance (> 0).
-    gamma_c, tau_c, upsilon : float
-        Acceptable error, defense period (s), adversary FLOPS (> 0).
+    threat : ThreatModel
+        Input power and noise variance, ``gamma_c``, ``tau_c``, ``Upsilon`` (``sigma_x2`` is
+        recorded in the result, not used by ``gamma_opt``).
     kind : {"closed_loop", "open_loop", "gaussian"}
         Which attack design to guard against.
-    sigma_x2 : float, default 1.0
-        Recorded in the result (not used by ``gamma_opt``).
     design : AttackDesign, optional
         A precomputed design of the same ``kind`` (skips the solve).
     solver : str, optional
@@ -490,8 +483,12 @@ def robust_security_design(
     """
     if not isinstance(kind, str) or kind not in KINDS:
         raise ParameterError(f"unknown kind {format_value(kind)}; expected one of {', '.join(KINDS)}")
-    A, B, su, sw = _check_inputs(A, B, sigma_u2, sigma_w2)
-    n, m = B.shape
+    if not isinstance(threat, ThreatModel):
+        raise ParameterError(f"robust_security_design: threat must be a ThreatModel, got {format_value(threat)}")
+    threat.require(*IDENTIFICATION_FIELDS)
+    p = as_plant(plant)
+    A, B, su, sw = p.A, p.B, float(threat.sigma_u2), float(threat.sigma_w2)
+    n, m = p.n, p.m
     if design is None:
         if kind == "gaussian":
             design = gaussian_attack_design(A, B, sigma_u2=su, sigma_w2=sw)
@@ -499,19 +496,14 @@ def robust_security_design(
             design = optimal_attack_design(A, B, sigma_u2=su, sigma_w2=sw, feedback=kind == "closed_loop", solver=solver)
     else:
         _check_design_fits(design, A, B, su, sw, kind)
-    N_star = sample_size_for_rate(design.rate, gamma_c)
+    N_star = sample_size_for_rate(design.rate, threat.gamma_c)
     return design_for_sample_size(
         kind,
         N_star,
         design.gamma,
+        threat,
         m=m,
         n=n,
-        sigma_u2=su,
-        sigma_w2=sw,
-        sigma_x2=sigma_x2,
         tr_psi_u=float(np.trace(controllability_gramian(A, B))),
         tr_psi_w=float(np.trace(noise_gramian(A))),
-        gamma_c=gamma_c,
-        tau_c=tau_c,
-        upsilon=upsilon,
     )

@@ -37,8 +37,9 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_int, check_nonnegative, check_positive, check_system, format_value
+from .._validation import check_int, check_nonnegative, check_positive, format_value
 from ..errors import ModelRangeError, ParameterError
+from ..plant import Plant, as_plant
 from ..presets import PAPER_DESIGN_EXAMPLE
 from .cost_models import (
     KeyBreakCost,
@@ -62,6 +63,7 @@ from .sample_size import (
     optimal_sample_size,
     sample_size_for_rate,
 )
+from .threat import IDENTIFICATION_FIELDS, ThreatModel
 
 __all__ = [
     "SecurityDesign",
@@ -90,7 +92,7 @@ __all__ = [
 PAPER_EXAMPLE: dict[str, Any] = PAPER_DESIGN_EXAMPLE
 
 #: Values of :attr:`SecurityDesign.method`: the complexity that gave ``N*``.
-METHODS: tuple[str, ...] = ("asymptotic", "exact", "closed_loop", "open_loop", "gaussian")
+METHODS: tuple[str, ...] = ("asymptotic", "exact", "closed_loop", "open_loop", "gaussian", "input_noise")
 
 
 @dataclass(frozen=True)
@@ -102,7 +104,8 @@ class SecurityDesign:
     method : str
         ``"asymptotic"`` (eq:sic2, the paper's Theorem thm:opt_sec), ``"exact"`` (eq:sic),
         ``"closed_loop"``, ``"open_loop"`` or ``"gaussian"`` (robust designs of
-        :mod:`encctl_gym.security.attack_design`).
+        :mod:`encctl_gym.security.attack_design`), ``"input_noise"`` (the defender's input noise,
+        :func:`encctl_gym.security.defenses.noise_defense_design`).
     N_star : int
         Smallest sample size with ``gamma(N) < gamma_c``.
     lam_star : int
@@ -250,20 +253,7 @@ def _gamma_float(gamma: Callable[[int], Any], N: int) -> float:
 
 
 def design_for_sample_size(
-    method: str,
-    N_star: int,
-    gamma: Callable[[int], Any],
-    *,
-    m: int,
-    n: int,
-    sigma_u2: Any,
-    sigma_w2: Any,
-    sigma_x2: Any,
-    tr_psi_u: Any,
-    tr_psi_w: Any,
-    gamma_c: Any,
-    tau_c: Any,
-    upsilon: Any,
+    method: str, N_star: int, gamma: Callable[[int], Any], threat: ThreatModel, *, m: int, n: int, tr_psi_u: Any, tr_psi_w: Any
 ) -> SecurityDesign:
     """Theorem thm:opt_sec and eq:opt_key for a given ``N*``: ``lam*``, ``k*`` and the record.
 
@@ -278,8 +268,10 @@ def design_for_sample_size(
         Smallest sample size with ``gamma(N) < gamma_c`` (>= 2).
     gamma : callable
         The complexity, for ``gamma(N*)`` and ``gamma(N* - 1)`` in the record.
-    m, n, sigma_u2, sigma_w2, sigma_x2, tr_psi_u, tr_psi_w, gamma_c, tau_c, upsilon
-        As in :func:`design_from_traces` (recorded as floats).
+    threat : ThreatModel
+        Variances, ``gamma_c``, ``tau_c`` and ``Upsilon`` (recorded as floats).
+    m, n, tr_psi_u, tr_psi_w
+        Dimensions and Gramian traces, as in :func:`design_from_traces` (recorded as floats).
 
     Returns
     -------
@@ -293,28 +285,29 @@ def design_for_sample_size(
     """
     if not isinstance(method, str) or method not in METHODS:
         raise ParameterError(f"unknown method {format_value(method)}; expected one of {', '.join(METHODS)}")
+    t = _threat(threat, "design_for_sample_size").require(*IDENTIFICATION_FIELDS)
     N_star = check_int("N_star", N_star, 2)
-    lam_star = optimal_security_parameter(N_star, tau_c=tau_c, upsilon=upsilon)
+    lam_star = optimal_security_parameter(N_star, tau_c=t.tau_c, upsilon=t.upsilon)
     try:
         k_star = minimum_key_length(lam_star)
     except ModelRangeError as exc:
         raise ModelRangeError(
-            f"Theorem thm:opt_sec gives lam* = {lam_star} for N* = {format_value(N_star)} (tau_c = {format_value(tau_c)} s, "
-            f"Upsilon = {format_value(upsilon)} FLOPS), and eq:opt_key cannot turn it into a key length: {exc}"
+            f"Theorem thm:opt_sec gives lam* = {lam_star} for N* = {format_value(N_star)} (tau_c = {format_value(t.tau_c)} s, "
+            f"Upsilon = {format_value(t.upsilon)} FLOPS), and eq:opt_key cannot turn it into a key length: {exc}"
         ) from None
     return SecurityDesign(
         method=method,
         N_star=N_star,
         lam_star=lam_star,
         k_star=k_star,
-        gamma_c=check_positive("gamma_c", gamma_c),
-        tau_c=check_positive("tau_c", tau_c),
-        upsilon=check_positive("upsilon", upsilon),
+        gamma_c=float(t.gamma_c),
+        tau_c=float(t.tau_c),
+        upsilon=float(t.upsilon),
         m=check_int("m", m, 1),
         n=check_int("n", n, 1),
-        sigma_u2=check_positive("sigma_u2", sigma_u2),
-        sigma_w2=check_positive("sigma_w2", sigma_w2),
-        sigma_x2=check_nonnegative("sigma_x2", sigma_x2),
+        sigma_u2=float(t.sigma_u2),
+        sigma_w2=float(t.sigma_w2),
+        sigma_x2=float(t.sigma_x2),
         tr_psi_u=check_nonnegative("tr_psi_u", tr_psi_u),
         tr_psi_w=check_positive("tr_psi_w", tr_psi_w),
         gamma_at_N_star=_gamma_float(gamma, N_star),
@@ -323,19 +316,14 @@ def design_for_sample_size(
     )
 
 
+def _threat(threat: Any, where: str) -> ThreatModel:
+    if not isinstance(threat, ThreatModel):
+        raise ParameterError(f"{where}: threat must be a ThreatModel, got {format_value(threat)}")
+    return threat
+
+
 def design_from_traces(
-    tr_psi_u: Any,
-    tr_psi_w: Any,
-    m: int,
-    n: int,
-    *,
-    sigma_u2: Any,
-    sigma_w2: Any,
-    sigma_x2: Any = 1.0,
-    gamma_c: Any,
-    tau_c: Any,
-    upsilon: Any,
-    method: str = "asymptotic",
+    tr_psi_u: Any, tr_psi_w: Any, m: int, n: int, threat: ThreatModel | None = None, *, method: str = "asymptotic", **fields: Any
 ) -> SecurityDesign:
     """Theorem thm:opt_sec and eq:opt_key from the Gramian traces.
 
@@ -345,93 +333,62 @@ def design_from_traces(
         ``tr Psi_u >= 0`` and ``tr Psi_w > 0``.
     m, n : int
         Dimensions.
-    sigma_u2, sigma_w2 : float
-        Attack-input and noise variances (> 0); only ``R_sigma`` matters for ``"asymptotic"``.
-    sigma_x2 : float, default 1.0
-        Variance of x_0 (used by ``"exact"``).
-    gamma_c, tau_c, upsilon : float
-        Acceptable error, defense period (s), adversary FLOPS (all > 0).
+    threat : ThreatModel
+        ``sigma_u2``, ``sigma_w2`` (only ``R_sigma`` matters for ``"asymptotic"``), ``sigma_x2``
+        (used by ``"exact"``), ``gamma_c``, ``tau_c``, ``upsilon``.
     method : {"asymptotic", "exact"}
         ``"asymptotic"``: eq:sic2 / eq:opt_sec as in the paper; ``"exact"``: eq:sic.
+    **fields
+        Instead of ``threat``: its fields as keywords (``sigma_u2=..., tau_c=...``), for a caller
+        that holds them one by one.
 
     Returns
     -------
     SecurityDesign
     """
+    t = ThreatModel.from_fields(threat, fields, "design_from_traces").require(*IDENTIFICATION_FIELDS)
     m = check_int("m", m, 1)
     n = check_int("n", n, 1)
-    su = decimal_fraction("sigma_u2", sigma_u2)
-    sw = decimal_fraction("sigma_w2", sigma_w2)
-    check_nonnegative("sigma_x2", sigma_x2)
+    su = decimal_fraction("sigma_u2", t.sigma_u2)
+    sw = decimal_fraction("sigma_w2", t.sigma_w2)
     if not isinstance(method, str):
         raise ParameterError(f"unknown method {format_value(method)}; expected 'asymptotic' or 'exact'")
     if method == "asymptotic":
-        N_star = optimal_sample_size(tr_psi_u, tr_psi_w, m, n, r_sigma=su / sw, gamma_c=gamma_c)
+        N_star = optimal_sample_size(tr_psi_u, tr_psi_w, m, n, r_sigma=su / sw, gamma_c=t.gamma_c)
         gamma = exact_sic_asymptotic_function(tr_psi_u, tr_psi_w, m, n, r_sigma=su / sw)
     elif method == "exact":
-        N_star = exact_optimal_sample_size(tr_psi_u, tr_psi_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=sigma_x2, gamma_c=gamma_c)
-        gamma = exact_sic_function(tr_psi_u, tr_psi_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=sigma_x2)
+        N_star = exact_optimal_sample_size(
+            tr_psi_u, tr_psi_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=t.sigma_x2, gamma_c=t.gamma_c
+        )
+        gamma = exact_sic_function(tr_psi_u, tr_psi_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=t.sigma_x2)
     else:
         raise ParameterError(f"unknown method {format_value(method)}; expected 'asymptotic' or 'exact'")
-    return design_for_sample_size(
-        method,
-        N_star,
-        gamma,
-        m=m,
-        n=n,
-        sigma_u2=sigma_u2,
-        sigma_w2=sigma_w2,
-        sigma_x2=sigma_x2,
-        tr_psi_u=tr_psi_u,
-        tr_psi_w=tr_psi_w,
-        gamma_c=gamma_c,
-        tau_c=tau_c,
-        upsilon=upsilon,
-    )
+    return design_for_sample_size(method, N_star, gamma, t, m=m, n=n, tr_psi_u=tr_psi_u, tr_psi_w=tr_psi_w)
 
 
 def design_security_parameter(
-    A: Any,
-    B: Any,
-    *,
-    sigma_u2: Any,
-    sigma_w2: Any,
-    sigma_x2: Any = 1.0,
-    gamma_c: Any,
-    tau_c: Any,
-    upsilon: Any,
-    method: str = "asymptotic",
+    plant: Plant | tuple[Any, Any], threat: ThreatModel, *, method: str = "asymptotic"
 ) -> SecurityDesign:
-    """Theorem thm:opt_sec and eq:opt_key for the plant ``(A, B)`` (Gramians by Lyapunov solves).
+    """Theorem thm:opt_sec and eq:opt_key for a plant (Gramians by Lyapunov solves).
 
     Parameters
     ----------
-    A, B : array_like
+    plant : Plant or (A, B)
         Plant of eq:system (``A`` Schur stable).
-    sigma_u2, sigma_w2, sigma_x2, gamma_c, tau_c, upsilon, method
+    threat : ThreatModel
+        As in :func:`design_from_traces`.
+    method : {"asymptotic", "exact"}
         As in :func:`design_from_traces`.
 
     Returns
     -------
     SecurityDesign
     """
-    A, B = check_system(A, B)
-    n, m = B.shape
-    tr_u = float(np.trace(controllability_gramian(A, B)))
-    tr_w = float(np.trace(noise_gramian(A)))
-    return design_from_traces(
-        tr_u,
-        tr_w,
-        m,
-        n,
-        sigma_u2=sigma_u2,
-        sigma_w2=sigma_w2,
-        sigma_x2=sigma_x2,
-        gamma_c=gamma_c,
-        tau_c=tau_c,
-        upsilon=upsilon,
-        method=method,
-    )
+    p = as_plant(plant)
+    t = _threat(threat, "design_security_parameter")
+    tr_u = float(np.trace(controllability_gramian(p.A, p.B)))
+    tr_w = float(np.trace(noise_gramian(p.A)))
+    return design_from_traces(tr_u, tr_w, p.m, p.n, t, method=method)
 
 
 def paper_design_example(method: str = "asymptotic") -> SecurityDesign:
@@ -448,4 +405,5 @@ def paper_design_example(method: str = "asymptotic") -> SecurityDesign:
     SecurityDesign
     """
     p: dict[str, Any] = dict(PAPER_DESIGN_EXAMPLE)
-    return design_from_traces(p.pop("tr_psi_u"), p.pop("tr_psi_w"), int(p.pop("m")), int(p.pop("n")), method=method, **p)
+    tr_u, tr_w, m, n = p.pop("tr_psi_u"), p.pop("tr_psi_w"), int(p.pop("m")), int(p.pop("n"))
+    return design_from_traces(tr_u, tr_w, m, n, ThreatModel(**p), method=method)

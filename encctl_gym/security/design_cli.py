@@ -36,69 +36,25 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
-from .._validation import (
-    check_int,
-    check_nonnegative,
-    check_positive,
-    check_schur_stable,
-    check_system,
-    format_value,
-    parse_number,
-)
-from ..errors import ConfigError, ParameterError, ResourceLimitError
+from .._validation import check_int, format_value, parse_number
+from ..errors import ConfigError, ParameterError
 from ..plant_file import load_plant_file, load_system
 from ..presets import DESIGN_FIELDS, design_defaults, get_preset, preset_names
 from ..units import SECONDS_PER_UNIT, parse_duration
-from .attack_design import SDP_MAX_DIMENSION, gaussian_attack_design, optimal_attack_design, robust_security_design
-from .complexity import input_upper_bound, noise_upper_bound, sic_asymptotic_from_traces, sic_from_traces
-from .cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION, check_gnfs_correction, gnfs_log2_complexity
-from .design import SecurityDesign, design_from_traces
-from .gramians import controllability_gramian, noise_gramian
-from .key_length import build_model, design_key_length, key_length_value
-from .records import RecordSet, default_records, load_records
+from .attack_design import SDP_MAX_DIMENSION
+from .cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION, check_gnfs_correction
+from .records import load_records
+from .report import COMPLEXITIES, LABELS, design_report
+from .threat import ThreatModel
 
-__all__ = [
-    "add_arguments",
-    "run",
-    "parse_duration",
-    "load_system",
-    "DEFAULTS",
-    "compute",
-    "COMPLEXITIES",
-    "MAX_STATE_DIMENSION",
-    "parse_cost_models",
-    "parse_gnfs_correction",
-]
+__all__ = ["add_arguments", "run", "parse_duration", "load_system", "DEFAULTS", "parse_cost_models", "parse_gnfs_correction"]
 
 #: Option defaults: the paper's design example (from :mod:`encctl_gym.presets`).
 DEFAULTS: dict[str, Any] = design_defaults()
-
-#: Largest state dimension the command accepts: the Lyapunov solves grow as n^3
-#: (n = m = 1000 took 18 s on the development machine).
-MAX_STATE_DIMENSION: int = 1000
-_LYAPUNOV_REF = (1000, 18.0)
-
-#: ``--complexity`` choices -> key of the designs table.
-COMPLEXITIES: dict[str, str] = {
-    "sic2": "paper_sic2",
-    "sic": "exact_sic",
-    "closed_loop": "closed_loop",
-    "open_loop": "open_loop",
-    "gaussian": "gaussian",
-}
-
-LABELS = {
-    "paper_sic2": "(a) eq:sic2, paper (thm:opt_sec)",
-    "exact_sic": "(b) eq:sic exact",
-    "closed_loop": "(c) gamma_opt closed loop",
-    "open_loop": "(d) gamma_opt open loop",
-    "gaussian": "(e) Gaussian, tr(Sigma^-1)",
-}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -194,193 +150,6 @@ def parse_gnfs_correction(text: Any) -> float:
     return check_gnfs_correction(parse_number("gnfs_correction", text))
 
 
-def _check_size(n: int, m: int) -> None:
-    if n > MAX_STATE_DIMENSION:
-        ref_n, ref_s = _LYAPUNOV_REF
-        raise ResourceLimitError(
-            f"the plant has n = {n} states; the design command accepts n <= {MAX_STATE_DIMENSION} (its Lyapunov "
-            f"solves grow as n^3: {ref_s:g} s at n = {ref_n} on the development machine, so about "
-            f"{ref_s * (n / ref_n) ** 3:.3g} s here)"
-        )
-
-
-# --------------------------------------------------------------------------- computation
-def _cost_model_section(
-    designs: dict[str, SecurityDesign],
-    *,
-    models: Sequence[str],
-    complexity: str,
-    gnfs_correction: float,
-    key_length: Any,
-    records: RecordSet,
-    tau_c: float,
-    upsilon: float,
-) -> dict[str, Any]:
-    key = COMPLEXITIES[complexity]
-    if key not in designs:
-        raise ParameterError(f"--complexity {complexity} was skipped for this plant (see the table); choose another")
-    N_star = designs[key].N_star
-    out_designs = {}
-    for name in models:
-        d = design_key_length(name, N_star, tau_c=tau_c, upsilon=upsilon, gnfs_correction=gnfs_correction, calibration=records)
-        out_designs[name] = d.to_dict()
-    k_val = designs[key].k_star if key_length is None else check_int("key_length", key_length)
-    values = {
-        name: key_length_value(
-            name, k_val, N_star=N_star, tau_c=tau_c, upsilon=upsilon, gnfs_correction=gnfs_correction, calibration=records
-        ).to_dict()
-        for name in models
-    }
-    first = next(iter(out_designs.values()))
-    return {
-        "complexity": complexity,
-        "N_star": N_star,
-        "budget_bits": first["budget_bits"],
-        "gnfs_correction": gnfs_correction,
-        "designs": out_designs,
-        "key_value": {"key_length": k_val, "models": values},
-    }
-
-
-def _records_section(records: RecordSet) -> dict[str, Any]:
-    out = records.to_dict()
-    for r, entry in zip(records.records, out["records"]):
-        entry["formula_bits"] = float(gnfs_log2_complexity(r.key_length))
-        entry["formula_minus_record_bits"] = None if r.log2_operations is None else entry["formula_bits"] - r.log2_operations
-    for row in out["nist_sp800_57"]["rows"]:
-        row["formula_bits"] = float(gnfs_log2_complexity(row["key_length"]))
-        row["formula_guillevic_bits"] = float(gnfs_log2_complexity(row["key_length"], GUILLEVIC_CORRECTION))
-    return out
-
-
-def compute(
-    A: Any,
-    B: Any,
-    *,
-    gamma_c: float,
-    tau_c: float,
-    upsilon: float,
-    sigma_u2: float,
-    sigma_w2: float,
-    sigma_x2: float = 1.0,
-    solver: str | None = None,
-    sdp_max_dimension: int | None = None,
-    cost_models: Sequence[str] | None = None,
-    gnfs_correction: Any = 0.0,
-    complexity: str = "sic2",
-    key_length: Any = None,
-    calibration: RecordSet | None = None,
-) -> dict[str, Any]:
-    """All quantities of the ``design`` output as a JSON-ready dict.
-
-    Parameters
-    ----------
-    A, B : array_like
-        Plant (``A`` Schur stable, ``n <= 1000``).
-    gamma_c, tau_c, upsilon, sigma_u2, sigma_w2, sigma_x2 : float
-        Design parameters (see the module docstring).
-    solver : str, optional
-        cvxpy solver for the attack designs.
-    sdp_max_dimension : int, optional
-        Largest ``n + m`` for the SDP rows (default :data:`~encctl_gym.security.attack_design.SDP_MAX_DIMENSION`).
-    cost_models : sequence of str, optional
-        Models for the cost-model section (none by default).
-    gnfs_correction : float, default 0.0
-        o(1) correction of the GNFS formula in the cost-model section.
-    complexity : str, default "sic2"
-        Which N* the cost-model section protects (:data:`COMPLEXITIES`).
-    key_length : int, optional
-        Key length valued in the cost-model section (default: the paper's k*).
-    calibration : RecordSet, optional
-        Records for the precomputation model (default: the shipped ones).
-
-    Returns
-    -------
-    dict
-        ``system``, ``parameters``, ``bounds``, ``designs`` (one :meth:`SecurityDesign.to_dict`
-        per method with ``ratio_to_paper``), ``skipped`` (rows not computed, with the reason),
-        and with ``cost_models`` also ``cost_models`` and ``records``.
-    """
-    A, B = check_system(A, B)
-    n, m = B.shape
-    _check_size(n, m)
-    rho = check_schur_stable(A)
-    gamma_c = check_positive("gamma_c", gamma_c)
-    tau_c = check_positive("tau_c", tau_c)
-    upsilon = check_positive("upsilon", upsilon)
-    su = check_positive("sigma_u2", sigma_u2)
-    sw = check_positive("sigma_w2", sigma_w2)
-    sx = check_nonnegative("sigma_x2", sigma_x2)
-    if not isinstance(complexity, str) or complexity not in COMPLEXITIES:
-        raise ParameterError(f"unknown complexity {format_value(complexity)}; choose one of {', '.join(COMPLEXITIES)}")
-    c = check_gnfs_correction(gnfs_correction)
-    tr_u = float(np.trace(controllability_gramian(A, B)))
-    tr_w = float(np.trace(noise_gramian(A)))
-    kw: dict[str, Any] = dict(gamma_c=gamma_c, tau_c=tau_c, upsilon=upsilon)
-    designs: dict[str, SecurityDesign] = {
-        "paper_sic2": design_from_traces(tr_u, tr_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=sx, method="asymptotic", **kw),
-        "exact_sic": design_from_traces(tr_u, tr_w, m, n, sigma_u2=su, sigma_w2=sw, sigma_x2=sx, method="exact", **kw),
-    }
-    attacks: dict[str, Any] = {}
-    skipped: dict[str, str] = {}
-    for kind, feedback in (("closed_loop", True), ("open_loop", False)):
-        try:
-            attacks[kind] = optimal_attack_design(
-                A, B, sigma_u2=su, sigma_w2=sw, feedback=feedback, solver=solver, max_dimension=sdp_max_dimension
-            )
-        except ResourceLimitError as exc:
-            skipped[kind] = str(exc)
-    attacks["gaussian"] = gaussian_attack_design(A, B, sigma_u2=su, sigma_w2=sw)
-    for kind, att in attacks.items():
-        designs[kind] = robust_security_design(A, B, sigma_u2=su, sigma_w2=sw, sigma_x2=sx, kind=kind, design=att, **kw)
-    designs = {k: designs[k] for k in LABELS if k in designs}
-    N_ref = designs["paper_sic2"].N_star
-    g_ref = float(sic_asymptotic_from_traces(N_ref, tr_u, tr_w, m, n, su / sw))
-    ratios = {
-        "paper_sic2": 1.0,
-        "exact_sic": float(sic_from_traces(N_ref, tr_u, tr_w, m, n, su, sw, sx)) / g_ref,
-        **{kind: float(att.gamma(N_ref)) / g_ref for kind, att in attacks.items()},
-    }
-    out_designs = {}
-    for name, d in designs.items():
-        entry = d.to_dict()
-        entry["ratio_to_paper"] = ratios[name]
-        if name in attacks:
-            entry["trace_inv_sigma"] = attacks[name].trace_inv
-        out_designs[name] = entry
-    res: dict[str, Any] = {
-        "system": {"n": n, "m": m, "spectral_radius": rho, "tr_psi_u": tr_u, "tr_psi_w": tr_w, "r_sigma": su / sw},
-        "parameters": {"gamma_c": gamma_c, "tau_c": tau_c, "upsilon": upsilon, "sigma_u2": su, "sigma_w2": sw, "sigma_x2": sx},
-        "bounds": {
-            "N": N_ref,
-            "input_upper_bound": float(input_upper_bound(N_ref, m, n, su / sw)),
-            "noise_upper_bound": float(noise_upper_bound(N_ref, m, n)),
-        },
-        "designs": out_designs,
-        "skipped": skipped,
-    }
-    if cost_models:
-        records = calibration if calibration is not None else default_records()
-        res["cost_models"] = _cost_model_section(
-            designs,
-            models=cost_models,
-            complexity=complexity,
-            gnfs_correction=c,
-            key_length=key_length,
-            records=records,
-            tau_c=tau_c,
-            upsilon=upsilon,
-        )
-        res["models"] = {name: _describe(name, c, records) for name in cost_models}
-        res["records"] = _records_section(records)
-    return res
-
-
-def _describe(name: str, c: float, records: RecordSet) -> dict[str, Any]:
-    return build_model(name, c, records).describe()
-
-
-# --------------------------------------------------------------------------- text output
 def _bits(x: float | None, width: int, digits: int = 3) -> str:
     if x is None:
         return f"{'-':>{width}}"
@@ -518,7 +287,7 @@ def run(args: argparse.Namespace) -> int:
         sources = {key: ("file" if key in spec.from_file else "default") for key in DESIGN_FIELDS}
     else:
         raise ConfigError("give a SYSTEM_FILE (JSON, YAML or NPZ with A and B) or --preset NAME")
-    values: dict[str, float] = {}
+    values: dict[str, Any] = {}
     for key in DESIGN_FIELDS:
         raw = getattr(args, key)
         if raw is None:
@@ -526,9 +295,7 @@ def run(args: argparse.Namespace) -> int:
         else:
             values[key] = parse_duration(raw, "tau_c") if key == "tau_c" else parse_number(key, raw)
             sources[key] = "option"
-    for key in ("gamma_c", "upsilon", "sigma_u2", "sigma_w2", "tau_c"):
-        check_positive(key, values[key])
-    check_nonnegative("sigma_x2", values["sigma_x2"])
+    threat = ThreatModel(**values)  # checks every value once
     if args.system_file:
         groups: dict[str, list[str]] = {}
         for key in DESIGN_FIELDS:
@@ -551,9 +318,9 @@ def run(args: argparse.Namespace) -> int:
     key_length = None if args.key_length is None else check_int("key_length", parse_number("key_length", args.key_length))
     records = None if args.calibration is None else load_records(args.calibration)
     sdp = None if args.sdp_max_dim is None else check_int("sdp_max_dim", parse_number("sdp_max_dim", args.sdp_max_dim), 2)
-    res = compute(
-        A,
-        B,
+    res = design_report(
+        (A, B),
+        threat,
         solver=args.solver,
         sdp_max_dimension=sdp,
         cost_models=models,
@@ -561,7 +328,6 @@ def run(args: argparse.Namespace) -> int:
         complexity=args.complexity,
         key_length=key_length,
         calibration=records,
-        **values,
     )
     if args.json:
         res["title"] = title

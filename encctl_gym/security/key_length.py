@@ -30,11 +30,13 @@ from dataclasses import asdict, dataclass
 from fractions import Fraction
 from typing import Any
 
-from .._validation import check_int
-from .cost_models import CostModel, PaperModel, deciphering_model, paper_security_parameter
+from .._validation import check_int, format_value
+from ..errors import ParameterError
+from .cost_models import DECIPHERING_MODELS, CostModel, PaperModel, deciphering_model, paper_security_parameter
 from .deciphering import keys_to_break, max_affordable_samples
 from .exact import decimal_fraction, log2_fraction
 from .records import nist_key_length, nist_strength
+from .threat import ThreatModel
 
 __all__ = ["KeyLengthDesign", "KeyValue", "design_key_length", "key_length_value", "defense_budget", "build_model"]
 
@@ -145,46 +147,40 @@ class KeyValue:
 
 
 def build_model(model: Any, gnfs_correction: Any = 0.0, calibration: Any = None) -> CostModel:
-    """A cost model by name with the options that apply to it: the GNFS correction for the paper and
-    precomputation models, the calibration for the precomputation model (a built model is returned
-    as it is)."""
+    """A cost model by name with the options that apply to it: the GNFS correction and the
+    calibration go to the models whose constructors take them (the paper and precomputation
+    models; the calibration only when given), so no model is named here. A built model is
+    returned as it is."""
     if isinstance(model, CostModel):
         return model
+    takes = DECIPHERING_MODELS.options(model)
     options: dict[str, Any] = {}
-    if model in ("paper", "precomputation"):
+    if "gnfs_correction" in takes:
         options["gnfs_correction"] = gnfs_correction
-    if model == "precomputation" and calibration is not None:
+    if "calibration" in takes and calibration is not None:
         options["calibration"] = calibration
     return deciphering_model(model, **options)
 
 
-def design_key_length(
-    model: Any,
-    N_star: int,
-    *,
-    tau_c: Any,
-    upsilon: Any,
-    scheme: str = "modified",
-    adversary: str = "eavesdropper",
-    gnfs_correction: Any = 0.0,
-    calibration: Any = None,
-) -> KeyLengthDesign:
-    """The smallest key length ``k*`` such that no ``N >= N*`` fits in ``tau_c`` under ``model``.
+def _threat(threat: Any, where: str) -> ThreatModel:
+    if not isinstance(threat, ThreatModel):
+        raise ParameterError(f"{where}: threat must be a ThreatModel, got {format_value(threat)}")
+    return threat
+
+
+def design_key_length(N_star: int, threat: ThreatModel, *, scheme: str = "modified") -> KeyLengthDesign:
+    """The smallest key length ``k*`` such that no ``N >= N*`` fits in ``tau_c`` under the threat's
+    cost model.
 
     Parameters
     ----------
-    model : {"paper", "precomputation", "generic"} or CostModel
-        Cost model (a built model carries its own correction and calibration).
     N_star : int
         Minimum sample size (>= 1), e.g. ``SecurityDesign.N_star``.
-    tau_c, upsilon : float
-        Defense period (s) and adversary FLOPS (> 0).
-    scheme, adversary : str
-        Key handling and adversary (:func:`~encctl_gym.security.deciphering.keys_to_break`).
-    gnfs_correction : float, default 0.0
-        o(1) correction of the GNFS formula (paper and precomputation models).
-    calibration : optional
-        Ratio calibration of the precomputation model.
+    threat : ThreatModel
+        ``tau_c``, ``upsilon``, the adversary and the cost model (a built model carries its own
+        GNFS correction and calibration: :func:`build_model`).
+    scheme : {"modified", "token", "static"}, default "modified"
+        Key handling (:func:`~encctl_gym.security.deciphering.keys_to_break`).
 
     Returns
     -------
@@ -195,10 +191,11 @@ def design_key_length(
     ModelRangeError
         If the answer lies outside the model's key-length range.
     """
-    m = build_model(model, gnfs_correction, calibration)
+    t = _threat(threat, "design_key_length")
+    m, adversary = t.model, t.adversary
     N_star = check_int("N_star", N_star, 1)
     keys = keys_to_break(N_star, scheme, adversary)
-    budget = defense_budget(tau_c, upsilon)
+    budget = defense_budget(t.tau_c, t.upsilon)
     k_star = m.minimum_key_length(keys, budget)
     cost = m.break_cost(k_star)
     work = log2_fraction(cost.operations(keys))
@@ -222,37 +219,30 @@ def design_key_length(
     )
 
 
-def key_length_value(
-    model: Any,
-    key_length: int,
-    *,
-    N_star: int,
-    tau_c: Any,
-    upsilon: Any,
-    scheme: str = "modified",
-    adversary: str = "eavesdropper",
-    gnfs_correction: Any = 0.0,
-    calibration: Any = None,
-) -> KeyValue:
-    """What a ``key_length``-bit key is worth under ``model`` against an adversary needing ``N*`` samples.
+def key_length_value(key_length: int, threat: ThreatModel, *, N_star: int, scheme: str = "modified") -> KeyValue:
+    """What a ``key_length``-bit key is worth under the threat's cost model against an adversary
+    needing ``N*`` samples.
 
     Parameters
     ----------
-    model, tau_c, upsilon, scheme, adversary, gnfs_correction, calibration
-        As in :func:`design_key_length`.
     key_length : int
         Bits of p.
+    threat : ThreatModel
+        As in :func:`design_key_length`.
     N_star : int
         Samples the adversary needs (>= 1).
+    scheme : str
+        As in :func:`design_key_length`.
 
     Returns
     -------
     KeyValue
     """
-    m = build_model(model, gnfs_correction, calibration)
+    t = _threat(threat, "key_length_value")
+    m, adversary = t.model, t.adversary
     N_star = check_int("N_star", N_star, 1)
     cost = m.break_cost(check_int("key_length", key_length))
-    n_max = max_affordable_samples(tau_c, cost, upsilon, scheme=scheme, adversary=adversary)
+    n_max = max_affordable_samples(t.tau_c, cost, t.upsilon, scheme=scheme, adversary=adversary)
     work = log2_fraction(cost.operations(keys_to_break(N_star, scheme, adversary)))
     if n_max == math.inf:
         log_n = math.inf

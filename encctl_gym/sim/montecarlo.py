@@ -2,10 +2,13 @@
 
 One task = one system: ``runs`` trajectories of length ``N_max`` under i.i.d. Gaussian attack
 inputs (Theorem thm:sic), and the error ``epsilon(N)`` of Definition def:error on a whole grid
-of sample sizes from each trajectory (:func:`~encctl_gym.ident.least_squares.identification_errors`),
+of sample sizes from each trajectory (:func:`~encctl_gym.ident.grid.identification_errors`),
 by least squares (eq:estimate) or any estimator of :mod:`encctl_gym.ident.registry`.
 A sweep spreads systems over workers with :func:`~encctl_gym.parallel.run_tasks`, one
-child seed per system.
+child seed per system. :func:`error_summaries` summarizes the runs per sample size with
+medians and quantiles, and flags the mean where the error's tail makes it infinite or
+unreliable (:mod:`encctl_gym.ident.tails`: least squares has no mean error below
+``N = n + m + 3``).
 """
 
 from __future__ import annotations
@@ -19,13 +22,15 @@ import numpy as np
 from .._validation import check_int, check_nonnegative, format_value
 from ..errors import ParameterError
 from ..ident.estimator import check_grid
-from ..ident.least_squares import check_sample_sizes, identification_errors
+from ..ident.grid import identification_errors
+from ..ident.least_squares import check_sample_sizes
 from ..ident.registry import make_estimator
+from ..ident.tails import ErrorSummary, error_tail_exponent, summarize_errors
 from ..parallel import SeedLike, run_tasks
 from ..resources import check_memory
 from .plant import LinearPlant, simulate_gaussian_attack
 
-__all__ = ["AttackSpec", "gaussian_attack_errors", "sweep_gaussian_attack", "log_grid"]
+__all__ = ["AttackSpec", "gaussian_attack_errors", "sweep_gaussian_attack", "log_grid", "error_summaries"]
 
 
 _N_MAX = 2**53  # the grid is spaced in float64 and rounded: integers beyond 2^53 are not exact
@@ -109,7 +114,7 @@ def gaussian_attack_errors(
     estimator : str, mapping or Estimator, optional
         Anything :func:`~encctl_gym.ident.registry.make_estimator` takes; ``None`` (default) is
         least squares with exactly the numbers of eq:estimate's grid
-        (:func:`~encctl_gym.ident.least_squares.identification_errors`). The same seed gives
+        (:func:`~encctl_gym.ident.grid.identification_errors`). The same seed gives
         the same trajectories whatever the estimator, so estimators compare on common data.
 
     Returns
@@ -194,3 +199,38 @@ def sweep_gaussian_attack(
         _task, jobs, seed=seed, n_jobs=n_jobs, scheduler=scheduler, cluster_kwargs=cluster_kwargs, progress=progress, desc=desc
     )
     return np.stack(out)
+
+
+def error_summaries(errors: Any, sample_sizes: Any, *, n: int, m: int, estimator: Any = None) -> list[ErrorSummary]:
+    """One :class:`~encctl_gym.ident.tails.ErrorSummary` per sample size of a Monte Carlo run.
+
+    Each carries the median and quantiles, the mean and its standard error, and the status of
+    the mean from the tail rule :func:`~encctl_gym.ident.tails.error_tail_exponent` (inputs with
+    a density, as the Gaussian attack) and the Hill check: ``"does not exist"`` below
+    ``N = n + m + 3`` for least squares, ``"unreliable"`` where the variance is infinite.
+
+    Parameters
+    ----------
+    errors : array_like, shape (runs, len(sample_sizes))
+        As returned by :func:`gaussian_attack_errors` (NaN: no estimate).
+    sample_sizes : array_like of int
+        The grid the errors were computed on.
+    n, m : int
+        Plant dimensions.
+    estimator : optional
+        The estimator the errors are of (``None``: least squares).
+
+    Returns
+    -------
+    list of ErrorSummary
+    """
+    try:
+        errors = np.asarray(errors, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"errors must be a numeric array, got {format_value(errors)}") from None
+    grid = [check_int(f"sample_sizes[{k}]", v, minimum=2) for k, v in enumerate(np.asarray(sample_sizes, dtype=object).ravel())]
+    if errors.ndim != 2 or errors.shape[1] != len(grid):
+        raise ParameterError(
+            f"errors must have shape (runs, {len(grid)}) for sample_sizes of length {len(grid)}, got {errors.shape}"
+        )
+    return [summarize_errors(errors[:, k], tail_exponent=error_tail_exponent(n, m, N, estimator)) for k, N in enumerate(grid)]

@@ -8,7 +8,8 @@ module                 holds
 ``settings``           :class:`Setting` (a system in one observation setting, with its bounds)
 ``attackers``          :data:`ATTACKERS` (baselines and the oracle by name), learned attackers
 ``statistics``         means, standard errors, paired ratios with 95 % intervals, the 1/N fit
-``protocol``           :class:`Curve`, :func:`evaluate`, :func:`compute` -> :class:`Result`
+``records``            :class:`Curve` and :class:`Result` (what a comparison measured)
+``protocol``           :func:`evaluate`, :func:`compute` -> :class:`Result`
 ``tables``             the rows (security consequence, paired ratios) and the CSV files
 ``plots``              the PNGs
 ``report``             the table printed by ``compare`` and ``evaluate``, ``summary.md``
@@ -18,7 +19,8 @@ module                 holds
 """
 
 from .attackers import ATTACKERS, learned_attackers, make_attackers, run_applies
-from .protocol import Curve, Result, compute, elgamal_check, evaluate, planned_steps
+from .protocol import compute, elgamal_check, evaluate, planned_steps
+from .records import Curve, Result
 from .report import comparison_table, findings, summary_markdown
 from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, Setting, length_grid, make_setting, parse_delays
 from .statistics import PairedRatio, fit_rate, mean_se, paired_ratio, samples_to_reach

@@ -11,33 +11,36 @@ a ``blind`` policy in every setting.
 from __future__ import annotations
 
 from collections import Counter
-from typing import Callable, Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from agents import Attacker, ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker, PRBSAttacker
 from agents.runs import RunInfo
 from encctl_gym.errors import ConfigError, EncctlError
+from encctl_gym.registry import Registry
 
 from .settings import Setting
 
 __all__ = ["ATTACKERS", "make_attackers", "run_applies", "learned_attackers"]
 
 #: Baseline and oracle attackers by name -> factory for a setting.
-ATTACKERS: dict[str, Callable[[Setting], Attacker]] = {
-    "gaussian": lambda s: GaussianAttacker(s.params),
-    "prbs": lambda s: PRBSAttacker(s.params),
-    "colored": lambda s: ColoredGaussianAttacker(s.params, rho=0.5),
-    "optimal": lambda s: OptimalDesignAttacker(s.params, design=s.design, feedback=s.params.decipher_delay is not None),
-}
+ATTACKERS: Registry[Callable[[Setting], Attacker]] = Registry(
+    "attacker",
+    {
+        "gaussian": lambda s: GaussianAttacker(s.params),
+        "prbs": lambda s: PRBSAttacker(s.params),
+        "colored": lambda s: ColoredGaussianAttacker(s.params, rho=0.5),
+        "optimal": lambda s: OptimalDesignAttacker(s.params, design=s.design, feedback=s.params.decipher_delay is not None),
+    },
+    error=ConfigError,
+)
 
 
 def make_attackers(setting: Setting, names: Sequence[str]) -> list[Attacker]:
     """The registered attackers ``names`` (keys of :data:`ATTACKERS`) built for ``setting``."""
-    unknown = [n for n in names if n not in ATTACKERS]
-    if unknown:
-        raise ConfigError(f"unknown attacker {unknown[0]!r}; choose among {', '.join(ATTACKERS)}")
-    return [ATTACKERS[n](setting) for n in names]
+    factories = [ATTACKERS.lookup(n) for n in names]  # every name is checked before any is built
+    return [make(setting) for make in factories]
 
 
 def run_applies(run: RunInfo, setting: Setting) -> bool:
@@ -71,7 +74,7 @@ def learned_attackers(setting: Setting, runs: Sequence[RunInfo], which: str = "b
                           "install the extra: pip install 'encctl-gym[rl]'") from exc
     names = [r.algo + ("-blind" if r.observation == "blind" else "") for r in chosen]
     count = Counter(names)
-    out = []
+    out: list[Attacker] = []
     for run, name in zip(chosen, names):
         label = name if count[name] == 1 else f"{name} ({run.path.name})"
         w = which if which == "final" or (run.path / "best_model.zip").exists() else "final"

@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 from agents.runs import MODEL_FILES, check_output_dir, find_runs
 from encctl_gym._validation import format_value
@@ -29,7 +29,8 @@ from encctl_gym.errors import ConfigError
 
 from .attackers import ATTACKERS
 from .plots import plot
-from .protocol import Result, compute
+from .protocol import compute
+from .records import Result
 from .report import summary_markdown
 from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, parse_delays
 from .tables import write_csvs

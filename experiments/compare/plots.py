@@ -1,6 +1,6 @@
 """Figures of a comparison: error against N per system, and the energy pacing within one attack.
 
-Every number drawn comes from a :class:`~experiments.compare.protocol.Result`.
+Every number drawn comes from a :class:`~experiments.compare.records.Result`.
 """
 
 from __future__ import annotations
@@ -11,7 +11,9 @@ from typing import Any
 
 import numpy as np
 
-from .protocol import Curve, Result
+from encctl_gym.plotting import legend_below, save_figure
+
+from .records import Curve, Result
 from .settings import Setting
 from .statistics import Z95
 
@@ -54,11 +56,23 @@ def plot(result: Result, out: Path) -> list[Path]:
             for c in cs:
                 lab = f"{c.attacker}{' (oracle)' if c.oracle else ''}, power {c.power.mean():.3g}"
                 top.plot(c.N, c.mean, color=color[c.attacker], lw=1.4, marker="o", ms=2.5, label=lab)
-                top.fill_between(c.N, np.maximum(c.mean - Z95 * c.se, 0.05 * c.mean), c.mean + Z95 * c.se,
-                                 color=color[c.attacker], alpha=0.2, lw=0)
+                top.fill_between(
+                    c.N,
+                    np.maximum(c.mean - Z95 * c.se, 0.05 * c.mean),
+                    c.mean + Z95 * c.se,
+                    color=color[c.attacker],
+                    alpha=0.2,
+                    lw=0,
+                )
                 bot.plot(c.N, (c.N - 1) * c.mean, color=color[c.attacker], lw=1.4, marker="o", ms=3)
-                bot.fill_between(c.N, (c.N - 1) * (c.mean - Z95 * c.se), (c.N - 1) * (c.mean + Z95 * c.se),
-                                 color=color[c.attacker], alpha=0.2, lw=0)
+                bot.fill_between(
+                    c.N,
+                    (c.N - 1) * (c.mean - Z95 * c.se),
+                    (c.N - 1) * (c.mean + Z95 * c.se),
+                    color=color[c.attacker],
+                    alpha=0.2,
+                    lw=0,
+                )
             gam, opt = s.params.gamma(Nline), s.design.gamma(Nline)
             top.plot(Nline, gam, "k--", lw=1.2, label="gamma(N), eq:sic (paper)")
             top.plot(Nline, opt, "k:", lw=1.6, label=f"gamma_opt(N), {s.design.kind}")
@@ -75,23 +89,35 @@ def plot(result: Result, out: Path) -> list[Path]:
             bot.set_xlabel("sample size N")
             for ax in (top, bot):
                 ax.grid(True, which="both", alpha=0.3)
-            top.legend(fontsize=7, loc="lower left")
-            if j == 0:
-                bot.legend(fontsize=7, loc="upper right")
-            # the axes hold the bounds and every attacker's band; a far worse curve may leave the top
+            # the axes hold the bounds and every attacker's points with their bands (the early,
+            # small-N points included)
             lo = min(float(np.nanmin((c.N - 1) * (c.mean - Z95 * np.nan_to_num(c.se)))) for c in cs)
+            hi = max(float(np.nanmax((c.N - 1) * (c.mean + Z95 * np.nan_to_num(c.se)))) for c in cs)
             ref = [float(gam[-1] * (Nline[-1] - 1)), float(gam[0] * (Nline[0] - 1)), s.design.rate, s.gauss.rate]
-            bot.set_ylim(0.85 * max(min([lo, *ref]), 1e-300), 2.5 * max(ref))
+            bot.set_ylim(0.85 * max(min([lo, *ref]), 1e-300), 1.15 * max(hi, 2.2 * max(ref)))
             g = [c for c in cs if c.attacker == "gaussian"]
-            top_hi = max(10 * float(np.nanmax(g[0].mean)) if g else 0.0, 1.5 * float(np.max(gam)), 1.5 * float(np.max(opt)))
+            top_hi = max(
+                10 * float(np.nanmax(g[0].mean)) if g else 0.0,
+                1.5 * float(np.max(gam)),
+                1.5 * float(np.max(opt)),
+                1.5 * max(float(np.nanmin(c.mean)) for c in cs),
+            )  # every curve keeps its best point in view
             top.set_ylim(0.3 * float(min(np.min(opt), np.min(gam))), top_hi)
         episodes = result.curves[sets[0].key][0].episodes
-        fig.suptitle("\n".join(textwrap.wrap(
-            f"Attackers against the sample identifying complexity: {system} ({episodes} episodes per attacker and N, "
-            "same seeds, energy budget m sigma_u2 N at every N)", 110)), fontsize=11)
-        fig.tight_layout(rect=(0, 0, 1, 0.96))
+        fig.suptitle(
+            "\n".join(
+                textwrap.wrap(
+                    f"Attackers against the sample identifying complexity: {system} ({episodes} episodes per attacker and N, "
+                    "same seeds, energy budget m sigma_u2 N at every N)",
+                    int(11 * fig.get_figwidth()),
+                )
+            ),
+            fontsize=11,
+        )
+        bottom = legend_below(fig, axes, ncol=3 * len(sets))  # one legend for every panel, off the data
+        fig.tight_layout(rect=(0, bottom, 1, 0.93 if len(sets) == 1 else 0.96))
         path = out / f"compare_{system}.png"
-        fig.savefig(path, dpi=110)
+        save_figure(fig, path, dpi=110)
         plt.close(fig)
         paths.append(path)
         along = [(s, c) for s in sets for c in result.curves[s.key] if c.along_N is not None]
@@ -114,15 +140,17 @@ def plot_pacing(system: str, along: list[tuple[Setting, Curve]], color: dict[str
     top.plot(Nl, s0.design.gamma(Nl), "k:", lw=1.5, label="gamma_opt(N)")
     bot.plot(Nl, Nl / s0.params.horizon, "k-", lw=0.8, alpha=0.6, label="uniform pacing")
     top.set(xscale="log", yscale="log", ylabel="mean error of the running estimate")
-    top.set_title(f"{system}, delay {s0.delay}: within one attack of N = {s0.params.horizon}\n"
-                  "(the energy budget holds for the whole attack)", fontsize=10)
+    top.set_title(
+        f"{system}, delay {s0.delay}: within one attack of N = {s0.params.horizon}\n"
+        "(the energy budget holds for the whole attack)",
+        fontsize=10,
+    )
     bot.set(xscale="log", xlabel="samples so far", ylabel="fraction of the energy budget spent")
-    top.legend(fontsize=7)
-    bot.legend(fontsize=7)
     for ax in (top, bot):
         ax.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
+    bottom = legend_below(fig, [top, bot], ncol=3)
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     path = Path(out) / f"pacing_{system}.png"
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path

@@ -23,9 +23,9 @@ from __future__ import annotations
 import math
 import sys
 import time
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -38,53 +38,15 @@ from encctl_gym.resources import check_memory
 from encctl_gym.sim.montecarlo import log_grid
 
 from .attackers import ATTACKERS, learned_attackers, make_attackers
+from .records import Curve, Result
 from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, Setting, length_grid, make_setting
 from .statistics import mean_se
+from .tables import bound_rows, security_row
 
-__all__ = ["Curve", "evaluate", "planned_steps", "record_bytes", "elgamal_check", "Result", "compute"]
+__all__ = ["evaluate", "planned_steps", "record_bytes", "elgamal_check", "compute"]
 
 #: The name the Gaussian baseline plays under (the reference of the paired ratios).
 GAUSSIAN_NAME = GaussianAttacker.name
-
-
-@dataclass
-class Curve:
-    """Mean error of one attacker against N, with the per-episode finals.
-
-    Attributes
-    ----------
-    attacker : str
-    oracle : bool
-        The attacker knows (A, B).
-    N, mean, se : ndarray (P,)
-        Grid of attack lengths, mean final error of the attacks of that length and its standard error.
-    episodes : int
-    final, power : ndarray (E,)
-        Final error and average power of each episode at the horizon (the last grid point).
-    seconds : float
-    along_N, along_mean, along_se, along_energy : ndarray, optional
-        With delivered states: the running estimate within one full-length attack and the mean
-        fraction of the episode's energy budget spent so far.
-    covariance : ndarray, optional
-        The regressor covariance the attacks at the horizon realised
-        (:attr:`agents.evaluate.Rollout.covariance`; its design efficiency is
-        :func:`agents.evaluate.design_efficiency`).
-    """
-
-    attacker: str
-    oracle: bool
-    N: np.ndarray
-    mean: np.ndarray
-    se: np.ndarray
-    episodes: int
-    final: np.ndarray
-    power: np.ndarray
-    seconds: float
-    along_N: np.ndarray | None = None
-    along_mean: np.ndarray | None = None
-    along_se: np.ndarray | None = None
-    along_energy: np.ndarray | None = None
-    covariance: np.ndarray | None = None
 
 
 def evaluate(setting: Setting, attacker: Attacker, *, episodes: int, seed: int, points: int, progress: Any = None) -> Curve:
@@ -167,34 +129,6 @@ def elgamal_check(setting: Setting, attacker: Attacker, *, episodes: int, N: int
     return rows
 
 
-@dataclass
-class Result:
-    """Everything one comparison measured.
-
-    Attributes
-    ----------
-    settings : list of Setting
-    curves : dict
-        ``(system, delay)`` -> the curves of that setting's attackers, in play order.
-    security, bounds : list of dict
-        Rows of :func:`~experiments.compare.tables.security_row` (one per attacker and
-        setting) and :func:`~experiments.compare.tables.bound_rows` (the references).
-    seconds : float
-    elgamal : list of dict
-        Rows of :func:`elgamal_check`.
-    seed : int
-        Environment seeds ``seed, seed + 1, ...`` of every attacker.
-    """
-
-    settings: list[Setting]
-    curves: dict[tuple[str, Any], list[Curve]]
-    security: list[dict[str, Any]]
-    bounds: list[dict[str, Any]]
-    seconds: float
-    elgamal: list[dict[str, Any]] = field(default_factory=list)
-    seed: int = 0
-
-
 def compute(
     systems: Sequence[str] = DEFAULT_SYSTEMS,
     *,
@@ -255,8 +189,6 @@ def compute(
         If the per-episode records (:func:`record_bytes`) would exceed
         :data:`encctl_gym.resources.MEMORY_LIMIT`, before any episode is played.
     """
-    from .tables import bound_rows, security_row
-
     t0 = time.perf_counter()
     infos = [r if isinstance(r, RunInfo) else read_run(r) for r in runs]
     if settings is None:

@@ -100,7 +100,7 @@ def make_setting(system: str, delay: Any, cap: int | None, *, config: dict[str, 
     base = resolve_params(cfg)
     target = length if length is not None else (cap if cap is not None and base.horizon > cap else None)
     capped = target is not None and target != base.horizon
-    if capped:  # another defense period, same lambda: the budget fractions keep their meaning
+    if target is not None and capped:  # another defense period, same lambda: the budget fractions keep their meaning
         cfg = budget_config(cfg, int(target))
     p = resolve_params(cfg)
     design = optimal_attack_design(p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, feedback=p.decipher_delay is not None)

@@ -4,8 +4,9 @@ single cases, command lines and hostile files."""
 from __future__ import annotations
 
 import json
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -61,8 +62,17 @@ def bad_args(
                 kwargs[param] = resolve(value)
                 return _call(target, kwargs, needs)
 
-            out.append(Case(f"{area}/{fname}({param}={label(value)})", area, cls, run, expect=expect,
-                            slow=slow or not representative, timeout=timeout))
+            out.append(
+                Case(
+                    f"{area}/{fname}({param}={label(value)})",
+                    area,
+                    cls,
+                    run,
+                    expect=expect,
+                    slow=slow or not representative,
+                    timeout=timeout,
+                )
+            )
     return out
 
 
@@ -85,6 +95,7 @@ def cli(
 
     ``argv`` may be a function of the scratch directory (to write the files it names).
     """
+
     def run(tmp: Path) -> CliRun:
         args = argv(tmp) if callable(argv) else argv
         return run_cli(list(args), check_options=check_options)
@@ -92,9 +103,16 @@ def cli(
     return Case(f"{area}/{name}", area, kind, run, expect=expect, **kw)
 
 
-def cli_valid(area: str, name: str, argv: Sequence[Any] | Callable[[Path], Sequence[Any]],
-              check: Callable[[CliRun], Any], kind: str = "silent", **kw: Any) -> Case:
+def cli_valid(
+    area: str,
+    name: str,
+    argv: Sequence[Any] | Callable[[Path], Sequence[Any]],
+    check: Callable[[CliRun], Any],
+    kind: str = "silent",
+    **kw: Any,
+) -> Case:
     """A valid command line: exit code 0 and ``check(run)``."""
+
     def run(tmp: Path) -> CliRun:
         args = argv(tmp) if callable(argv) else argv
         return run_cli(list(args))
@@ -163,7 +181,10 @@ FILES: dict[str, tuple[str, Any]] = {
     "oversized": ("big.json", lambda tmp: _oversized(tmp)),
     "unknown_suffix": ("plant.txt", '{"A": [[0.5]], "B": [[1]]}'),
     "npz_complex": ("complex.npz", lambda tmp: _npz(tmp, "complex.npz", A=np.array([[0.5, 0.1j], [0, 0.3]]), B=np.ones((2, 1)))),
-    "npz_object": ("object.npz", lambda tmp: _npz(tmp, "object.npz", A=np.array([[0.5, None], [0, 0.3]], dtype=object), B=np.ones((2, 1)))),
+    "npz_object": (
+        "object.npz",
+        lambda tmp: _npz(tmp, "object.npz", A=np.array([[0.5, None], [0, 0.3]], dtype=object), B=np.ones((2, 1))),
+    ),
     "npz_strings": ("strings.npz", lambda tmp: _npz(tmp, "strings.npz", A=np.array([["a", "b"], ["c", "d"]]), B=np.ones((2, 1)))),
     "npz_missing_b": ("nob.npz", lambda tmp: _npz(tmp, "nob.npz", A=0.5 * np.eye(2))),
     "npz_nan": ("nan.npz", lambda tmp: _npz(tmp, "nan.npz", A=np.array([[np.nan, 0], [0, 0.3]]), B=np.ones((2, 1)))),

@@ -8,8 +8,9 @@ failures are reported, not fixed, on the probe's branch.
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from .build import FILES, cli, cli_valid, write_file, write_json
 from .harness import Case, CliRun
@@ -29,7 +30,14 @@ def _design() -> list[Case]:
         out.append(cli(K, f"design --sigma-x2 {v!r}", [*P, "--sigma-x2", v], "silent"))
     for v in ("abc", "-5y", "1e-300", "0", "nan", "5 parsecs", "9" * 5000, "1e400y", "infs", "10y10y", "1e-20"):
         out.append(cli(K, f"design --tau-c {v[:12]!r}", [*P, "--tau-c", v], "silent"))
-    out.append(cli(K, "design paper-example --tau-c 1e-300 (the issue)", ["design", "--preset", "paper-example", "--tau-c", "1e-300"], "silent"))
+    out.append(
+        cli(
+            K,
+            "design paper-example --tau-c 1e-300 (the issue)",
+            ["design", "--preset", "paper-example", "--tau-c", "1e-300"],
+            "silent",
+        )
+    )
     for v in ("bogus", "", "['small']", "small,fig1-a"):
         out.append(cli(K, f"design --preset {v!r}", ["design", "--preset", v], "silent"))
     for v in ("bogus", "3"):
@@ -43,20 +51,62 @@ def _design() -> list[Case]:
     out.append(cli(K, "design --complexity bogus", [*P, "--complexity", "bogus"], "traceback"))
     for v in ("0", "-1", "abc", "2.5", "9" * 401, "1e308", "10", "100000000"):
         out.append(cli(K, f"design --key-length {v[:12]!r}", [*P, "--cost-model", "paper", "--key-length", v], "silent"))
-    for which in ("missing", "directory", "empty", "top_level_list", "deep_nesting_json", "digits_5000", "nan_json", "binary_junk", "oversized",
-                  "broken_yaml", "hostile_yaml"):
-        out.append(cli(K, f"design --calibration {which}", lambda tmp, w=which: [*P, "--cost-model", "precomputation", "--calibration", write_file(tmp, w)],
-                       "traceback"))
+    for which in (
+        "missing",
+        "directory",
+        "empty",
+        "top_level_list",
+        "deep_nesting_json",
+        "digits_5000",
+        "nan_json",
+        "binary_junk",
+        "oversized",
+        "broken_yaml",
+        "hostile_yaml",
+    ):
+        out.append(
+            cli(
+                K,
+                f"design --calibration {which}",
+                lambda tmp, w=which: [*P, "--cost-model", "precomputation", "--calibration", write_file(tmp, w)],
+                "traceback",
+            )
+        )
     for which in FILES:
-        out.append(cli(K, f"design FILE={which}", lambda tmp, w=which: ["design", write_file(tmp, w), "--json"],
-                       "hang" if which in ("alias_bomb", "oversized", "deep_nesting_json", "deep_nesting_yaml") else "traceback"))
-    out.append(cli(K, "design FILE and --preset", lambda tmp: ["design", write_json(tmp, "p.json", {"A": [[0.5]], "B": [[1]]}), "--preset", "small"],
-                   "silent"))
-    out.append(cli(K, "design FILE with a 200-state plant", lambda tmp: ["design", _big_plant(tmp, 200), "--json"], "hang", expect="either",
-                   timeout=120, slow=True))
+        out.append(
+            cli(
+                K,
+                f"design FILE={which}",
+                lambda tmp, w=which: ["design", write_file(tmp, w), "--json"],
+                "hang" if which in ("alias_bomb", "oversized", "deep_nesting_json", "deep_nesting_yaml") else "traceback",
+            )
+        )
+    out.append(
+        cli(
+            K,
+            "design FILE and --preset",
+            lambda tmp: ["design", write_json(tmp, "p.json", {"A": [[0.5]], "B": [[1]]}), "--preset", "small"],
+            "silent",
+        )
+    )
+    out.append(
+        cli(
+            K,
+            "design FILE with a 200-state plant",
+            lambda tmp: ["design", _big_plant(tmp, 200), "--json"],
+            "hang",
+            expect="either",
+            timeout=120,
+            slow=True,
+        )
+    )
     out.append(cli(K, "design --bogus-option", ["design", "--bogus-option"], check_options=False))
     out.append(cli(K, "design --tau-c (no value)", ["design", "--tau-c"], check_options=False))
-    out.append(cli_valid(K, "valid: design --preset paper-example --json", ["design", "--preset", "paper-example", "--json"], _design_json_ok))
+    out.append(
+        cli_valid(
+            K, "valid: design --preset paper-example --json", ["design", "--preset", "paper-example", "--json"], _design_json_ok
+        )
+    )
     return out
 
 
@@ -98,9 +148,24 @@ def _crack() -> list[Case]:
     base = ["crack", "--no-progress", "--json"]
     for v in ("0", "1", "-5", "abc", "2.5", "9" * 401, "4096", "100000"):
         out.append(cli(K, f"crack --bits {v[:12]!r}", [*base, "--bits", v, "--keys", "2"], "silent", timeout=30))
-    out.append(cli(K, "crack --bits 712 (index calculus) refused before any work", [*base, "--bits", "712", "--keys", "2"], "hang", timeout=30))
-    out.append(cli(K, "crack --bits 712 --breaker bsgs refused before any work", [*base, "--bits", "712", "--keys", "2", "--breaker", "bsgs"], "hang",
-                   timeout=30))
+    out.append(
+        cli(
+            K,
+            "crack --bits 712 (index calculus) refused before any work",
+            [*base, "--bits", "712", "--keys", "2"],
+            "hang",
+            timeout=30,
+        )
+    )
+    out.append(
+        cli(
+            K,
+            "crack --bits 712 --breaker bsgs refused before any work",
+            [*base, "--bits", "712", "--keys", "2", "--breaker", "bsgs"],
+            "hang",
+            timeout=30,
+        )
+    )
     for v in ("0", "-1", "abc", "2.5", "9" * 401, "1000000000000"):
         out.append(cli(K, f"crack --keys {v[:12]!r}", [*base, "--bits", "32", "--keys", v], "silent", timeout=30))
     for opt, vals in (("--breaker", ("bogus",)), ("--inner", ("bogus",)), ("--group", ("bogus",))):
@@ -112,19 +177,45 @@ def _crack() -> list[Case]:
         out.append(cli(K, f"crack --time-limit {v!r}", [*base, "--bits", "32", "--keys", "2", "--time-limit", v], "silent"))
     for v in ("-1", "abc", "2.5"):
         out.append(cli(K, f"crack --max-bits {v!r}", [*base, "--bits", "32", "--keys", "2", "--max-bits", v], "silent"))
-    out.append(cli(K, "crack --max-bits 100000 --bits 712 refused or bounded", [*base, "--bits", "712", "--keys", "1", "--max-bits", "100000",
-                                                                                "--breaker", "rho"], "hang", timeout=30))
+    out.append(
+        cli(
+            K,
+            "crack --max-bits 100000 --bits 712 refused or bounded",
+            [*base, "--bits", "712", "--keys", "1", "--max-bits", "100000", "--breaker", "rho"],
+            "hang",
+            timeout=30,
+        )
+    )
     for v in ("0", "abc", "-5"):
         out.append(cli(K, f"crack --n-jobs {v!r}", [*base, "--bits", "32", "--keys", "2", "--n-jobs", v], "silent"))
-    out.append(cli(K, "crack --scheduler bogus", [*base, "--bits", "32", "--keys", "2", "--scheduler", "bogus"], "traceback", timeout=30))
-    out.append(cli(K, "crack --breaker token-chain --inner token-chain", [*base, "--breaker", "token-chain", "--inner", "token-chain"]))
-    out.append(cli_valid(K, "valid: crack --bits 32 --keys 3", [*base, "--bits", "32", "--keys", "3", "--breaker", "bsgs"], _crack_ok))
+    out.append(
+        cli(K, "crack --scheduler bogus", [*base, "--bits", "32", "--keys", "2", "--scheduler", "bogus"], "traceback", timeout=30)
+    )
+    out.append(
+        cli(K, "crack --breaker token-chain --inner token-chain", [*base, "--breaker", "token-chain", "--inner", "token-chain"])
+    )
+    out.append(
+        cli_valid(K, "valid: crack --bits 32 --keys 3", [*base, "--bits", "32", "--keys", "3", "--breaker", "bsgs"], _crack_ok)
+    )
     for breaker in ("rho-multi", "pari"):
-        out.append(cli(K, f"crack --breaker {breaker} --max-bits 100000 --bits 712 refused", [*base, "--bits", "712", "--keys", "1", "--max-bits",
-                                                                                              "100000", "--breaker", breaker], "hang", timeout=30))
+        out.append(
+            cli(
+                K,
+                f"crack --breaker {breaker} --max-bits 100000 --bits 712 refused",
+                [*base, "--bits", "712", "--keys", "1", "--max-bits", "100000", "--breaker", breaker],
+                "hang",
+                timeout=30,
+            )
+        )
     out.append(cli(K, "crack --scheduler tcp:// (no address)", [*base, "--bits", "32", "--keys", "2", "--scheduler", "tcp://"]))
-    out.append(cli_valid(K, "valid: crack --keys 1 --json is strict JSON", [*base, "--bits", "32", "--keys", "1", "--breaker", "bsgs"],
-                         _crack_strict_json))
+    out.append(
+        cli_valid(
+            K,
+            "valid: crack --keys 1 --json is strict JSON",
+            [*base, "--bits", "32", "--keys", "1", "--breaker", "bsgs"],
+            _crack_strict_json,
+        )
+    )
     return out
 
 
@@ -147,38 +238,109 @@ def _agent(name: str, argv: Any, kind: str = "traceback", **kw: Any) -> Case:
 
 
 def _train_base(tmp: Path) -> list[Any]:
-    return ["train", "--algo", "ppo", "--preset", "small", "--quick", "--n-timesteps", "64", "--n-envs", "1", "--no-progress",
-            "--no-tensorboard", "--no-final-eval", "--out", tmp / "runs"]
+    return [
+        "train",
+        "--algo",
+        "ppo",
+        "--preset",
+        "small",
+        "--quick",
+        "--n-timesteps",
+        "64",
+        "--n-envs",
+        "1",
+        "--no-progress",
+        "--no-tensorboard",
+        "--no-final-eval",
+        "--out",
+        tmp / "runs",
+    ]
 
 
 def _train() -> list[Case]:
     out: list[Case] = []
     out.append(_agent("train --algo bogus", ["train", "--algo", "bogus"]))
     out.append(_agent("train --preset bogus", lambda tmp: [*_train_base(tmp), "--preset", "bogus"], "silent"))
-    for opt, vals in (("--n-timesteps", ("0", "-1", "abc", "9" * 401)), ("--n-envs", ("0", "-1", "abc", "1000000")), ("--seed", ("-1", "abc", "2.5")),
-                      ("--verbose", ("abc", "7", "-1"))):
+    for opt, vals in (
+        ("--n-timesteps", ("0", "-1", "abc", "9" * 401)),
+        ("--n-envs", ("0", "-1", "abc", "1000000")),
+        ("--seed", ("-1", "abc", "2.5")),
+        ("--verbose", ("abc", "7", "-1")),
+    ):
         for v in vals:
             out.append(_agent(f"train {opt} {v[:12]!r}", lambda tmp, o=opt, v=v: [*_train_base(tmp), o, v], "silent", timeout=90))
-    for which in ("missing", "broken_yaml", "hostile_yaml", "hostile_yaml_name", "top_level_list", "top_level_scalar", "alias_bomb", "digits_401",
-                  "binary_junk", "oversized", "deep_nesting_yaml"):
-        out.append(_agent(f"train --config {which}", lambda tmp, w=which: [*_train_base(tmp), "--config", write_file(tmp, w)],
-                          "hang" if which in ("alias_bomb", "oversized") else "traceback", timeout=90))
-        out.append(_agent(f"train --system {which}", lambda tmp, w=which: [*_train_base(tmp), "--system", write_file(tmp, w)],
-                          "hang" if which in ("alias_bomb", "oversized") else "traceback", timeout=90))
+    for which in (
+        "missing",
+        "broken_yaml",
+        "hostile_yaml",
+        "hostile_yaml_name",
+        "top_level_list",
+        "top_level_scalar",
+        "alias_bomb",
+        "digits_401",
+        "binary_junk",
+        "oversized",
+        "deep_nesting_yaml",
+    ):
+        out.append(
+            _agent(
+                f"train --config {which}",
+                lambda tmp, w=which: [*_train_base(tmp), "--config", write_file(tmp, w)],
+                "hang" if which in ("alias_bomb", "oversized") else "traceback",
+                timeout=90,
+            )
+        )
+        out.append(
+            _agent(
+                f"train --system {which}",
+                lambda tmp, w=which: [*_train_base(tmp), "--system", write_file(tmp, w)],
+                "hang" if which in ("alias_bomb", "oversized") else "traceback",
+                timeout=90,
+            )
+        )
     for which in ("unknown_key.yaml", "bad_hyper.yaml"):
         text = {"unknown_key.yaml": "bogus_section:\n  x: 1\n", "bad_hyper.yaml": "hyperparams:\n  learning_rate: abc\n"}[which]
-        out.append(_agent(f"train --config {which}", lambda tmp, w=which, t=text: [*_train_base(tmp), "--config", _write(tmp / w, t)], "silent",
-                          timeout=90))
-    for setting in ("policy_kwargs.activation_fn=bogus", "bogus.key=1", "env.max_samples=abc", "env.bogus=1", "hyperparams.gamma=2.5",
-                    "hyperparams.learning_rate=-1", "noequals", "=1", "env.gamma_opt=maybe", "hyperparams.n_steps=0", "env.x_bound=2e4",
-                    "hyperparams.batch_size=" + "9" * 401, "n_timesteps=!!python/object/apply:os.getcwd []",
-                    # found while fixing the above: seeds NumPy cannot take, counts no float holds, networks no memory holds
-                    "seed=4294967296", "eval.seed=" + "9" * 401, "horizon=" + "9" * 401, "eval.final_episodes=" + "9" * 401,
-                    "n_envs=" + "9" * 401, "eval.elgamal.key_length=100000", "hyperparams.policy_kwargs.net_arch=[100000000]"):
-        out.append(_agent(f"train --set {setting[:40]}", lambda tmp, s=setting: [*_train_base(tmp), "--set", s], "silent", timeout=90))
+        out.append(
+            _agent(
+                f"train --config {which}",
+                lambda tmp, w=which, t=text: [*_train_base(tmp), "--config", _write(tmp / w, t)],
+                "silent",
+                timeout=90,
+            )
+        )
+    for setting in (
+        "policy_kwargs.activation_fn=bogus",
+        "bogus.key=1",
+        "env.max_samples=abc",
+        "env.bogus=1",
+        "hyperparams.gamma=2.5",
+        "hyperparams.learning_rate=-1",
+        "noequals",
+        "=1",
+        "env.gamma_opt=maybe",
+        "hyperparams.n_steps=0",
+        "env.x_bound=2e4",
+        "hyperparams.batch_size=" + "9" * 401,
+        "n_timesteps=!!python/object/apply:os.getcwd []",
+        # found while fixing the above: seeds NumPy cannot take, counts no float holds, networks no memory holds
+        "seed=4294967296",
+        "eval.seed=" + "9" * 401,
+        "horizon=" + "9" * 401,
+        "eval.final_episodes=" + "9" * 401,
+        "n_envs=" + "9" * 401,
+        "eval.elgamal.key_length=100000",
+        "hyperparams.policy_kwargs.net_arch=[100000000]",
+    ):
+        out.append(
+            _agent(f"train --set {setting[:40]}", lambda tmp, s=setting: [*_train_base(tmp), "--set", s], "silent", timeout=90)
+        )
     out.append(_agent("train --out an existing file", lambda tmp: [*_train_base(tmp)[:-1], _touch(tmp / "afile")], timeout=90))
-    out.append(_agent("train --name ../escape", lambda tmp: [*_train_base(tmp), "--name", "../../escape"], "security", timeout=90))
-    out.append(_agent("train --name /abs", lambda tmp: [*_train_base(tmp), "--name", "/tmp/encctl-probe-abs"], "security", timeout=90))
+    out.append(
+        _agent("train --name ../escape", lambda tmp: [*_train_base(tmp), "--name", "../../escape"], "security", timeout=90)
+    )
+    out.append(
+        _agent("train --name /abs", lambda tmp: [*_train_base(tmp), "--name", "/tmp/encctl-probe-abs"], "security", timeout=90)
+    )
     out += _tune()
     return out
 
@@ -188,13 +350,23 @@ def _tune() -> list[Case]:
     out: list[Case] = []
     base = lambda tmp: ["tune", "--algo", "ars", "--preset", "small", "--quick", "--no-progress", "--out", tmp / "tune"]  # noqa: E731
     out.append(_agent("tune --algo bogus", ["tune", "--algo", "bogus"]))
-    for opt, vals in (("--trials", ("0", "-1", "abc", "9" * 401)), ("--episodes", ("1", "abc", "9" * 401)),
-                      ("--seed", ("-1", "abc", "4294967296")), ("--n-timesteps", ("0", "9" * 401))):
+    for opt, vals in (
+        ("--trials", ("0", "-1", "abc", "9" * 401)),
+        ("--episodes", ("1", "abc", "9" * 401)),
+        ("--seed", ("-1", "abc", "4294967296")),
+        ("--n-timesteps", ("0", "9" * 401)),
+    ):
         for v in vals:
             out.append(_agent(f"tune {opt} {v[:12]!r}", lambda tmp, o=opt, v=v: [*base(tmp), o, v], "silent", timeout=90))
     for setting in ("bogus.key=1", "hyperparams.n_delta=0", "noequals"):
         out.append(_agent(f"tune --set {setting}", lambda tmp, s=setting: [*base(tmp), "--set", s], "silent", timeout=90))
-    out.append(_agent("tune --config deep_nesting_yaml", lambda tmp: [*base(tmp), "--config", write_file(tmp, "deep_nesting_yaml")], timeout=90))
+    out.append(
+        _agent(
+            "tune --config deep_nesting_yaml",
+            lambda tmp: [*base(tmp), "--config", write_file(tmp, "deep_nesting_yaml")],
+            timeout=90,
+        )
+    )
     out.append(_agent("tune --out an existing file", lambda tmp: [*base(tmp)[:-1], _touch(tmp / "afile")], timeout=90))
     return out
 
@@ -215,8 +387,14 @@ def _run_dir(tmp: Path, meta: Any, model: bytes | None = None, name: str = "run"
     return d
 
 
-_META = {"algo": "ppo", "observation": "full", "env": {"preset": "small", "max_samples": 20}, "system": "small", "seed": 0,
-         "config": {"algo": "ppo", "system": "small"}}
+_META = {
+    "algo": "ppo",
+    "observation": "full",
+    "env": {"preset": "small", "max_samples": 20},
+    "system": "small",
+    "seed": 0,
+    "config": {"algo": "ppo", "system": "small"},
+}
 _RUNS: dict[str, Callable[[Path], Path]] = {
     "no run.json": lambda tmp: _run_dir(tmp, None, b"x"),
     "broken run.json": lambda tmp: _run_dir(tmp, "{not json", b"x"),
@@ -225,8 +403,12 @@ _RUNS: dict[str, Callable[[Path], Path]] = {
     "run.json unknown algo": lambda tmp: _run_dir(tmp, {**_META, "algo": "bogus"}, b"x"),
     "run.json bad env": lambda tmp: _run_dir(tmp, {**_META, "env": {"preset": "bogus"}}, b"x"),
     "run.json env x_bound 2e4": lambda tmp: _run_dir(tmp, {**_META, "env": {"preset": "small", "x_bound": 2e4}}, b"x"),
-    "run.json 5000 digits": lambda tmp: _run_dir(tmp, '{"algo": "ppo", "observation": "full", "env": {}, "seed": ' + "9" * 5000 + "}", b"x"),
-    "run.json deep nesting": lambda tmp: _run_dir(tmp, '{"algo": "ppo", "observation": "full", "env": ' + "[" * 100000 + "]" * 100000 + "}", b"x"),
+    "run.json 5000 digits": lambda tmp: _run_dir(
+        tmp, '{"algo": "ppo", "observation": "full", "env": {}, "seed": ' + "9" * 5000 + "}", b"x"
+    ),
+    "run.json deep nesting": lambda tmp: _run_dir(
+        tmp, '{"algo": "ppo", "observation": "full", "env": ' + "[" * 100000 + "]" * 100000 + "}", b"x"
+    ),
     "corrupt model.zip": lambda tmp: _run_dir(tmp, _META, b"PK\x03\x04" + b"\x00" * 40 + b"garbage"),
     "model.zip not a zip": lambda tmp: _run_dir(tmp, _META, b"not a zip at all"),
     "no model.zip": lambda tmp: _run_dir(tmp, _META, None),
@@ -238,24 +420,50 @@ _RUNS: dict[str, Callable[[Path], Path]] = {
 def _evaluate() -> list[Case]:
     out: list[Case] = []
     for name, make in _RUNS.items():
-        out.append(_agent(f"evaluate RUN_DIR={name}", lambda tmp, mk=make: ["evaluate", mk(tmp), "--episodes", "1", "--no-progress", "--out", tmp / "ev"],
-                          timeout=90))
+        out.append(
+            _agent(
+                f"evaluate RUN_DIR={name}",
+                lambda tmp, mk=make: ["evaluate", mk(tmp), "--episodes", "1", "--no-progress", "--out", tmp / "ev"],
+                timeout=90,
+            )
+        )
     good_meta = lambda tmp: _run_dir(tmp, _META, b"PK\x03\x04" + b"\x00" * 40)  # noqa: E731
-    for opt, vals in (("--episodes", ("0", "-1", "abc")), ("--systems", ("bogus", "")), ("--delays", ("abc", "-1", "2.5", "")),
-                      ("--samples", ("0", "-1", "abc", "9" * 401)), ("--points", ("0", "-1", "abc", "100000000")), ("--seed", ("-1", "abc")),
-                      ("--elgamal-episodes", ("-1", "abc")), ("--which", ("bogus",))):
+    for opt, vals in (
+        ("--episodes", ("0", "-1", "abc")),
+        ("--systems", ("bogus", "")),
+        ("--delays", ("abc", "-1", "2.5", "")),
+        ("--samples", ("0", "-1", "abc", "9" * 401)),
+        ("--points", ("0", "-1", "abc", "100000000")),
+        ("--seed", ("-1", "abc")),
+        ("--elgamal-episodes", ("-1", "abc")),
+        ("--which", ("bogus",)),
+    ):
         for v in vals:
-            out.append(_agent(f"evaluate {opt} {v!r}", lambda tmp, o=opt, v=v: ["evaluate", good_meta(tmp), o, v, "--no-progress", "--out", tmp / "ev"],
-                              "silent", timeout=90))
+            out.append(
+                _agent(
+                    f"evaluate {opt} {v!r}",
+                    lambda tmp, o=opt, v=v: ["evaluate", good_meta(tmp), o, v, "--no-progress", "--out", tmp / "ev"],
+                    "silent",
+                    timeout=90,
+                )
+            )
     return out
 
 
 def _compare() -> list[Case]:
     out: list[Case] = []
     base = lambda tmp: ["compare", "--quick", "--episodes", "1", "--no-progress", "--elgamal-episodes", "0", "--out", tmp / "cmp"]  # noqa: E731
-    for opt, vals in (("--delays", ("abc", "-1", "2.5", "", "0,abc")), ("--systems", ("bogus", "", "small,bogus")), ("--attackers", ("bogus", "", "gaussian,bogus")),
-                      ("--episodes", ("0", "-1", "abc", "1000000000000")), ("--max-samples", ("0", "-1", "abc", "9" * 401)), ("--points", ("0", "-1", "abc", "100000000")),
-                      ("--seed", ("-1", "abc")), ("--elgamal-episodes", ("-1", "abc")), ("--which", ("bogus",))):
+    for opt, vals in (
+        ("--delays", ("abc", "-1", "2.5", "", "0,abc")),
+        ("--systems", ("bogus", "", "small,bogus")),
+        ("--attackers", ("bogus", "", "gaussian,bogus")),
+        ("--episodes", ("0", "-1", "abc", "1000000000000")),
+        ("--max-samples", ("0", "-1", "abc", "9" * 401)),
+        ("--points", ("0", "-1", "abc", "100000000")),
+        ("--seed", ("-1", "abc")),
+        ("--elgamal-episodes", ("-1", "abc")),
+        ("--which", ("bogus",)),
+    ):
         for v in vals:
             out.append(_agent(f"compare {opt} {v[:12]!r}", lambda tmp, o=opt, v=v: [*base(tmp), o, v], "silent", timeout=120))
     for name in ("broken run.json", "corrupt model.zip", "run.json a list", "run dir missing", "run.json deep nesting"):

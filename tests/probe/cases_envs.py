@@ -57,22 +57,44 @@ def _config_cases() -> list[Case]:
     spec: dict[str, Any] = {
         "preset": explicit(["bogus", "", ["small"], 3, {"name": "small"}, b"small"]),
         "A": [(v, c) for v, c in BAD["matrix"] if v is not None] + explicit([np.array([[1.5, 0], [0, 0.5]]), np.eye(3) * 0.5]),
-        "B": explicit([np.ones((3, 2)), np.array([[1 + 1j, 0], [0, 1]]), np.array([[NAN, 0], [0, 1]]), "abc", np.ones((2, 2, 1)), np.zeros((2, 0))]),
+        "B": explicit(
+            [
+                np.ones((3, 2)),
+                np.array([[1 + 1j, 0], [0, 1]]),
+                np.array([[NAN, 0], [0, 1]]),
+                "abc",
+                np.ones((2, 2, 1)),
+                np.zeros((2, 0)),
+            ]
+        ),
         "sigma_w2": "pos?",
         "sigma_x2": "nonneg?",
         "sigma_u2": "pos?",
         "scheme": "name",
         "adversary": "name",
         "security_parameter": [(v, c) for v, c in BAD["pos"] if v is not None] + explicit([1e12, 2.0**53, 1e300], "hang"),
-        "key_length": [(v, c) for v, c in BAD["int"] if v is not None] + explicit([1e308, 10**308, 2**40], "hang") + explicit([39, 10], "silent"),
+        "key_length": [(v, c) for v, c in BAD["int"] if v is not None]
+        + explicit([1e308, 10**308, 2**40], "hang")
+        + explicit([39, 10], "silent"),
         "upsilon": "pos?",
         "tau_c": [(v, c) for v, c in BAD["duration"] if v is not None] + explicit([1e-300, 1e-30, "1e-300s"], "silent"),
         "gamma_c": "pos?",
         "max_samples": [(v, c) for v, c in BAD["int"] if v is not None and not (isinstance(v, int) and v > 10**300)],
         "decipher_delay": explicit([-1, 2.5, "soon", "END", np.array([1, 2]), True, NAN, [3], 3 + 0j]),
         "warmup_steps": BAD["int0"] + explicit([10**9, 10**12, HUGE], "hang"),
-        "estimator": explicit(["bogus", {"name": "bogus"}, {"name": "bayes", "bogus": 1}, 3, {"name": "forgetting", "forgetting_factor": 2.0},
-                               {}, {"name": "bayes", "prior_variance": -1.0}, ["ls"], {"name": "iv", "lags": -1}]),
+        "estimator": explicit(
+            [
+                "bogus",
+                {"name": "bogus"},
+                {"name": "bayes", "bogus": 1},
+                3,
+                {"name": "forgetting", "forgetting_factor": 2.0},
+                {},
+                {"name": "bayes", "prior_variance": -1.0},
+                ["ls"],
+                {"name": "iv", "lags": -1},
+            ]
+        ),
         "reward": "name",
         "logdet_regularization": BAD["pos"],
         "crypto": "name",
@@ -90,38 +112,113 @@ def _config_cases() -> list[Case]:
     out = bad_args(E, play, {}, spec, name="config", drawn=1)
     # keys the issue names, with the settings they need
     elg = {**BASE, "crypto": "elgamal", "key_length": 64, "max_samples": 20}
-    out += bad_args(E, lambda kw: _play({**elg, "breaker": "index-calculus", **kw}), {},
-                    {"breaker_time_limit": explicit([-1.0, 0.0, NAN, "abc", True, HUGE, None, "5 parsecs"]),
-                     "deciphering_clock": explicit(["bogus", 3])}, name="config(breaker)", drawn=0)
-    out += bad_args(E, lambda kw: _play({**BASE, **kw}), {},
-                    {"breaker": explicit(["bogus", 3, ["bsgs"], "index-calculus"]),  # the last needs crypto="elgamal"
-                     "deciphering_clock": explicit(["measured"])}, name="config(ideal)", drawn=0)
+    out += bad_args(
+        E,
+        lambda kw: _play({**elg, "breaker": "index-calculus", **kw}),
+        {},
+        {
+            "breaker_time_limit": explicit([-1.0, 0.0, NAN, "abc", True, HUGE, None, "5 parsecs"]),
+            "deciphering_clock": explicit(["bogus", 3]),
+        },
+        name="config(breaker)",
+        drawn=0,
+    )
+    out += bad_args(
+        E,
+        lambda kw: _play({**BASE, **kw}),
+        {},
+        {
+            "breaker": explicit(["bogus", 3, ["bsgs"], "index-calculus"]),  # the last needs crypto="elgamal"
+            "deciphering_clock": explicit(["measured"]),
+        },
+        name="config(ideal)",
+        drawn=0,
+    )
     for breaker in ("bsgs", "index-calculus", "rho", "rho-multi", "token-chain"):
-        out.append(case(E, f"config(breaker={breaker}, key_length=712) refused before any work", "hang",
-                        lambda _, b=breaker: _make({**BASE, "crypto": "elgamal", "key_length": 712, "max_samples": 20, "breaker": b}),
-                        timeout=30))
-    out.append(case(E, "config(deciphering_clock=measured, no max_samples)", "silent",
-                    lambda _: _play({**BASE, "crypto": "elgamal", "key_length": 64, "breaker": "index-calculus", "deciphering_clock": "measured"})))
-    out.append(case(E, "config(security_parameter=128) works or is refused quickly", "hang",
-                    lambda _: _play({**BASE, "security_parameter": 128}), expect="either", timeout=30))
-    out.append(case(E, "config(key_length=3000, ideal) works or is refused quickly", "hang",
-                    lambda _: _play({**BASE, "key_length": 3000}), expect="either", timeout=30))
-    out.append(case(E, "config(upsilon=tau_c=1e300) works or is refused quickly", "hang",
-                    lambda _: _play({**BASE, "upsilon": 1e300, "tau_c": 1e300}), expect="either", timeout=30))
-    out.append(case(E, "config(security_parameter and key_length disagree)", "silent",
-                    lambda _: _play({**BASE, "security_parameter": 74, "key_length": 2048})))
+        out.append(
+            case(
+                E,
+                f"config(breaker={breaker}, key_length=712) refused before any work",
+                "hang",
+                lambda _, b=breaker: _make({**BASE, "crypto": "elgamal", "key_length": 712, "max_samples": 20, "breaker": b}),
+                timeout=30,
+            )
+        )
+    out.append(
+        case(
+            E,
+            "config(deciphering_clock=measured, no max_samples)",
+            "silent",
+            lambda _: _play(
+                {**BASE, "crypto": "elgamal", "key_length": 64, "breaker": "index-calculus", "deciphering_clock": "measured"}
+            ),
+        )
+    )
+    out.append(
+        case(
+            E,
+            "config(security_parameter=128) works or is refused quickly",
+            "hang",
+            lambda _: _play({**BASE, "security_parameter": 128}),
+            expect="either",
+            timeout=30,
+        )
+    )
+    out.append(
+        case(
+            E,
+            "config(key_length=3000, ideal) works or is refused quickly",
+            "hang",
+            lambda _: _play({**BASE, "key_length": 3000}),
+            expect="either",
+            timeout=30,
+        )
+    )
+    out.append(
+        case(
+            E,
+            "config(upsilon=tau_c=1e300) works or is refused quickly",
+            "hang",
+            lambda _: _play({**BASE, "upsilon": 1e300, "tau_c": 1e300}),
+            expect="either",
+            timeout=30,
+        )
+    )
+    out.append(
+        case(
+            E,
+            "config(security_parameter and key_length disagree)",
+            "silent",
+            lambda _: _play({**BASE, "security_parameter": 74, "key_length": 2048}),
+        )
+    )
     out.append(case(E, "config(A without B)", "silent", lambda _: _play({**BASE, "preset": None, "A": A2})))
     for reward in ("logdet", "a_optimality"):
         for reg in (1e-300, 1e-320, 5e-324):
-            out.append(case(E, f"config(reward={reward}, logdet_regularization={reg:g}) gives finite rewards or an error", "silent",
-                            lambda _, r=reward, g=reg: _finite_rewards({**BASE, "reward": r, "logdet_regularization": g}), expect="either"))
+            out.append(
+                case(
+                    E,
+                    f"config(reward={reward}, logdet_regularization={reg:g}) gives finite rewards or an error",
+                    "silent",
+                    lambda _, r=reward, g=reg: _finite_rewards({**BASE, "reward": r, "logdet_regularization": g}),
+                    expect="either",
+                )
+            )
     out.append(case(E, "config(preset=None, nothing else)", "silent", lambda _: _play({**BASE, "preset": None})))
     out.append(case(E, "config(max_samples below n+m+1 with gamma)", "silent", lambda _: _play({**BASE, "max_samples": 0})))
     # the configuration argument itself
-    out += bad_args(E, lambda kw: api(ENV)(**kw), {"config": BASE},
-                    {"config": explicit(["abc", [1, 2], {1: 2}, 42, ("preset", "small")], "traceback"),
-                     "render_mode": explicit(["bogus", 3, "human", ["rgb_array"]]), "bogus_kwarg": explicit([1], "silent")},
-                    name="EncryptedLTIAttackEnv", drawn=0)
+    out += bad_args(
+        E,
+        lambda kw: api(ENV)(**kw),
+        {"config": BASE},
+        {
+            "config": explicit(["abc", [1, 2], {1: 2}, 42, ("preset", "small")], "traceback"),
+            "render_mode": explicit(["bogus", 3, "human", ["rgb_array"]]),
+            "bogus_kwarg": explicit([1], "silent"),
+        },
+        name="EncryptedLTIAttackEnv",
+        drawn=0,
+    )
     return out
 
 
@@ -132,21 +229,57 @@ def _reset_step_cases() -> list[Case]:
         env = _make(dict(BASE))
         return env.reset(**kw)
 
-    out += bad_args(E, reset, {}, {"seed": explicit([True, False, -1, 2.5, "a", [1, 2], NAN, 3 + 0j, np.array([1, 2])]),
-                                   "options": explicit(["abc", {"bogus": 1}, {"x0": np.array([1 + 1j, 0])}, {"x0": np.zeros(3)},
-                                                        {"x0": np.array([NAN, 0.0])}, {"x0": "abc"}, {"noise": np.zeros((5, 7))},
-                                                        {"noise": np.zeros((10**3, 2), dtype=complex)}, {"noise": "abc"}, [1],
-                                                        {"x0": np.array([HUGE, 0], dtype=object)}, {"noise": np.full((10**4, 2), NAN)}])},
-                    name="reset", drawn=0)
+    out += bad_args(
+        E,
+        reset,
+        {},
+        {
+            "seed": explicit([True, False, -1, 2.5, "a", [1, 2], NAN, 3 + 0j, np.array([1, 2])]),
+            "options": explicit(
+                [
+                    "abc",
+                    {"bogus": 1},
+                    {"x0": np.array([1 + 1j, 0])},
+                    {"x0": np.zeros(3)},
+                    {"x0": np.array([NAN, 0.0])},
+                    {"x0": "abc"},
+                    {"noise": np.zeros((5, 7))},
+                    {"noise": np.zeros((10**3, 2), dtype=complex)},
+                    {"noise": "abc"},
+                    [1],
+                    {"x0": np.array([HUGE, 0], dtype=object)},
+                    {"noise": np.full((10**4, 2), NAN)},
+                ]
+            ),
+        },
+        name="reset",
+        drawn=0,
+    )
 
     def step(kw: dict[str, Any]) -> Any:
         env = _make(dict(BASE))
         env.reset(seed=0)
         return env.step(**kw)
 
-    actions = explicit([np.array([NAN, 0.0], dtype=np.float32), np.array([INF, 0.0]), np.array([0.5 + 1j, 0.0]), np.array(["a", "b"]),
-                        "ab", np.zeros(3), None, np.array([2.0, 0.0]), {"a": 1}, np.array([0.1, None], dtype=object),
-                        [0.1, "x"], np.array([True, False]), 0.5, [HUGE, 0], np.zeros((2, 2))])
+    actions = explicit(
+        [
+            np.array([NAN, 0.0], dtype=np.float32),
+            np.array([INF, 0.0]),
+            np.array([0.5 + 1j, 0.0]),
+            np.array(["a", "b"]),
+            "ab",
+            np.zeros(3),
+            None,
+            np.array([2.0, 0.0]),
+            {"a": 1},
+            np.array([0.1, None], dtype=object),
+            [0.1, "x"],
+            np.array([True, False]),
+            0.5,
+            [HUGE, 0],
+            np.zeros((2, 2)),
+        ]
+    )
     out += bad_args(E, step, {}, {"action": actions}, name="step", drawn=0)
 
     def step_before_reset(_: Path) -> Any:
@@ -177,13 +310,29 @@ def _vector_cases() -> list[Case]:
         finally:
             env.close()
 
-    out += bad_args(V, make, {}, {"num_envs": BAD["int"] + explicit([10**6, 10**9], "hang"),
-                                  "config": explicit(["abc", [1], {"preset": "bogus"}, {"bogus_key": 1}, {"gamma_opt": "no"}, {"x_bound": 2e4}]),
-                                  "max_episode_steps": explicit([0, -1, 2.5, "a", True, NAN]),
-                                  "parallel": explicit(["no", 0, 1, None, NAN]), "helper_thread": explicit(["no", 0, 1, None, 3.5, "abc"])},
-                    name="EncryptedLTIAttackVectorEnv", drawn=0)
-    out.append(case(V, "EncryptedLTIAttackVectorEnv(num_envs=10**6) refused with an estimate", "hang",
-                    lambda _: api(VEC)(num_envs=10**6, config={"preset": "paper-example", "gamma_opt": False}, helper_thread=False), timeout=30))
+    out += bad_args(
+        V,
+        make,
+        {},
+        {
+            "num_envs": BAD["int"] + explicit([10**6, 10**9], "hang"),
+            "config": explicit(["abc", [1], {"preset": "bogus"}, {"bogus_key": 1}, {"gamma_opt": "no"}, {"x_bound": 2e4}]),
+            "max_episode_steps": explicit([0, -1, 2.5, "a", True, NAN]),
+            "parallel": explicit(["no", 0, 1, None, NAN]),
+            "helper_thread": explicit(["no", 0, 1, None, 3.5, "abc"]),
+        },
+        name="EncryptedLTIAttackVectorEnv",
+        drawn=0,
+    )
+    out.append(
+        case(
+            V,
+            "EncryptedLTIAttackVectorEnv(num_envs=10**6) refused with an estimate",
+            "hang",
+            lambda _: api(VEC)(num_envs=10**6, config={"preset": "paper-example", "gamma_opt": False}, helper_thread=False),
+            timeout=30,
+        )
+    )
 
     def reset(kw: dict[str, Any]) -> Any:
         env = api(VEC)(num_envs=2, config=dict(BASE), helper_thread=False)
@@ -192,9 +341,17 @@ def _vector_cases() -> list[Case]:
         finally:
             env.close()
 
-    out += bad_args(V, reset, {}, {"seed": explicit([True, -1, 2.5, "a", [1, 2, 3], [1, "a"], [True, False], NAN]),
-                                   "options": explicit(["abc", {"bogus": 1}, {"x0": np.zeros((3, 2))}, {"x0": np.full((2, 2), 1j)}])},
-                    name="vector.reset", drawn=0)
+    out += bad_args(
+        V,
+        reset,
+        {},
+        {
+            "seed": explicit([True, -1, 2.5, "a", [1, 2, 3], [1, "a"], [True, False], NAN]),
+            "options": explicit(["abc", {"bogus": 1}, {"x0": np.zeros((3, 2))}, {"x0": np.full((2, 2), 1j)}]),
+        },
+        name="vector.reset",
+        drawn=0,
+    )
 
     def step(kw: dict[str, Any]) -> Any:
         env = api(VEC)(num_envs=2, config=dict(BASE), helper_thread=False)
@@ -204,9 +361,29 @@ def _vector_cases() -> list[Case]:
         finally:
             env.close()
 
-    out += bad_args(V, step, {}, {"actions": explicit([np.zeros((2, 3)), np.zeros(2), np.zeros((3, 2)), np.full((2, 2), NAN), np.full((2, 2), 1j),
-                                                       np.array([["a", "b"], ["c", "d"]]), None, "ab", np.full((2, 2), 2.0), [[0.1, None], [0, 0]]])},
-                    name="vector.step", drawn=0)
+    out += bad_args(
+        V,
+        step,
+        {},
+        {
+            "actions": explicit(
+                [
+                    np.zeros((2, 3)),
+                    np.zeros(2),
+                    np.zeros((3, 2)),
+                    np.full((2, 2), NAN),
+                    np.full((2, 2), 1j),
+                    np.array([["a", "b"], ["c", "d"]]),
+                    None,
+                    "ab",
+                    np.full((2, 2), 2.0),
+                    [[0.1, None], [0, 0]],
+                ]
+            )
+        },
+        name="vector.step",
+        drawn=0,
+    )
 
     def step_before_reset(_: Path) -> Any:
         env = api(VEC)(num_envs=2, config=dict(BASE), helper_thread=False)
@@ -250,8 +427,17 @@ def _first_draws(src: Any, k: int = 4) -> tuple[int, ...]:
 
 def _server_randomness(scheme: str, seed: int | None) -> Any:
     def run(_: Path) -> None:
-        env = _make({**BASE, "crypto": "elgamal", "key_length": 64, "max_samples": 20, "scheme": scheme, "crypto_seed": seed,
-                     **({"adversary": "server"} if scheme == "token" else {})})
+        env = _make(
+            {
+                **BASE,
+                "crypto": "elgamal",
+                "key_length": 64,
+                "max_samples": 20,
+                "scheme": scheme,
+                "crypto_seed": seed,
+                **({"adversary": "server"} if scheme == "token" else {}),
+            }
+        )
         env.reset(seed=0)
         env.step(np.zeros(2, dtype=np.float32))
         loop = getattr(env.unwrapped, "loop", None) or getattr(env.unwrapped, "_loop", None)
@@ -271,6 +457,7 @@ def _server_randomness(scheme: str, seed: int | None) -> Any:
         held = _walk(server, (sk_cls,))
         if held:
             raise SecurityFinding(f"the {scheme} server holds a secret key: {held[:2]}")
+
     return run
 
 
@@ -325,8 +512,17 @@ def _privileged_documented(_: Path) -> None:
 
 def _security_cases() -> list[Case]:
     S = "security"
-    out = [case(E, f"the {s} server holds none of the plant's randomness (crypto_seed={seed})", S, _server_randomness(s, seed), expect="result")
-           for s in ("modified", "token", "static") for seed in (123, None)]
+    out = [
+        case(
+            E,
+            f"the {s} server holds none of the plant's randomness (crypto_seed={seed})",
+            S,
+            _server_randomness(s, seed),
+            expect="result",
+        )
+        for s in ("modified", "token", "static")
+        for seed in (123, None)
+    ]
     out += [
         case(E, "each party has its own stream under one crypto_seed", S, _parties_distinct_streams, expect="result"),
         case(E, "decipher_delay='end': nothing delivered before the end", S, _blind_until_end, expect="result"),

@@ -39,8 +39,9 @@ def _checkout() -> str:
 
     root = Path(encctl_gym.__file__).resolve().parents[1]
     try:
-        rev = subprocess.run(["git", "-C", str(root), "describe", "--always", "--dirty"], capture_output=True, text=True,
-                             timeout=10).stdout.strip()
+        rev = subprocess.run(
+            ["git", "-C", str(root), "describe", "--always", "--dirty"], capture_output=True, text=True, timeout=10
+        ).stdout.strip()
     except (OSError, subprocess.SubprocessError):
         rev = "?"
     return f"{root} (git {rev or '?'})"
@@ -66,7 +67,9 @@ def table(rows: dict[str, dict[str, int]]) -> str:
     lines = [head, "-" * len(head)]
     for key, row in rows.items():
         lines.append(f"{key:<10}" + "".join(f"{row[c]:>11}" for c in cols))
-    lines.append(f"(columns {', '.join(CLASSES)}: how the failing cases failed; n/a: the name the case needs is not in this checkout)")
+    lines.append(
+        f"(columns {', '.join(CLASSES)}: how the failing cases failed; n/a: the name the case needs is not in this checkout)"
+    )
     return "\n".join(lines)
 
 
@@ -95,12 +98,32 @@ def main(argv: list[str] | None = None) -> int:
     seconds = time.perf_counter() - t0
     rows = count(results, cases)
     if args.json:
-        print(json.dumps({
-            "checkout": where, "seconds": round(seconds, 1), "timeout": args.timeout, "counts": rows,
-            "cases": [{"name": c.name, "area": c.area, "class": c.kind, "expect": c.expect, "slow": c.slow, "owner": c.owner,
-                       "known": KNOWN_FAILURES.get(c.name), "outcome": results[c.name].outcome,
-                       "detail": results[c.name].detail[:500], "seconds": round(results[c.name].seconds, 3)} for c in cases],
-        }, indent=1))
+        print(
+            json.dumps(
+                {
+                    "checkout": where,
+                    "seconds": round(seconds, 1),
+                    "timeout": args.timeout,
+                    "counts": rows,
+                    "cases": [
+                        {
+                            "name": c.name,
+                            "area": c.area,
+                            "class": c.kind,
+                            "expect": c.expect,
+                            "slow": c.slow,
+                            "owner": c.owner,
+                            "known": KNOWN_FAILURES.get(c.name),
+                            "outcome": results[c.name].outcome,
+                            "detail": results[c.name].detail[:500],
+                            "seconds": round(results[c.name].seconds, 3),
+                        }
+                        for c in cases
+                    ],
+                },
+                indent=1,
+            )
+        )
         return 0
     if sys.stderr.isatty():
         print(file=sys.stderr)

@@ -47,8 +47,9 @@ import tempfile
 import time
 import traceback
 import warnings
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
-from typing import Any, Callable, Iterable, Sequence
+from typing import Any
 
 __all__ = [
     "CLASSES",
@@ -254,7 +255,7 @@ def run_cli(argv: Sequence[str], *, check_options: bool = True) -> CliRun:
     return CliRun(int(rc) if isinstance(rc, int) else -1, out.getvalue(), lines)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _known_options(command: str) -> frozenset[str]:
     build = api("encctl_gym.cli:build_parser")
     parser = build(command)
@@ -273,7 +274,7 @@ def _check_options(command: str, args: Sequence[str]) -> None:
 
 # --------------------------------------------------------------------------- running one case
 def _short(text: str, limit: int = 1500) -> str:
-    return text if len(text) <= limit else text[: limit // 2] + " ... " + text[-limit // 2:]
+    return text if len(text) <= limit else text[: limit // 2] + " ... " + text[-limit // 2 :]
 
 
 def _classify_cli(case: Case, run: CliRun) -> tuple[str, str]:
@@ -372,6 +373,7 @@ def _batch_child(cases: Sequence[Case], conn: Any, extra: int, scratch_root: str
             with contextlib.suppress(Exception):
                 importlib.import_module(module)
         import encctl_gym.errors  # noqa: F401 - execute needs it
+
         gc.freeze()  # what the child inherited is never collected: the collection after each case stays cheap
         conn.send(("ready",))
         for i, case in enumerate(cases):
@@ -473,8 +475,11 @@ def run_cases(
                     proc.join(5)
                     code = proc.exitcode
                     why = f"killed by signal {-code}" if code is not None and code < 0 else f"exit code {code}"
-                    record(Result(case.name, "hang", f"the child died ({why}): memory exhausted or a crash",
-                                  time.perf_counter() - t0))
+                    record(
+                        Result(
+                            case.name, "hang", f"the child died ({why}): memory exhausted or a crash", time.perf_counter() - t0
+                        )
+                    )
                     _kill(proc)
                     done += 1
                     break

@@ -23,7 +23,8 @@ from __future__ import annotations
 
 import math
 import zlib
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from hypothesis import HealthCheck, Phase, given, settings
@@ -36,11 +37,7 @@ INF = float("inf")
 HUGE = 10**400  # beyond float64, and str() works
 HUGER = 10**5000  # beyond Python's int-to-str limit of 4300 digits
 
-_TYPES_WRONG: list[tuple[Any, str]] = [
-    ("abc", "traceback"),
-    (None, "traceback"),
-    ([1.0, 2.0], "traceback"),
-]
+_TYPES_WRONG: list[tuple[Any, str]] = [("abc", "traceback"), (None, "traceback"), ([1.0, 2.0], "traceback")]
 
 _REAL_WRONG: list[tuple[Any, str]] = [
     (NAN, "silent"),
@@ -59,25 +56,59 @@ BAD: dict[str, list[tuple[Any, str]]] = {
     "real": list(_REAL_WRONG),
     "prob": [(0.0, "silent"), (1.5, "silent"), (-0.5, "silent"), *_REAL_WRONG],
     "int": [
-        (0, "silent"), (-1, "silent"), (2.5, "silent"), (True, "silent"), (NAN, "silent"), (INF, "silent"),
-        (3 + 0j, "silent"), (HUGE, "hang"), (HUGER, "traceback"), ("3", "traceback"), (None, "traceback"),
+        (0, "silent"),
+        (-1, "silent"),
+        (2.5, "silent"),
+        (True, "silent"),
+        (NAN, "silent"),
+        (INF, "silent"),
+        (3 + 0j, "silent"),
+        (HUGE, "hang"),
+        (HUGER, "traceback"),
+        ("3", "traceback"),
+        (None, "traceback"),
         ([3], "traceback"),
     ],
     "int0": [
-        (-1, "silent"), (2.5, "silent"), (True, "silent"), (NAN, "silent"), (INF, "silent"), (3 + 0j, "silent"),
-        (-HUGE, "traceback"), (HUGER, "traceback"), ("3", "traceback"), (None, "traceback"), ([3], "traceback"),
+        (-1, "silent"),
+        (2.5, "silent"),
+        (True, "silent"),
+        (NAN, "silent"),
+        (INF, "silent"),
+        (3 + 0j, "silent"),
+        (-HUGE, "traceback"),
+        (HUGER, "traceback"),
+        ("3", "traceback"),
+        (None, "traceback"),
+        ([3], "traceback"),
     ],
     "bool": [
-        ("no", "silent"), ("false", "silent"), (0, "silent"), (1, "silent"), (2, "silent"), (NAN, "silent"),
-        ([True], "silent"), (None, "silent"), (np.array([True, False]), "traceback"),
+        ("no", "silent"),
+        ("false", "silent"),
+        (0, "silent"),
+        (1, "silent"),
+        (2, "silent"),
+        (NAN, "silent"),
+        ([True], "silent"),
+        (None, "silent"),
+        (np.array([True, False]), "traceback"),
     ],
     "name": [
-        ("bogus", "silent"), ("", "silent"), (3, "traceback"), (None, "traceback"), (["x"], "traceback"),
+        ("bogus", "silent"),
+        ("", "silent"),
+        (3, "traceback"),
+        (None, "traceback"),
+        (["x"], "traceback"),
         ("x" * 10**6, "traceback"),
     ],
     "seed": [
-        (-1, "silent"), (2.5, "silent"), (True, "silent"), (NAN, "silent"), ("abc", "traceback"),
-        ([1, 2], "traceback"), (2 + 0j, "silent"),
+        (-1, "silent"),
+        (2.5, "silent"),
+        (True, "silent"),
+        (NAN, "silent"),
+        ("abc", "traceback"),
+        ([1, 2], "traceback"),
+        (2 + 0j, "silent"),
     ],
     "matrix": [
         (np.array([[0.5, 0.1], [0.0, 0.3 + 1j]]), "silent"),
@@ -110,10 +141,24 @@ BAD: dict[str, list[tuple[Any, str]]] = {
     ],
 }
 BAD["duration"] = [
-    ("abc", "traceback"), ("-5y", "silent"), ("5 parsecs", "traceback"), ("", "traceback"), ("nany", "silent"),
-    ("1e400y", "silent"), ("infy", "silent"), ("5y5y", "traceback"), ("9" * 10**6, "hang"),
-    (0.0, "silent"), (-1.0, "silent"), (NAN, "silent"), (INF, "silent"), (True, "silent"), (2 + 1j, "silent"),
-    (HUGE, "traceback"), (None, "traceback"), ([1.0], "traceback"),
+    ("abc", "traceback"),
+    ("-5y", "silent"),
+    ("5 parsecs", "traceback"),
+    ("", "traceback"),
+    ("nany", "silent"),
+    ("1e400y", "silent"),
+    ("infy", "silent"),
+    ("5y5y", "traceback"),
+    ("9" * 10**6, "hang"),
+    (0.0, "silent"),
+    (-1.0, "silent"),
+    (NAN, "silent"),
+    (INF, "silent"),
+    (True, "silent"),
+    (2 + 1j, "silent"),
+    (HUGE, "traceback"),
+    (None, "traceback"),
+    ([1.0], "traceback"),
 ]
 
 
@@ -151,8 +196,14 @@ def draw(strategy: st.SearchStrategy, n: int) -> list[Any]:
     seen: list[Any] = []
     keys: set[str] = set()
 
-    @settings(max_examples=max(4 * n, 20), derandomize=True, database=None, phases=[Phase.generate], deadline=None,
-              suppress_health_check=list(HealthCheck))
+    @settings(
+        max_examples=max(4 * n, 20),
+        derandomize=True,
+        database=None,
+        phases=[Phase.generate],
+        deadline=None,
+        suppress_health_check=list(HealthCheck),
+    )
     @given(strategy)
     def collect(value: Any) -> None:
         key = label(value) + type(value).__name__
@@ -176,23 +227,75 @@ STRATEGIES: dict[str, st.SearchStrategy] = {
     "nonneg": st.one_of(st.floats(max_value=-1e-300, allow_nan=False, allow_infinity=False), _complex, _non_number),
     "real": st.one_of(_complex, _non_number, st.integers(min_value=10**309, max_value=10**600)),
     "prob": st.one_of(st.floats(min_value=1.0000001, max_value=1e300), _non_positive, _complex),
-    "int": st.one_of(st.integers(max_value=0), st.floats(allow_nan=False, allow_infinity=False).filter(lambda v: not float(v).is_integer()), _non_number),
-    "int0": st.one_of(st.integers(max_value=-1), st.floats(allow_nan=False, allow_infinity=False).filter(lambda v: not float(v).is_integer())),
+    "int": st.one_of(
+        st.integers(max_value=0),
+        st.floats(allow_nan=False, allow_infinity=False).filter(lambda v: not float(v).is_integer()),
+        _non_number,
+    ),
+    "int0": st.one_of(
+        st.integers(max_value=-1), st.floats(allow_nan=False, allow_infinity=False).filter(lambda v: not float(v).is_integer())
+    ),
     "bool": st.one_of(st.integers(), _words, st.floats(allow_nan=True)),
-    "name": st.one_of(st.text(min_size=1, max_size=10).filter(lambda s: s.isidentifier() and s not in _NAMES_IN_USE), st.integers()),
+    "name": st.one_of(
+        st.text(min_size=1, max_size=10).filter(lambda s: s.isidentifier() and s not in _NAMES_IN_USE), st.integers()
+    ),
     "seed": st.one_of(st.integers(max_value=-1), st.floats(allow_nan=False).filter(lambda v: not float(v).is_integer())),
-    "matrix": st.lists(st.lists(st.complex_numbers(max_magnitude=0.4, allow_nan=False).filter(lambda z: z.imag != 0),
-                                min_size=2, max_size=2), min_size=2, max_size=2).map(np.array),
-    "vector": st.lists(st.complex_numbers(max_magnitude=0.4, allow_nan=False).filter(lambda z: z.imag != 0), min_size=2, max_size=2).map(np.array),
+    "matrix": st.lists(
+        st.lists(st.complex_numbers(max_magnitude=0.4, allow_nan=False).filter(lambda z: z.imag != 0), min_size=2, max_size=2),
+        min_size=2,
+        max_size=2,
+    ).map(np.array),
+    "vector": st.lists(
+        st.complex_numbers(max_magnitude=0.4, allow_nan=False).filter(lambda z: z.imag != 0), min_size=2, max_size=2
+    ).map(np.array),
     "duration": st.one_of(_words, _non_positive),
 }
 
 # names that pick a valid branch somewhere (a drawn "name" must not be one of them by chance)
 _NAMES_IN_USE = {
-    "modified", "token", "static", "eavesdropper", "server", "paper", "precomputation", "generic", "ideal", "elgamal",
-    "ls", "bayes", "forgetting", "iv", "log_error", "logdet", "a_optimality", "asymptotic", "exact", "sic", "sic2",
-    "closed_loop", "open_loop", "gaussian", "bsgs", "rho", "pari", "auto", "gram", "qr", "model", "measured", "end",
-    "all", "guillevic", "small", "fresh", "shipped", "best", "final", "prbs", "colored", "optimal",
+    "modified",
+    "token",
+    "static",
+    "eavesdropper",
+    "server",
+    "paper",
+    "precomputation",
+    "generic",
+    "ideal",
+    "elgamal",
+    "ls",
+    "bayes",
+    "forgetting",
+    "iv",
+    "log_error",
+    "logdet",
+    "a_optimality",
+    "asymptotic",
+    "exact",
+    "sic",
+    "sic2",
+    "closed_loop",
+    "open_loop",
+    "gaussian",
+    "bsgs",
+    "rho",
+    "pari",
+    "auto",
+    "gram",
+    "qr",
+    "model",
+    "measured",
+    "end",
+    "all",
+    "guillevic",
+    "small",
+    "fresh",
+    "shipped",
+    "best",
+    "final",
+    "prbs",
+    "colored",
+    "optimal",
 }
 
 _DRAWN: dict[str, list[Any]] = {}

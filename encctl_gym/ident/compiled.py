@@ -1,0 +1,190 @@
+"""Compiled online forms of estimators: what an estimator provides to run on the episode's fast path.
+
+An estimator that provides kernels implements :class:`ProvidesKernels`:
+``online_kernels(K, A, B, Q, refresh, cond_limit)`` returns an :class:`OnlineKernels` that keeps
+``K`` copies' estimates up to date from the episode's data arrays with compiled code, and
+scores them (Definition def:error) against the true plant. The episode uses it when the
+estimator provides one and calls the estimator column by column
+(:meth:`~encctl_gym.ident.estimator.Estimator.update`) otherwise: no estimator is special-cased
+by its class. :class:`OnlineKernels` with ``fused = True`` keep their steady state as the
+recursion ``Q = [P | Theta_hat^T]`` that the environment's fused step runs inline.
+
+:class:`RecursiveLeastSquaresKernels` is ordinary least squares' (eq:estimate): recursive least
+squares by Sherman-Morrison (:mod:`encctl_gym.ident._rls_kernels`), re-anchored to the exact
+solve from the running Gram matrices every ``refresh`` columns and at the end.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+
+from . import _rls_kernels as rk
+
+__all__ = ["OnlineKernels", "ProvidesKernels", "RecursiveLeastSquaresKernels"]
+
+
+@runtime_checkable
+class OnlineKernels(Protocol):
+    """K copies of an estimator's compiled online form, on the episode's arrays.
+
+    Attributes
+    ----------
+    fused : bool
+        Its steady state is the recursion in ``Q`` that the fused step runs.
+    all_ready : bool
+        Every copy is in the steady state.
+    since_refresh : int
+        Columns since the last exact re-anchoring.
+    refresh : int
+        Columns between exact re-anchorings.
+    """
+
+    fused: bool
+    all_ready: bool
+    since_refresh: int
+    refresh: int
+
+    def reset(self) -> None:
+        """Forget all data (a new episode)."""
+        ...
+
+    def add_columns(self, dims: Any, X: np.ndarray, U: np.ndarray, first: int, target: int, GC: np.ndarray) -> None:
+        """The regression columns ``first <= j < target`` into the Gram matrices ``GC`` and the estimates."""
+        ...
+
+    def steady_error(self, dims: Any, eps: np.ndarray) -> None:
+        """The error of every copy's estimate into ``eps`` (steady state: all copies ready)."""
+        ...
+
+    def settle(self, dims: Any, G: np.ndarray, C: np.ndarray, columns: int, delivered: int, final: bool, eps: np.ndarray) -> None:
+        """After ``columns`` new columns (``delivered`` samples in all): re-anchor where due (always
+        when ``final``), and the error of every copy with an estimate into ``eps``."""
+        ...
+
+
+@runtime_checkable
+class ProvidesKernels(Protocol):
+    """An estimator with a compiled online form (see the module docstring)."""
+
+    def online_kernels(
+        self, K: int, A: np.ndarray, B: np.ndarray, Q: np.ndarray, refresh: int, cond_limit: float
+    ) -> OnlineKernels:
+        """The compiled online form for ``K`` copies of the plant ``(A, B)``, keeping its state in ``Q``."""
+        ...
+
+
+def _condition(Gs: np.ndarray) -> np.ndarray:
+    """2-norm condition numbers of symmetric positive semidefinite matrices (..., d, d), from
+    their eigenvalues (``inf`` where singular)."""
+    lam = np.linalg.eigvalsh(Gs)
+    lo, hi = lam[..., 0], lam[..., -1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(lo > 0.0, hi / np.where(lo > 0.0, lo, 1.0), np.inf)
+
+
+def _pinv_psd(G: np.ndarray) -> np.ndarray:
+    """Moore-Penrose pseudo-inverses of symmetric positive semidefinite matrices (..., d, d),
+    from their eigendecompositions; eigenvalues below ``d * eps * max`` count as zero (NumPy's
+    default cut-off for ``pinv``)."""
+    lam, V = np.linalg.eigh(G)
+    keep = lam > G.shape[-1] * np.finfo(float).eps * lam[..., -1:]
+    inv = np.where(keep, 1.0 / np.where(keep, lam, 1.0), 0.0)
+    return (V * inv[..., None, :]) @ np.swapaxes(V, -1, -2)
+
+
+class RecursiveLeastSquaresKernels:
+    """Ordinary least squares (eq:estimate) online for K copies, compiled.
+
+    Parameters
+    ----------
+    K : int
+        Copies.
+    A, B : numpy.ndarray
+        The true plant (the error of Definition def:error is against it).
+    Q : numpy.ndarray, shape (d (d + n), K)
+        Where the recursion ``[P | Theta_hat^T]`` is kept (P by its upper triangle, copies innermost).
+    refresh : int
+        Every copy is re-anchored to the exact solve after this many columns.
+    cond_limit : float
+        A copy starts its recursion once the condition number of its Jacobi-scaled Gram matrix is below this.
+    """
+
+    fused = True
+
+    def __init__(self, K: int, A: np.ndarray, B: np.ndarray, Q: np.ndarray, refresh: int, cond_limit: float) -> None:
+        self.n, self.m = A.shape[0], B.shape[1]
+        self.d = self.n + self.m
+        self.K = K
+        self.theta_true_T = np.ascontiguousarray(np.hstack([A, B]).T)
+        self.c = float(self.n * self.d)  # Definition def:error
+        self.Q = Q
+        self.ready = np.zeros(K, dtype=bool)  # recursion started (well-conditioned Gram matrix)
+        self.refresh = refresh
+        self.cond_limit = cond_limit
+        self.since_refresh = 0
+        self.all_ready = False
+
+    def reset(self) -> None:
+        self.ready[:] = False
+        self.all_ready = False
+        self.since_refresh = 0
+
+    def add_columns(self, dims: Any, X: np.ndarray, U: np.ndarray, first: int, target: int, GC: np.ndarray) -> None:
+        rk.add_columns(dims, X, U, first, target, GC, self.Q, self.ready)
+
+    def steady_error(self, dims: Any, eps: np.ndarray) -> None:
+        rk.estimation_error(dims, self.Q, self.theta_true_T, self.c, self.ready, eps)
+
+    def settle(self, dims: Any, G: np.ndarray, C: np.ndarray, columns: int, delivered: int, final: bool, eps: np.ndarray) -> None:
+        if delivered - 1 < self.d:  # fewer than n + m columns: no estimate yet
+            return
+        self.since_refresh += columns
+        if final or self.since_refresh >= self.refresh:  # exact solve: bounds drift; final = eq:estimate
+            stale = np.ones(self.K, dtype=bool)
+            self.since_refresh = 0
+        else:
+            stale = ~self.ready
+        if stale.any():
+            rows = np.nonzero(stale)[0]
+            theta_hat_T = self._refresh(G, C, rows)
+            eps[rows] = ((theta_hat_T - self.theta_true_T) ** 2).sum(axis=(1, 2)) / self.c
+        rk.estimation_error(dims, self.Q, self.theta_true_T, self.c, self.ready & ~stale, eps)
+        self.all_ready = bool(self.ready.all())
+
+    def _refresh(self, G_all: np.ndarray, C_all: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """Exact least squares (eq:estimate) for the copies ``rows`` from the running Gram matrices.
+
+        A copy whose Jacobi-scaled Gram matrix is well conditioned (condition number below
+        ``cond_limit``) solves ``G [P | Theta_hat^T] = [I | C]`` and (re)starts its recursion
+        from the solution; any other copy gets the minimum-norm least-squares solution
+        ``pinv(G) C`` of eq:estimate and stays non-recursive. A started recursion is re-anchored
+        without a new check: G only grows, by positive semidefinite terms, so its smallest
+        eigenvalue never falls. Called for copies that are not yet recursive, and for every copy
+        each ``refresh`` columns to bound rounding drift. Returns Theta_hat^T of those copies,
+        shape (len(rows), n + m, n).
+        """
+        d = self.d
+        G, C = G_all[rows], C_all[rows]
+        ok = self.ready[rows]  # a copy: the ones already recursive stay so
+        if not ok.all():
+            fresh = ~ok
+            g = G[fresh]
+            s = 1.0 / np.sqrt(np.maximum(np.einsum("kii->ki", g), 1e-300))
+            ok[fresh] = _condition(g * s[:, :, None] * s[:, None, :]) < self.cond_limit
+        sol = np.zeros((len(rows), d, d + self.n))
+        if ok.any():
+            g, c = G[ok], C[ok]
+            s = 1.0 / np.sqrt(np.einsum("kii->ki", g))  # Jacobi scaling
+            rhs = np.concatenate((np.broadcast_to(np.eye(d), g.shape) * s[:, :, None], c * s[:, :, None]), axis=2)
+            try:
+                sol[ok] = np.linalg.solve(g * s[:, :, None] * s[:, None, :], rhs) * s[:, :, None]
+            except np.linalg.LinAlgError:  # cannot happen to a well-conditioned matrix; never crash on it
+                ok[:] = False
+        if not ok.all():
+            bad = ~ok
+            sol[bad, :, d:] = _pinv_psd(G[bad]) @ C[bad]
+        self.Q[:, rows[ok]] = sol[ok].reshape(-1, d * (d + self.n)).T
+        self.ready[rows] = ok
+        return sol[:, :, d:]

@@ -1,0 +1,128 @@
+"""The plant side's checks of what comes back from the controller server: audits and a detector.
+
+Both run where the secret key is, on the plant side of Figure fig:ecs, on batches of ``K`` loops
+in lockstep (the vector environment's copies), each with its own random stream:
+
+* :class:`Audit` -- with probability ``p`` per step the plant side recomputes ``Phi x`` itself
+  (it encrypted ``Phi``, so it knows it) and compares it with the input it decrypted; a difference
+  beyond the encoder's error bound is an alarm. A step whose input is the controller's own
+  (nothing injected) never alarms.
+* :class:`ChiSquaredDetector` -- no local controller computation: the closed-loop innovation
+  ``r[t] = x[t+1] - (A + B Phi) x[t]`` is ``N(0, Sigma)`` without an attack, so the window sum
+  ``S[t] = sum_{k=t-W+1}^{t} r_k^T Sigma^-1 r_k`` is chi-squared with ``n W`` degrees of freedom
+  and the threshold of :func:`encctl_gym.security.defenses.chi2_threshold` gives the false-alarm
+  rate per step. Whatever the attacker injects instead of ``Phi x`` enters ``r`` as
+  ``B (a - Phi x)``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .._validation import as_finite_array, check_int, check_nonnegative
+from ..errors import ParameterError, ShapeError
+from ..security.defenses import chi2_threshold
+
+__all__ = ["Audit", "ChiSquaredDetector"]
+
+
+class Audit:
+    """Random audits of the decrypted input against the plant side's own ``Phi x``.
+
+    Parameters
+    ----------
+    Phi : array_like, shape (m, n)
+        The controller gain the plant side encrypted.
+    rate : float
+        Audit probability per step, in [0, 1].
+    tolerance : float
+        The largest difference (max-norm) the encoding can explain: the decoded ``Phi x`` differs
+        from the real one by at most this much (the encoder's error bound).
+    rng : numpy.random.Generator
+        The plant side's own stream for the audit draws.
+    """
+
+    def __init__(self, Phi: Any, rate: float, tolerance: float, rng: np.random.Generator) -> None:
+        self.Phi = as_finite_array("Phi", Phi, ndim=2)
+        rate = check_nonnegative("audit_rate", rate)
+        if rate > 1:
+            raise ParameterError(f"audit_rate must lie in [0, 1], got {rate}")
+        self.rate = rate
+        self.tolerance = check_nonnegative("tolerance", tolerance)
+        self._rng = rng
+        self.audits = 0
+
+    def check(self, x: Any, u_decrypted: Any) -> np.ndarray:
+        """One step of ``K`` loops: which are audited and caught, shape (K,) of bool."""
+        x = np.atleast_2d(np.asarray(x, dtype=float))
+        u = np.atleast_2d(np.asarray(u_decrypted, dtype=float))
+        if x.shape[1] != self.Phi.shape[1] or u.shape != (x.shape[0], self.Phi.shape[0]):
+            raise ShapeError(
+                f"x and u must have shapes (K, {self.Phi.shape[1]}) and (K, {self.Phi.shape[0]}), got {x.shape} and {u.shape}"
+            )
+        audited = self._rng.random(x.shape[0]) < self.rate
+        self.audits += int(audited.sum())
+        if not audited.any():
+            return audited
+        diff = np.max(np.abs(u - x @ self.Phi.T), axis=1)
+        return audited & (diff > self.tolerance)
+
+
+class ChiSquaredDetector:
+    """The window chi-squared test on the closed-loop innovation (module docstring).
+
+    Parameters
+    ----------
+    A_cl : array_like, shape (n, n)
+        ``A + B Phi``.
+    noise_covariance : array_like, shape (n, n)
+        ``Sigma`` of the innovation without an attack (``sigma_w2 I``, plus ``sigma_d2 B B^T`` with
+        the defender's input noise); positive definite.
+    window : int
+        ``W``, the number of innovations summed.
+    false_alarm_rate : float
+        The target probability of an alarm at a step without an attack.
+    num_loops : int
+        ``K``, the loops checked in lockstep.
+    """
+
+    def __init__(self, A_cl: Any, noise_covariance: Any, *, window: int, false_alarm_rate: float, num_loops: int = 1) -> None:
+        self.A_cl = as_finite_array("A_cl", A_cl, ndim=2)
+        n = self.A_cl.shape[0]
+        S = as_finite_array("noise_covariance", noise_covariance, ndim=2)
+        if self.A_cl.shape != (n, n) or S.shape != (n, n):
+            raise ShapeError(f"A_cl and noise_covariance must be square of the same size, got {self.A_cl.shape} and {S.shape}")
+        try:
+            L = np.linalg.cholesky(0.5 * (S + S.T))
+        except np.linalg.LinAlgError:
+            raise ParameterError("noise_covariance must be positive definite") from None
+        self._whiten = np.linalg.inv(L)  # r^T Sigma^-1 r = ||L^-1 r||^2
+        self.window = check_int("window", window, minimum=1, maximum=10**6)
+        self.threshold = chi2_threshold(n, self.window, false_alarm_rate)
+        self.false_alarm_rate = float(false_alarm_rate)
+        self.K = check_int("num_loops", num_loops, minimum=1)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the window (a new episode)."""
+        self._buffer = np.zeros((self.K, self.window))
+        self._filled = 0
+        self._pos = 0
+        self.statistic = np.zeros(self.K)
+
+    def update(self, x: Any, x_next: Any) -> np.ndarray:
+        """Add the innovation of one step of ``K`` loops; returns the alarms, shape (K,) of bool
+        (none until the window is full)."""
+        x = np.atleast_2d(np.asarray(x, dtype=float))
+        x_next = np.atleast_2d(np.asarray(x_next, dtype=float))
+        r = x_next - x @ self.A_cl.T
+        s = np.sum((r @ self._whiten.T) ** 2, axis=1)
+        self._buffer[:, self._pos] = s
+        self._pos = (self._pos + 1) % self.window
+        self._filled = min(self._filled + 1, self.window)
+        self.statistic = self._buffer.sum(axis=1)
+        if self._filled < self.window:
+            return np.zeros(self.K, dtype=bool)
+        return self.statistic > self.threshold

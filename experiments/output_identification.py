@@ -1,0 +1,229 @@
+"""Identification from outputs: what measuring less costs the attacker in samples and the
+defender in key bits.
+
+For the design example (preset ``paper-example``) and Figure 1 (c) (``fig1-c``), the paper's
+Gaussian attack is measured through ``y = C x + v`` with ``C = I`` (every state), ``C = [I 0]``
+(half the states) and one output ``C = [1 1 1 1]``, each with ``sigma_v2 = 0`` and
+``sigma_v2 = sigma_w2``, and identified by N4SID, PO-MOESP and ARX
+(:mod:`encctl_gym.ident.subspace`). Every estimate is scored by the basis-free Markov-parameter
+error (:func:`~encctl_gym.ident.subspace.markov_error`); least squares on the states gives the
+reference, in the same error.
+
+The accuracy target is the one the paper designs for, moved into the Markov error: the fitted
+state least-squares Markov error at the paper's ``N*`` (eq:opt_sec). Each case's empirical
+complexity (:mod:`encctl_gym.security.empirical`, a fitted ``c / N^a`` with bootstrap intervals)
+gives the ``N*`` at which it reaches that target and the ``k*`` (paper model, eq:opt_key) a
+defender then needs, with intervals; an ``N*`` beyond the simulated grid is an extrapolation and
+is marked.
+
+    python -m experiments.output_identification [--runs 20] [--points 6] [--quick] [--out docs/results/output]
+
+Writes ``output_identification.csv``, ``output_identification.md`` and
+``output_identification.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from encctl_gym.errors import EncctlError
+from encctl_gym.plotting import legend_below, save_figure
+from encctl_gym.presets import get_preset
+from encctl_gym.security.design import design_security_parameter
+from encctl_gym.security.empirical import empirical_design, fit_empirical_complexity
+from encctl_gym.sim.output import OUTPUT_ESTIMATORS, output_attack_errors
+from encctl_gym.sim.plant import LinearPlant
+
+SYSTEMS = ("paper-example", "fig1-c")
+OUTPUTS = {"C = I": np.eye(4), "C = [I 0]": np.eye(4)[:2], "one output": np.ones((1, 4))}
+
+
+def run(runs: int, points: int, n_max: int | None, seed: int) -> list[dict[str, Any]]:
+    """Every case of the module docstring: one row each (the numbers of the table and figure)."""
+    rows: list[dict[str, Any]] = []
+    for system in SYSTEMS:
+        p = get_preset(system)
+        plant = LinearPlant(p.A, p.B, sigma_w2=p.sigma_w2)
+        paper = design_security_parameter(p.plant(), p.threat())
+        top = n_max or 2 * paper.N_star
+        grid = np.unique(np.geomspace(200, top, points).astype(int))
+        ref = output_attack_errors(
+            plant, np.eye(4), sample_sizes=grid, runs=runs, sigma_u2=p.sigma_u2, sigma_v2=0.0, seed=seed, estimator="arx"
+        )
+        ls_fit = fit_empirical_complexity(grid, ref["state_ls_markov"])
+        target = float(ls_fit(paper.N_star))
+        base = empirical_design(ls_fit, p.threat(), gamma_c=target)
+        rows.append(
+            _row(system, "states (least squares)", 0.0, "ls", grid, ref["state_ls_markov"], ls_fit, base, paper.N_star, target)
+        )
+        for label, C in OUTPUTS.items():
+            for sv in (0.0, p.sigma_w2):
+                for est in OUTPUT_ESTIMATORS:
+                    out = output_attack_errors(
+                        plant, C, sample_sizes=grid, runs=runs, sigma_u2=p.sigma_u2, sigma_v2=sv, seed=seed, estimator=est
+                    )
+                    fit = fit_empirical_complexity(grid, out["markov"])
+                    d: Any
+                    try:
+                        d = empirical_design(fit, p.threat(), gamma_c=target)
+                    except EncctlError as exc:  # a rate that does not decrease: reported, not designed
+                        d = exc
+                    rows.append(_row(system, label, sv, est, grid, out["markov"], fit, d, paper.N_star, target))
+    return rows
+
+
+def _row(
+    system: str,
+    output: str,
+    sigma_v2: float,
+    estimator: str,
+    grid: np.ndarray,
+    errors: np.ndarray,
+    fit: Any,
+    design: Any,
+    paper_N_star: int,
+    target: float,
+) -> dict[str, Any]:
+    row: dict[str, Any] = {
+        "system": system,
+        "output": output,
+        "sigma_v2": sigma_v2,
+        "estimator": estimator,
+        "runs": errors.shape[0],
+        "N": grid.tolist(),
+        "median": np.median(errors, axis=0).tolist(),
+        "mean": errors.mean(axis=0).tolist(),
+        "a": fit.a,
+        "a_low": fit.a_interval[0],
+        "a_high": fit.a_interval[1],
+        "target": target,
+        "paper_N_star": paper_N_star,
+    }
+    if isinstance(design, Exception):
+        row.update(
+            N_star="", N_star_low="", N_star_high="", k_star="", k_star_low="", k_star_high="", extrapolated="", note=str(design)
+        )
+    else:
+        row.update(
+            N_star=design.N_star,
+            N_star_low=design.N_star_interval[0],
+            N_star_high=design.N_star_interval[1],
+            k_star=design.k_star,
+            k_star_low=design.k_star_interval[0],
+            k_star_high=design.k_star_interval[1],
+            extrapolated=design.extrapolated,
+            note="",
+        )
+    return row
+
+
+def format_table(rows: list[dict[str, Any]]) -> str:
+    """The markdown table of the rows."""
+    head = (
+        "| system | measured | sigma_v2 | estimator | rate a [95 %] | N* [95 %] | k* (paper model) [95 %] |\n"
+        "|---|---|---|---|---|---|---|"
+    )
+    lines = [head]
+    for r in rows:
+        if r["N_star"] == "":
+            ns, ks = f"none ({r['note']})", "-"
+        else:
+            ext = " (extrapolated)" if r["extrapolated"] else ""
+            ns = f"{r['N_star']} [{r['N_star_low']}, {r['N_star_high']}]{ext}"
+            ks = f"{r['k_star']} [{r['k_star_low']}, {r['k_star_high']}]"
+        lines.append(
+            f"| {r['system']} | {r['output']} | {r['sigma_v2']:g} | {r['estimator']} | "
+            f"{r['a']:.3f} [{r['a_low']:.3f}, {r['a_high']:.3f}] | {ns} | {ks} |"
+        )
+    return "\n".join(lines)
+
+
+def write(rows: list[dict[str, Any]], out: Path) -> list[Path]:
+    """CSV, markdown and figure of the rows into ``out``."""
+    out.mkdir(parents=True, exist_ok=True)
+    fields = [k for k in rows[0] if k not in ("N", "median", "mean")]
+    csv_path = out / "output_identification.csv"
+    with csv_path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow([*fields, "N", "median", "mean"])
+        for r in rows:
+            w.writerow(
+                [r[f] for f in fields]
+                + [" ".join(map(str, r["N"])), " ".join(f"{v:.6g}" for v in r["median"]), " ".join(f"{v:.6g}" for v in r["mean"])]
+            )
+    md = out / "output_identification.md"
+    md.write_text(
+        "# Identification from outputs\n\nCommand: `python -m experiments.output_identification`"
+        f" ({rows[0]['runs']} runs per case). Target: the state least-squares Markov error at the paper's N*.\n\n"
+        + format_table(rows)
+        + "\n"
+    )
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    systems = list(dict.fromkeys(r["system"] for r in rows))
+    fig, axes = plt.subplots(
+        len(systems), len(OUTPUTS), figsize=(4.2 * len(OUTPUTS), 3.4 * len(systems)), squeeze=False, sharey="row"
+    )
+    colors = {"n4sid": "tab:blue", "moesp": "tab:orange", "arx": "tab:green", "ls": "k"}
+    for i, system in enumerate(systems):
+        ref = next(r for r in rows if r["system"] == system and r["estimator"] == "ls")
+        for j, label in enumerate(OUTPUTS):
+            ax = axes[i, j]
+            ax.plot(ref["N"], ref["mean"], color="k", lw=1.6, label="states, least squares")
+            for r in rows:
+                if r["system"] == system and r["output"] == label:
+                    ax.plot(
+                        r["N"],
+                        r["mean"],
+                        color=colors[r["estimator"]],
+                        ls="-" if r["sigma_v2"] == 0 else "--",
+                        marker="o",
+                        ms=2.5,
+                        label=f"{r['estimator']}, sigma_v2 = {r['sigma_v2']:g}",
+                    )
+            ax.axhline(ref["target"], color="0.5", lw=0.8, ls=":", label="target (states at the paper's N*)")
+            ax.set(xscale="log", yscale="log", title=f"{system}: {label}")
+            ax.grid(True, which="major", alpha=0.3)
+            if i == len(systems) - 1:
+                ax.set_xlabel("attack length N")
+            if j == 0:
+                ax.set_ylabel("mean Markov-parameter error")
+    bottom = legend_below(fig, axes, ncol=4)
+    fig.tight_layout(rect=(0, bottom, 1, 1))
+    png = save_figure(fig, out / "output_identification.png", dpi=100)
+    plt.close(fig)
+    return [csv_path, md, png]
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m experiments.output_identification", description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=20, help="attacks per case and N (default 20)")
+    parser.add_argument("--points", type=int, default=6, help="sample sizes on the log grid (default 6)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--quick", action="store_true", help="4 runs, 4 points up to N = 2000")
+    parser.add_argument("--out", type=Path, default=Path("results/output_identification"))
+    args = parser.parse_args(argv)
+    runs, points, n_max = (4, 4, 2000) if args.quick else (args.runs, args.points, None)
+    try:
+        rows = run(runs, points, n_max, args.seed)
+        paths = write(rows, args.out)
+    except EncctlError as exc:
+        print(f"output_identification: {exc}", file=sys.stderr)
+        return 2
+    print(format_table(rows))
+    for p in paths:
+        print(f"  wrote {p}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
