@@ -54,8 +54,8 @@ from typing import Any
 import yaml
 
 from encctl_gym._validation import format_value
+from encctl_gym.envs.config import completion_preset, resolve_params
 from encctl_gym.envs.config import default_config as env_default_config
-from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ConfigError, EncctlError, ParameterError
 
 from .base import OBSERVATION_MODES
@@ -211,20 +211,21 @@ def _check_algo(algo: Any) -> None:
         raise ConfigError(f"unknown algorithm {algo!r}; choose one of {', '.join(algos)}")
 
 
-def plant_config(path: str | Path, preset: str | None = None) -> dict[str, Any]:
+def plant_config(path: str | Path, preset: str | None) -> dict[str, Any]:
     """The environment entries of a plant file: ``A``, ``B`` and every design value.
 
     The one place ``train --system FILE`` reads a plant, through the package's one plant-file
     schema (:func:`encctl_gym.plant_file.load_plant_file`, the reader of ``encctl-gym design``):
     the values the file gives (variances, gamma_c, tau_c, Upsilon) are used, the others come
-    from ``preset`` (the system the configuration names, kept as the source of defaults) or,
-    without one, the paper's defaults. Every value is written out, so the environment takes
-    nothing from the preset silently.
+    from ``preset`` (the environment's rule, :func:`encctl_gym.envs.config.completion_preset`:
+    the system the configuration names, else ``paper-example``); with ``preset=None`` the file
+    must give them all. Every value is written out, so the environment takes nothing from the
+    preset silently.
     """
     from encctl_gym.plant_file import load_plant_file
     from encctl_gym.presets import get_preset
 
-    spec = load_plant_file(path, defaults=get_preset(preset) if preset is not None else None)
+    spec = load_plant_file(path, defaults=get_preset(preset) if preset is not None else {})
     return {"preset": preset, "A": spec.A.tolist(), "B": spec.B.tolist(), **spec.values()}
 
 
@@ -289,7 +290,7 @@ def load_config(
         if not isinstance(cfg.get("env"), dict):
             raise ConfigError(f"env must be a mapping, got {cfg.get('env')!r}")
     if system is not None:
-        cfg["env"].update(plant_config(system, cfg["env"].get("preset")))
+        cfg["env"].update(plant_config(system, completion_preset(cfg["env"])))
         cfg["system"] = Path(system).stem
     else:
         cfg["system"] = str(cfg["env"].get("preset"))

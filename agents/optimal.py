@@ -21,10 +21,18 @@ __all__ = ["OptimalDesignAttacker", "psd_sqrt"]
 
 
 def psd_sqrt(S: np.ndarray) -> np.ndarray:
-    """A square root ``L`` with ``L L^T = S`` of a symmetric PSD matrix (eigenvalues clipped at 0)."""
+    """The symmetric square root ``L = U diag(sqrt(w)) U^T`` (``L L^T = S``) of a symmetric PSD
+    matrix, eigenvalues clipped at 0.
+
+    The symmetric root is unique and continuous in ``S``; the factor ``U diag(sqrt(w))`` alone
+    is not: where eigenvalues coincide (the design example's ``V`` is a multiple of the identity)
+    the eigenvectors ``U`` are any basis, chosen by the rounding of the solver's last digits and
+    by the LAPACK build, and so would be the attacker's inputs for a given seed.
+    """
     S = 0.5 * (np.asarray(S, dtype=float) + np.asarray(S, dtype=float).T)
     w, U = np.linalg.eigh(S)
-    return U * np.sqrt(np.clip(w, 0.0, None))
+    L = (U * np.sqrt(np.clip(w, 0.0, None))) @ U.T
+    return 0.5 * (L + L.T)
 
 
 class OptimalDesignAttacker(Attacker):

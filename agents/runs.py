@@ -139,13 +139,18 @@ def read_run(run_dir: str | Path) -> RunInfo:
     Raises
     ------
     ConfigError
-        If the directory or its ``run.json`` is missing, larger than :data:`MAX_RUN_FILE_BYTES`,
+        If the directory does not exist (naming its ``-quick`` sibling when there is one, the
+        directory ``train --quick`` writes), its ``run.json`` is missing, larger than :data:`MAX_RUN_FILE_BYTES`,
         is not valid JSON (including integers of over 4300 digits and nesting deeper than
         Python's recursion limit), or lacks a field (``algo``, ``observation``, ``env``) or has
         one of the wrong type.
     """
     path = Path(run_dir)
     meta_path = path / RUN_FILE
+    if not path.exists():
+        quick = path.with_name(path.name + "-quick") if path.name else None
+        hint = f"; a smoke-test run (--quick) of that name is {str(quick)!r}" if quick is not None and (quick / RUN_FILE).is_file() else ""
+        raise ConfigError(f"the run directory {str(path)!r} does not exist{hint}")
     if not meta_path.is_file():
         raise ConfigError(f"{str(path)!r} is not a training run (no {RUN_FILE})")
     size = meta_path.stat().st_size
@@ -173,11 +178,14 @@ def read_run(run_dir: str | Path) -> RunInfo:
                    seed=seed, quick=bool(config.get("quick", False)), meta=meta)
 
 
-def find_runs(roots: Sequence[str | Path], *, include_quick: bool = False) -> list[RunInfo]:
+def find_runs(roots: Sequence[str | Path], *, include_quick: bool = False,
+              left_out: list[tuple[Path, str]] | None = None) -> list[RunInfo]:
     """The training runs (a ``run.json`` and a ``model.zip``) under ``roots``.
 
     A root that is itself a run is taken as given; under any other root every direct
     subdirectory that is a run counts, quick (smoke-test) runs only with ``include_quick``.
+    The directories with a ``run.json`` that are not taken (a quick run, a run without
+    ``model.zip``) are appended to ``left_out`` with the reason, when it is given.
 
     Raises
     ------
@@ -194,10 +202,14 @@ def find_runs(roots: Sequence[str | Path], *, include_quick: bool = False) -> li
             raise ConfigError(f"runs directory {str(root)!r} does not exist")
         for meta in sorted(root.glob(f"*/{RUN_FILE}")):
             if not (meta.parent / MODEL_FILES["final"]).exists():
+                if left_out is not None:
+                    left_out.append((meta.parent, f"no {MODEL_FILES['final']} (training unfinished or failed)"))
                 continue
             info = read_run(meta.parent)
             if include_quick or not info.quick:
                 out.append(info)
+            elif left_out is not None:
+                left_out.append((meta.parent, "a smoke-test run (--quick); give its directory to --runs to include it"))
     return out
 
 

@@ -318,10 +318,17 @@ def load_attacker(
                 vecnorm = VecNormalize.load(str(pkl_path), venv)
             except (EOFError, OSError, ValueError, KeyError, AttributeError, pickle.UnpicklingError) as exc:
                 raise ConfigError(f"cannot load {pkl_path}: {type(exc).__name__}: {_first_line(exc)}") from exc
-    return SB3Attacker(
-        model, vecnorm, deterministic, params=params, observation=run.observation, features=run.features,
-        name=name or run.algo,
-    )
+    try:
+        return SB3Attacker(
+            model, vecnorm, deterministic, params=params, observation=run.observation, features=run.features,
+            name=name or run.algo,
+        )
+    except ParameterError as exc:  # an environment other than the run's: name the run and the difference
+        trained = resolve_params(env_cfg)
+        diff = [f"{k} = {getattr(trained, k)} in training, {getattr(params, k)} here" for k in ("n", "m", "input_history")
+                if getattr(trained, k) != getattr(params, k)]
+        raise ConfigError(f"the run {run.path} cannot play in this environment: {exc}"
+                          + (f" ({'; '.join(diff)})" if diff else "")) from None
 
 
 def _first_line(exc: BaseException) -> str:

@@ -264,6 +264,21 @@ def _summary(r: Any) -> dict[str, Any]:
 
 
 # --------------------------------------------------------------------------- command line
+def system_summary(cfg: dict[str, Any], plant: str | Path) -> str:
+    """The line ``train --system FILE`` prints: the plant's values and the system's own defense
+    period ``tau_c``, then the training attack length and the shortened defense period that sets
+    it (``horizon``, :func:`agents.evaluate.budget_config`), which is not the system's."""
+    p = resolve_params({**cfg["env"], "gamma_opt": False})
+    text = (f"plant A ({p.n} x {p.n}), B ({p.n} x {p.m}) from {plant}; sigma_w2 = {p.sigma_w2:g}, sigma_u2 = {p.sigma_u2:g}, "
+            f"sigma_x2 = {p.sigma_x2:g}, gamma_c = {p.gamma_c:g}, defense period tau_c = {p.tau_c:g} s, Upsilon = {p.upsilon:g} "
+            f"(the values the file does not give are preset {cfg['env'].get('preset')}'s unless set with --set env.KEY=VALUE)")
+    t = resolve_params(env_config(cfg))
+    if t.horizon != p.horizon:
+        text += (f"; training attacks of N = {t.horizon} samples (horizon), through a defense period shortened to "
+                 f"{t.tau_c:g} s at lambda = {t.security_parameter:g} (the system's tau_c allows N = {p.horizon})")
+    return text
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``encctl-gym train``."""
     parser.add_argument("--algo", required=True, choices=list(ALGORITHMS), help="learning algorithm")
@@ -272,7 +287,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "agents/configs/{algo}_{preset}.yaml is merged over the algorithm's default when it exists")
     parser.add_argument("--system", default=None, metavar="FILE",
                         help="plant file (JSON/YAML {A: ..., B: ...} or NPZ, as `design` reads) replacing the preset's A and B; "
-                        "noise variances, gamma_c, tau_c and Upsilon stay the preset's unless set with --set env.KEY=VALUE")
+                        "the values the file does not give (noise variances, gamma_c, tau_c, Upsilon) come from the config's env.preset "
+                        "(default paper-example; env.preset=null: the file must give them), as for the environment's "
+                        "config={'A': A, 'B': B}; --set env.KEY=VALUE overrides any")
     parser.add_argument("--config", default=None, metavar="FILE",
                         help="config file merged over the algorithm's default (instead of the preset's tuned file)")
     parser.add_argument("--quick", action="store_true", help="smoke test: the configs' quick sections (a few thousand steps)")
@@ -302,10 +319,7 @@ def run(args: argparse.Namespace) -> int:
     for item in args.overrides:
         apply_override(cfg, item)
     if args.system is not None:
-        p = resolve_params(env_config(cfg))
-        print(f"plant A ({p.n} x {p.n}), B ({p.n} x {p.m}) from {args.system}; sigma_w2 = {p.sigma_w2:g}, "
-              f"sigma_u2 = {p.sigma_u2:g}, sigma_x2 = {p.sigma_x2:g}, gamma_c = {p.gamma_c:g}, tau_c = {p.tau_c:g} s, "
-              f"Upsilon = {p.upsilon:g} from preset {cfg['env'].get('preset')} unless set with --set env.KEY=VALUE")
+        print(system_summary(cfg, args.system))
     run_dir = train(cfg, out=args.out, seed=args.seed, progress=not args.no_progress, tensorboard=not args.no_tensorboard,
                     verbose=args.verbose, name=args.name, overwrite=args.overwrite)
     meta = read_run(run_dir).meta

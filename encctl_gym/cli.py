@@ -8,6 +8,7 @@ as one line (``encctl-gym: error: ...``) with exit code 2, never as a traceback.
 from __future__ import annotations
 
 import argparse
+import difflib
 import importlib
 import os
 import sys
@@ -88,7 +89,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args_list = list(sys.argv[1:] if argv is None else argv)
     selected = next((a for a in args_list if a in SUBCOMMANDS), None)
     parser = build_parser(selected)
-    args = parser.parse_args(args_list)
+    args, unknown = parser.parse_known_args(args_list)
+    if unknown:
+        _refuse_unknown(parser, getattr(args, "command", None), unknown)
     if not getattr(args, "_run", None):
         parser.print_help()
         return 2
@@ -103,6 +106,27 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # the reader of stdout went away (``encctl-gym design ... | head``)
         _silence_stdout()
         return 1
+
+
+def _refuse_unknown(parser: argparse.ArgumentParser, command: str | None, unknown: list[str]) -> NoReturn:
+    """Refuse arguments no parser took, from the subcommand they were given to, suggesting its
+    nearest option for each (``--gamma_c`` -> ``--gamma-c``): one line, exit code 2."""
+    target = parser
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction) and command in action.choices:
+            target = action.choices[command]
+    options = [o for action in target._actions for o in action.option_strings if o.startswith("--")]
+    hints = []
+    for arg in unknown:
+        name = arg.split("=", 1)[0]
+        if not name.startswith("-"):
+            continue
+        dashed = "--" + name.lstrip("-").replace("_", "-")
+        match = [dashed] if dashed in options else difflib.get_close_matches(dashed, options, n=1)
+        if match:
+            hints.append(f"did you mean {match[0]} for {name}?")
+    hint = ("; " + " ".join(hints)) if hints else ""
+    target.error(f"unrecognized arguments: {' '.join(unknown)}{hint}")
 
 
 def _silence_stdout() -> None:

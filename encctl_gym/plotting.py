@@ -190,7 +190,8 @@ def save_figure(fig: Any, path: str | Path, *, dpi: int = 110, tight: bool = Fal
 
 def legend_below(fig: Any, axes: Any, *, fontsize: float = 8, ncol: int | None = None) -> float:
     """One legend for the whole figure, below its axes, with every distinct label of ``axes``
-    (an array or list of axes) once; returns the fraction of the figure height it needs, for
+    (an array or list of axes) once, in ``ncol`` columns or as many fewer as the figure's width
+    holds; returns the fraction of the figure height it needs, for
     ``fig.tight_layout(rect=(0, that, 1, top))``."""
     import numpy as np
 
@@ -201,7 +202,14 @@ def legend_below(fig: Any, axes: Any, *, fontsize: float = 8, ncol: int | None =
     if not handles:
         return 0.0
     ncol = ncol or min(len(handles), 6)
+    renderer = _renderer(fig)
+    while True:  # as many columns as fit the figure's width
+        legend = fig.legend(
+            list(handles.values()), list(handles), loc="lower center", ncol=ncol, fontsize=fontsize, frameon=False
+        )
+        if ncol == 1 or legend.get_window_extent(renderer).width <= 0.98 * fig.bbox.width:
+            break
+        legend.remove()
+        ncol -= 1
     rows = -(-len(handles) // ncol)
-    height = fig.get_figheight()
-    fig.legend(list(handles.values()), list(handles), loc="lower center", ncol=ncol, fontsize=fontsize, frameon=False)
-    return min(0.4, (rows * fontsize * 1.9 + 6) / 72.0 / height)
+    return min(0.45, (rows * fontsize * 1.9 + 6) / 72.0 / fig.get_figheight())

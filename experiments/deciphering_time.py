@@ -56,6 +56,7 @@ from __future__ import annotations
 import argparse
 import csv
 import dataclasses
+import math
 import sys
 import time
 from collections.abc import Sequence
@@ -289,6 +290,38 @@ def write_csv(rows: Sequence[dict[str, Any]], path: str | Path, columns: Sequenc
     return path
 
 
+def _same_values(a: Sequence[dict[str, Any]], b: Sequence[dict[str, Any]], columns: Sequence[str]) -> bool:
+    """Whether two tables hold the same values: floats within a relative 1e-9 (a fit redone on
+    another machine's BLAS changes the last digits, not the value), NaN equal to NaN."""
+    if len(a) != len(b):
+        return False
+    for ra, rb in zip(a, b, strict=True):
+        for c in columns:
+            x, y = ra.get(c), rb.get(c)
+            if isinstance(x, float) or isinstance(y, float):
+                try:
+                    fx, fy = float(x), float(y)  # type: ignore[arg-type]
+                except (TypeError, ValueError):
+                    return False
+                if not (math.isclose(fx, fy, rel_tol=1e-9, abs_tol=0.0) or (math.isnan(fx) and math.isnan(fy))):
+                    return False
+            elif str(x) != str(y):
+                return False
+    return True
+
+
+def _write_csv_if_changed(rows: Sequence[dict[str, Any]], path: Path, columns: Sequence[str]) -> Path:
+    """Write ``rows`` to ``path`` unless the file already holds the same values (so that a
+    redraw ``--from-csv`` changes no data file)."""
+    if path.is_file():
+        try:
+            if _same_values(read_csv(path), rows, columns):
+                return path
+        except (OSError, ValueError, csv.Error):
+            pass  # unreadable or of another layout: overwrite it
+    return write_csv(rows, path, columns)
+
+
 def read_csv(path: str | Path) -> list[dict[str, Any]]:
     """Read ``deciphering_time.csv`` (or the fit CSV) back, numbers as int or float."""
     with Path(path).open(newline="") as fh:
@@ -474,8 +507,8 @@ def run(args: argparse.Namespace) -> int:
                        scheduler=args.scheduler, progress=not args.no_progress)
     elapsed = time.perf_counter() - t0
     fits = fit(rows)
-    csv_path = write_csv(rows, out / "deciphering_time.csv")
-    fit_path = write_csv(fits, out / "deciphering_time_fit.csv", FIT_COLUMNS)
+    csv_path = _write_csv_if_changed(rows, out / "deciphering_time.csv", COLUMNS)
+    fit_path = _write_csv_if_changed(fits, out / "deciphering_time_fit.csv", FIT_COLUMNS)
     png_path = plot(rows, out / "deciphering_time.png")
     models_path = plot_models(rows, out / "deciphering_models.png")
     print(f"Deciphering time: {len(rows)} rows in {elapsed:.1f} s" + (f" (read from {source})" if source else ""))

@@ -79,8 +79,8 @@ from encctl_gym.plotting import legend_below, save_figure
 from encctl_gym.security.design import minimum_key_length, optimal_security_parameter, sample_size_for_rate
 from encctl_gym.sim.montecarlo import log_grid
 from experiments.common import add_common_arguments, ensure_out_dir, entry_point
-from experiments.compare.attackers import ATTACKERS, learned_attackers, make_attackers
-from experiments.compare.settings import Setting, make_setting
+from experiments.compare.attackers import ATTACKERS, learned_players, left_out, make_attackers
+from experiments.compare.settings import Setting, make_setting, system_entry
 from experiments.compare.statistics import fit_rate
 from experiments.compare.tables import bound_rows
 
@@ -291,18 +291,20 @@ def compute(
     curves: dict[str, list[Curve]] = {}
     checks: dict[str, Any] = {}
     sizes: dict[str, Any] = {}
-    for system in systems:
-        s = make_setting(system, 0, cap)
+    for entry in systems:
+        system, plant = system_entry(entry)  # a preset, or a plant file as train --system reads it
+        s = make_setting(system, 0, cap, config=plant)
         settings.append(s)
         sizes[system] = table_sizes(s, cap)
         grid = attack_lengths(s, cap, points)
         p = s.params
         for est in ests:
             est.check_dimensions(p.n, p.m)
-        atts = make_attackers(s, tuple(ATTACKERS)) + learned_attackers(s, list(runs), which)
+        # a learned attacker plays in the environment it was trained in (its run.json)
+        atts = [(a, s) for a in make_attackers(s, tuple(ATTACKERS))] + learned_players(s, list(runs), which)
         curves[system] = []
         worst = 0.0
-        for att in atts:
+        for att, play in atts:
             errs = {est.label: np.full((replicates * episodes, grid.size), np.nan) for est in ests}  # type: ignore[attr-defined]
             if progress:
                 print(f"identification strategies: {system}, {att.name}, {grid.size} attack lengths up to {grid[-1]}, "
@@ -310,7 +312,7 @@ def compute(
             for r in range(replicates):
                 rows = slice(r * episodes, (r + 1) * episodes)
                 for k, N in enumerate(grid):
-                    x, u, eps_env = collect(att, budget_config(s.config, int(N)), episodes=episodes, seed=seed + r * episodes)
+                    x, u, eps_env = collect(att, budget_config(play.config, int(N)), episodes=episodes, seed=seed + r * episodes)
                     for est in ests:
                         if N < est.min_sample_size(p.n, p.m):
                             continue
@@ -663,7 +665,8 @@ def add_own_arguments(parser: argparse.ArgumentParser) -> None:
     """The options that ``encctl-gym reproduce`` does not have (their defaults apply there)."""
     parser.add_argument("--episodes", type=int, default=None, help=f"attacks per attacker and N (default {DEFAULT_EPISODES}; quick {QUICK_EPISODES})")
     parser.add_argument("--replicates", type=int, default=1, help="independent repetitions on disjoint seeds (default 1)")
-    parser.add_argument("--systems", default=None, help=f"comma-separated presets (default {','.join(DEFAULT_SYSTEMS)})")
+    parser.add_argument("--systems", default=None,
+                        help=f"comma-separated presets or plant files (as train --system reads; default {','.join(DEFAULT_SYSTEMS)})")
     parser.add_argument("--estimators", default=None, help=f"comma-separated registry names (default {','.join(DEFAULT_ESTIMATORS)}; "
                         f"known: {', '.join(estimator_names())})")
     parser.add_argument("--max-samples", type=int, default=None, help=f"cap on the attack length (default {DEFAULT_CAP}; quick {QUICK_CAP})")
@@ -686,8 +689,15 @@ def run(args: argparse.Namespace) -> int:
     roots = getattr(args, "runs", None) or []
     which = getattr(args, "which", "best")
     out = ensure_out_dir(getattr(args, "out", "results/strategies"))
+    skipped: list[tuple[Path, str]] = []
+    runs = find_runs(roots, left_out=skipped)
+    if runs:  # the runs that play in none of the systems, said before the work
+        entries = [system_entry(e) for e in systems]
+        skipped += [(r.path, why) for r, why in left_out(runs, [make_setting(label, 0, cap, config=cfg) for label, cfg in entries])]
+    for path, why in skipped:
+        print(f"identification strategies: leaving out the run {path}: {why}", file=sys.stderr)
     result = compute(systems, estimators=estimators, episodes=episodes, seed=args.seed, cap=cap, points=points,
-                     runs=find_runs(roots), which=which, progress=not getattr(args, "no_progress", True),
+                     runs=runs, which=which, progress=not getattr(args, "no_progress", True),
                      replicates=getattr(args, "replicates", 1) or 1)
     files = write_csvs(result, out)
     plots = plot(result, out)

@@ -245,3 +245,26 @@ def test_design_efficiency_of_the_gaussian_attack_and_the_oracle():
     assert design_efficiency(g.covariance, opt) == pytest.approx(best.fun / tr_inv(0.0), abs=0.02)
     assert design_efficiency(o.covariance, opt) == pytest.approx(1.0, abs=0.02)
     assert np.allclose(np.diag(g.covariance)[p.n :], p.sigma_u2, rtol=0.05)
+
+
+def test_the_design_noise_root_does_not_depend_on_the_eigenvector_basis():
+    """The design example's V is a multiple of the identity up to the solver's last digits: any
+    orthonormal basis diagonalises it, so an eigenvector factor U diag(sqrt(w)) (and the inputs
+    of a seed) is set by rounding; the symmetric root is sqrt(c) I for every such perturbation."""
+    from agents.optimal import psd_sqrt
+
+    rng = np.random.default_rng(0)
+    c, n = 8.5, 4
+    roots = []
+    for _ in range(3):
+        E = rng.standard_normal((n, n)) * 1e-12
+        S = c * np.eye(n) + (E + E.T)
+        L = psd_sqrt(S)
+        assert np.allclose(L @ L.T, S, rtol=0, atol=1e-9)
+        roots.append(L)
+    for L in roots:
+        assert np.allclose(L, np.sqrt(c) * np.eye(n), rtol=0, atol=1e-9)
+    # a rank-deficient covariance keeps its null space
+    u = np.array([[1.0], [2.0], [0.0], [0.0]])
+    L = psd_sqrt(u @ u.T)
+    assert np.allclose(L @ L.T, u @ u.T, atol=1e-12) and np.allclose(L[2:], 0.0)

@@ -97,6 +97,23 @@ def test_system_file_replaces_a_and_b(tmp_path):
         load_config("ppo", system=bad)  # unstable A: the environment's error, as a ConfigError
 
 
+def test_a_plant_file_and_the_environments_config_are_completed_by_one_rule(tmp_path):
+    """train --system and config={"A": A, "B": B} take the same missing values from the same
+    preset; with preset None neither completes anything."""
+    from agents.config import plant_config
+
+    A, B = [[0.5, 0.1], [0.0, 0.3]], [[1.0], [0.5]]
+    f = tmp_path / "plant.json"
+    f.write_text(json.dumps({"A": A, "B": B}))
+    cli_side = resolve_params(env_config(load_config("ppo", system=f)))
+    with pytest.warns(UserWarning, match="sigma_w2"):
+        env_side = resolve_params({"A": A, "B": B, "gamma_opt": False})
+    keys = ("sigma_w2", "sigma_u2", "sigma_x2", "gamma_c", "upsilon")
+    assert [getattr(cli_side, k) for k in keys] == [getattr(env_side, k) for k in keys]
+    with pytest.raises(ConfigError, match="sigma_w2"):
+        plant_config(f, None)
+
+
 # ------------------------------------------------------------------ the schema and --set
 @pytest.mark.parametrize(
     "item, needle",

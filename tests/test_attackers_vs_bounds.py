@@ -299,3 +299,30 @@ def test_record_bytes_by_hand():
 
     with pytest.raises(ResourceLimitError, match="episodes = 1000000000000"):
         cmp.compute(["small"], delays=(0,), episodes=10**12, cap=20, points=4, attackers=("gaussian",), elgamal_episodes=0)
+
+
+def test_the_kernels_are_warmed_before_the_progress_bar_starts(monkeypatch):
+    """The bar's rate, and so its ETA, must not include compile time: one short episode of every
+    setting is played before the bar is made, and the results do not depend on it."""
+    import tqdm
+
+    from experiments.compare import protocol
+
+    events: list[str] = []
+    real_warm_up, real_tqdm = protocol.warm_up, tqdm.tqdm
+
+    def warm_up(*args, **kwargs):
+        events.append("warm")
+        return real_warm_up(*args, **kwargs)
+
+    def bar(*args, **kwargs):
+        events.append("bar")
+        return real_tqdm(*args, **{**kwargs, "disable": True})
+
+    monkeypatch.setattr(protocol, "warm_up", warm_up)
+    monkeypatch.setattr(tqdm, "tqdm", bar)
+    kw = dict(delays=(0,), episodes=4, seed=3, cap=20, points=2, attackers=("gaussian",), elgamal_episodes=1)
+    with_bar = cmp.compute(["small"], progress=True, **kw)
+    assert events[:2] == ["warm", "bar"], events
+    plain = cmp.compute(["small"], progress=False, **kw)
+    assert with_bar.security == plain.security

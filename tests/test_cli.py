@@ -57,7 +57,8 @@ def test_a_reader_that_closes_the_pipe_ends_the_command_quietly() -> None:
     # `encctl-gym design ... | head -1`: the reader goes away after one line
     proc = subprocess.Popen(
         [sys.executable, "-m", "encctl_gym.cli", "design", "--preset", "paper-example", "--cost-model", "all"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
     )
     assert proc.stdout is not None
     proc.stdout.readline()
@@ -65,3 +66,17 @@ def test_a_reader_that_closes_the_pipe_ends_the_command_quietly() -> None:
     _, err = proc.communicate(timeout=120)
     assert b"Traceback" not in err and b"BrokenPipeError" not in err
     assert proc.returncode in (0, 1)
+
+
+def test_python_dash_m_encctl_gym_runs_the_command_line() -> None:
+    res = subprocess.run([sys.executable, "-m", "encctl_gym", "--version"], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0 and "encctl-gym" in res.stdout, res.stderr
+
+
+def test_an_underscored_option_is_answered_with_the_dashed_one(capsys: pytest.CaptureFixture) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["design", "--preset", "paper-example", "--gamma_c", "1e-5"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert err[0].startswith("encctl-gym design: error:") and "--gamma-c" in err[0] and "design --help" in err[0]

@@ -234,6 +234,25 @@ def test_models_figure_and_from_csv(quick_rows: list, tmp_path) -> None:
     assert deciphering_time.main(["--from-csv", str(tmp_path / "missing.csv"), "--out", str(out)]) == 2
 
 
+def test_a_redraw_from_csv_leaves_data_files_that_hold_the_same_values_untouched(quick_rows: list, tmp_path) -> None:
+    """The fit CSV on disk differs from a refit only in the last digit (another machine's
+    rounding): a redraw keeps it byte for byte; a real change of value is written."""
+    out = tmp_path / "fig"
+    out.mkdir()
+    source = deciphering_time.write_csv(quick_rows, out / "deciphering_time.csv")
+    fits = deciphering_time.fit(quick_rows)
+    nudged = [dict(f, T_first=float(np.nextafter(f["T_first"], np.inf))) for f in fits]
+    fit_path = deciphering_time.write_csv(nudged, out / "deciphering_time_fit.csv", deciphering_time.FIT_COLUMNS)
+    before = {p.name: p.read_bytes() for p in (source, fit_path)}
+    assert deciphering_time.main(["--from-csv", str(source), "--out", str(out), "--no-progress"]) == 0
+    assert {p.name: p.read_bytes() for p in (source, fit_path)} == before
+    changed = [dict(f, T_first=2 * f["T_first"]) for f in fits]
+    deciphering_time.write_csv(changed, fit_path, deciphering_time.FIT_COLUMNS)
+    assert deciphering_time.main(["--from-csv", str(source), "--out", str(out), "--no-progress"]) == 0
+    redone = deciphering_time.read_csv(fit_path)
+    assert [r["T_first"] for r in redone] == pytest.approx([f["T_first"] for f in fits], rel=1e-12)
+
+
 # ----------------------------------------------------------------------------- hardening
 @pytest.mark.parametrize(
     "args, message",
@@ -248,6 +267,32 @@ def test_crack_refuses_unbounded_work_in_one_line(capsys: pytest.CaptureFixture,
     assert main(["crack", *args, "--no-progress", "--json"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and message in err[0], err
+
+
+def test_crack_refuses_at_once_what_the_environment_refuses_and_prints_its_estimate_first(capsys, monkeypatch) -> None:
+    """The environment's estimate (Breaker.check_time) decides for crack too: two rho keys at 64
+    bits are refused before any work, naming --max-seconds; raising it lets the job start, and
+    the estimate is the first line printed."""
+    from encctl_gym.cryptanalysis import get_breaker
+    from encctl_gym.cryptanalysis.cli import DEFAULT_MAX_SECONDS
+    from encctl_gym.crypto.group import shipped_group
+
+    started = []
+
+    def no_work(*args, **kwargs):
+        started.append(True)
+        raise KeyboardInterrupt  # stop before any key is broken (a real run takes about 17 minutes)
+
+    monkeypatch.setattr("encctl_gym.cryptanalysis.cli.break_sequence", no_work)
+    first, per_key = get_breaker("rho").expected_seconds(shipped_group(64))
+    assert first + per_key > DEFAULT_MAX_SECONDS  # the case of the check below
+    assert main(["crack", "--bits", "64", "--keys", "2", "--breaker", "rho", "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--max-seconds" in err[0] and "rho" in err[0] and not started, err
+    limit = str(2 * (first + per_key))
+    assert main(["crack", "--bits", "64", "--keys", "2", "--breaker", "rho", "--no-progress", "--max-seconds", limit]) == 130
+    out = capsys.readouterr().out.strip().splitlines()
+    assert started and out and "expected about" in out[0] and "2 keys" in out[0], out
 
 
 def test_crack_keys_limit_and_its_memory_estimate() -> None:

@@ -11,8 +11,10 @@ import pytest
 
 import encctl_gym  # noqa: F401  (registers the environment)
 from encctl_gym.envs import ENV_ID, EncryptedLTIAttackEnv, resolve_params
+from encctl_gym.envs.config import default_config
 from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
 from encctl_gym.errors import BudgetError, ParameterError, ResourceLimitError, ShapeError, UnstableSystemError
+from encctl_gym.presets import get_preset
 
 SMALL = {"preset": "small", "gamma_opt": False}
 
@@ -577,14 +579,19 @@ def test_a_tiny_logdet_regularization_still_gives_finite_rewards():
     assert all(math.isfinite(r) for r in rewards)
 
 
-def test_a_users_plant_is_not_completed_from_the_default_preset():
+def test_a_users_plant_is_completed_from_the_default_preset_with_a_warning_and_not_with_preset_none():
     A, B = [[0.5, 0.0], [0.1, 0.4]], [[1.0], [0.5]]
+    paper = get_preset(default_config()["preset"])
+    with pytest.warns(UserWarning, match=f"preset '{paper.name}'.*sigma_w2"):
+        d = resolve_params({"A": A, "B": B, "gamma_opt": False})
+    assert d.sources["A"] == "config" and d.sources["sigma_w2"] == f"preset {paper.name}"
+    assert (d.sigma_w2, d.sigma_u2, d.tau_c, d.upsilon) == (paper.sigma_w2, paper.sigma_u2, paper.tau_c, paper.upsilon)
     with pytest.raises(ParameterError) as err:
-        resolve_params({"A": A, "B": B})
+        resolve_params({"A": A, "B": B, "preset": None})
     for key in ("sigma_w2", "sigma_u2", "upsilon", "tau_c", "gamma_c"):
         assert key in str(err.value)  # every missing value named at once
     full = {"A": A, "B": B, "sigma_w2": 0.1, "sigma_u2": 1.0, "upsilon": 1e9, "tau_c": 1e3, "gamma_c": 1e-3, "key_length": 64}
-    p = resolve_params(full)
+    p = resolve_params({**full, "preset": None})
     assert p.sources["sigma_x2"] == "default" and p.sources["A"] == "config" and p.sources["tau_c"] == "config"
     with pytest.warns(UserWarning, match="preset 'small'.*sigma_w2"):
         q = resolve_params({"preset": "small", "A": A, "B": B, "gamma_opt": False})

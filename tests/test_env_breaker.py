@@ -198,3 +198,24 @@ def test_pari_breaker_in_the_loop_matches():
     a, _, _ = rollout(make(max_samples=9))
     b, _, _ = rollout(make(max_samples=9, breaker="pari"))
     assert a == b
+
+
+def test_the_readme_real_break_without_max_samples_runs_with_a_capped_horizon():
+    """crypto="elgamal", key_length=64, breaker="index-calculus" and nothing else: 64-bit keys buy
+    about 9e18 samples, which no episode can hold; the attack is capped (and truncated) at
+    MAX_DEFAULT_HORIZON with a warning instead of being refused for memory."""
+    import gymnasium as gym
+
+    from encctl_gym.envs import ENV_ID
+    from encctl_gym.envs.config import MAX_DEFAULT_HORIZON
+
+    with pytest.warns(UserWarning, match="MAX_DEFAULT_HORIZON"):
+        env = gym.make(ENV_ID, config=dict(crypto="elgamal", key_length=64, breaker="index-calculus"))
+    p = env.unwrapped.params
+    assert p.horizon == MAX_DEFAULT_HORIZON < p.budget_samples and not p.budget_limited
+    env.reset(seed=0)
+    for _ in range(3):
+        _, reward, term, trunc, info = env.step(env.action_space.sample())
+        assert np.isfinite(reward) and not (term or trunc)
+    assert info["samples_collected"] == 4
+    env.close()

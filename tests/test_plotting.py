@@ -90,3 +90,13 @@ def test_a_learning_curve_that_stays_above_the_cut_is_still_drawn(tmp_path):
         warnings.simplefilter("error", FigureLayoutWarning)
         path = plot_learning_curves([curve], tmp_path / "curve.png")
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_legend_below_wraps_to_the_figure_width():
+    fig, ax = plt.subplots(figsize=(3, 2.5))
+    for k in range(6):
+        ax.plot([1, 2], [k, k + 1], label=f"a rather long label for curve number {k}")
+    bottom = legend_below(fig, [ax], ncol=6)
+    fig.tight_layout(rect=(0, bottom, 1, 1))
+    assert not [p for p in layout_problems(fig) if "outside the canvas" in p]
+    plt.close(fig)

@@ -21,19 +21,23 @@ def test_a_sample_budget_beyond_the_float_range_gives_the_requested_horizon(extr
     assert params.budget_samples > 10**500
 
 
-def test_a_sample_budget_beyond_the_float_range_without_max_samples_is_the_budget() -> None:
+def test_a_sample_budget_beyond_the_float_range_without_max_samples_caps_the_horizon() -> None:
+    from encctl_gym.envs.config import MAX_DEFAULT_HORIZON
+
     params = resolve_params({**HUGE_BUDGET, "max_samples": None, "key_length": 3072})
-    assert params.budget_limited
-    assert params.horizon == params.budget_samples > 10**500
+    assert params.budget_samples > 10**500
+    assert params.horizon_capped and params.horizon == MAX_DEFAULT_HORIZON
 
 
-def test_an_environment_with_a_budget_beyond_the_float_range_is_refused_for_its_memory() -> None:
+def test_an_environment_with_a_budget_beyond_the_float_range_is_made_with_the_capped_horizon() -> None:
     import gymnasium as gym
 
+    from encctl_gym.envs.config import MAX_DEFAULT_HORIZON
     from encctl_gym.registration import ENV_ID
 
-    with pytest.raises(ResourceLimitError, match="max_samples"):
-        gym.make(ENV_ID, config={**HUGE_BUDGET, "max_samples": None, "key_length": 3072})
+    with pytest.warns(UserWarning, match="2\\^20|1048576|cap"):
+        env = gym.make(ENV_ID, config={**HUGE_BUDGET, "max_samples": None, "key_length": 3072, "gamma_opt": False})
+    assert env.unwrapped.params.horizon == MAX_DEFAULT_HORIZON
     assert issubclass(ResourceLimitError, EncctlError)
 
 

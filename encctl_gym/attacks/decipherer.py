@@ -27,7 +27,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, Protocol, runtime_checkable
 
-from ..errors import BreakerLimitError, ParameterError
+from ..errors import ParameterError
 
 __all__ = ["Decipherer", "KeyOracle", "KeyBreaking", "make_decipherer", "DEFAULT_BREAKER_TIME_LIMIT"]
 
@@ -120,20 +120,16 @@ class KeyBreaking:
         rng: Any = None,
     ) -> None:
         from ..cryptanalysis import TokenChain, get_breaker
-        from ..cryptanalysis.base import format_seconds
 
         b = get_breaker(breaker, rng=rng)
         if scheme == "token" and adversary == "server" and not isinstance(b, TokenChain):
             b = TokenChain(b, rng=rng)
-        b.check_feasible(group)
-        first, per_key = b.expected_seconds(group)
-        if first > time_limit:
-            raise BreakerLimitError(
-                f"breaker {breaker!r} would take about {format_seconds(first)} for the first key of the "
-                f"{group.bits}-bit group (then {format_seconds(per_key)} per key), more than "
-                f"breaker_time_limit = {format_seconds(time_limit)}; use a shorter key_length, another "
-                "breaker or a longer breaker_time_limit"
-            )
+        b.check_time(
+            group,
+            time_limit,
+            limit_name="breaker_time_limit",
+            advice="use a shorter key_length, another breaker or a longer breaker_time_limit",
+        )
         self.breaker = b
         self.group = group
         self.time_limit = float(time_limit)

@@ -353,6 +353,51 @@ class Breaker(abc.ABC):
                 f"the ceiling of {MAX_EXPECTED_SECONDS / (86400 * 365.25):g} year (MAX_EXPECTED_SECONDS)"
             )
 
+    def check_time(
+        self, group: GroupParams, limit: float, *, keys: int = 1, limit_name: str = "the time limit", advice: str = ""
+    ) -> tuple[float, float, float]:
+        """The feasibility estimate of breaking ``keys`` keys of ``group``, checked against ``limit``.
+
+        One estimate for the environment (``breaker_time_limit``, one key) and ``encctl-gym
+        crack`` (``--max-seconds``, the whole sequence): :meth:`check_feasible`, then the cost
+        model's :meth:`expected_seconds`, ``T_first + (keys - 1) T_1``, refused above ``limit``
+        before any work.
+
+        Parameters
+        ----------
+        group : GroupParams
+        limit : float
+            Seconds allowed for the expected work.
+        keys : int
+            Number of keys of the sequence (>= 1).
+        limit_name, advice : str
+            The name of the limit and what to do instead, for the message.
+
+        Returns
+        -------
+        (float, float, float)
+            Expected ``T_first``, ``T_1`` and total seconds.
+
+        Raises
+        ------
+        BreakerLimitError
+            Above ``limit`` (the message gives the estimate), or from :meth:`check_feasible`.
+        """
+        keys = check_int("keys", keys, minimum=1)
+        self.check_feasible(group)
+        first, per_key = self.expected_seconds(group)
+        total = first + (keys - 1) * per_key
+        if not total <= limit:
+            if keys == 1:
+                what = f"{format_seconds(first)} for the first key of the {group.bits}-bit group (then "
+            else:
+                what = f"{format_seconds(total)} for {keys} keys of the {group.bits}-bit group ({format_seconds(first)} for the first key, then "
+            raise BreakerLimitError(
+                f"breaker {self.name!r} would take about {what}{format_seconds(per_key)} per key), more than "
+                f"{limit_name} = {format_seconds(limit)}" + (f"; {advice}" if advice else "")
+            )
+        return first, per_key, total
+
     def _check_group(self, group: GroupParams) -> None:
         """Further structural requirements of a breaker (raise GroupError); none by default."""
 

@@ -16,9 +16,12 @@ runs once; the table lists each key's wall time, CPU time and operation counts, 
 is checked (g^s = h) and compared with the sequence's secret key.
 
 Work that cannot finish is refused in one line before it starts: more than :data:`~.keys.MAX_KEYS`
-keys, a group beyond the breaker's ``--max-bits``, and a first key that the breaker's cost
+keys, a group beyond the breaker's ``--max-bits``, a first key that the breaker's cost
 model expects to take more than a year whatever ``--max-bits`` says
-(:data:`~encctl_gym.cryptanalysis.base.MAX_EXPECTED_SECONDS`).
+(:data:`~encctl_gym.cryptanalysis.base.MAX_EXPECTED_SECONDS`), and a sequence expected to take
+longer than ``--max-seconds`` (default :data:`DEFAULT_MAX_SECONDS`; the same estimate as the
+environment's ``breaker_time_limit``). The estimate is printed before the work (on stderr with
+``--json``).
 
 With ``--scheduler`` (``local`` starts a Dask ``LocalCluster``; needs ``encctl-gym[dask]``) the
 keys are split into chunks that run as tasks of :func:`encctl_gym.parallel.run_tasks`, each with
@@ -37,12 +40,18 @@ from .._validation import check_int, check_positive
 from ..crypto import arith
 from ..crypto.group import SHIPPED_BITS, GroupParams, generate_safe_prime_group, shipped_group
 from ..errors import BreakerError, ParameterError
+from ..parallel import check_scheduler
 from .base import format_seconds
 from .keys import MAX_KEYS, check_keys, key_sequence
 from .registry import BREAKERS, get_breaker
 from .sequence import BreakReport, break_sequence
 
-__all__ = ["add_arguments", "run", "crack_group"]
+__all__ = ["add_arguments", "run", "crack_group", "DEFAULT_MAX_SECONDS"]
+
+#: Default of ``crack --max-seconds``: the expected time of the whole sequence (the breaker's
+#: cost model, :meth:`~encctl_gym.cryptanalysis.base.Breaker.check_time`) above which the work
+#: is refused before it starts.
+DEFAULT_MAX_SECONDS = 600.0
 
 
 def crack_group(bits: int, source: str, seed: int) -> tuple[GroupParams, str]:
@@ -88,6 +97,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="T",
         help="seconds allowed for the precomputation and for each key (default: none)",
+    )
+    parser.add_argument(
+        "--max-seconds",
+        dest="max_seconds",
+        type=float,
+        default=DEFAULT_MAX_SECONDS,
+        metavar="S",
+        help=f"refuse, before any work, a job the breaker's cost model expects to take longer (default {DEFAULT_MAX_SECONDS:g})",
     )
     parser.add_argument(
         "--max-bits", dest="max_bits", type=int, default=None, help="override the breaker's size limit (bits of p)"
@@ -137,7 +154,16 @@ def run(args: argparse.Namespace) -> int:
         kwargs["inner"] = args.inner
     breaker = get_breaker(args.breaker, **kwargs)
     group, source = crack_group(args.bits, args.group, seed)
-    breaker.check_feasible(group)  # refuse before generating keys
+    check_scheduler(args.scheduler)  # every refusal comes before the estimate is printed
+    advice = "raise --max-seconds, or use fewer --keys, a smaller --bits or another --breaker"
+    max_seconds = check_positive("--max-seconds", args.max_seconds)
+    first, per_key, total = breaker.check_time(group, max_seconds, keys=n, limit_name="--max-seconds", advice=advice)
+    print(
+        f"crack: {breaker.name} on the {group.bits}-bit group, {n} keys: expected about {format_seconds(total)} "
+        f"on this machine ({format_seconds(first)} for the first key, then {format_seconds(per_key)} per key)",
+        file=sys.stderr if args.json else sys.stdout,  # --json keeps stdout to the JSON document
+        flush=True,
+    )
     hs, secrets, tokens = key_sequence(group, n, arith.seeded_random(seed + 1))
     report = break_sequence(
         breaker,

@@ -47,7 +47,7 @@ from ..units import parse_duration
 from .layout import ObservationLayout
 from .rewards import REWARDS as _REWARD_CLASSES
 
-__all__ = ["default_config", "AttackParams", "resolve_params", "REWARDS", "BACKENDS", "DECIPHERING_CLOCKS"]
+__all__ = ["default_config", "AttackParams", "resolve_params", "completion_preset", "REWARDS", "BACKENDS", "DECIPHERING_CLOCKS"]
 
 #: What the environment charges for deciphering: the cost model's tau(N), or the breaker's measured seconds.
 DECIPHERING_CLOCKS: tuple[str, ...] = ("model", "measured")
@@ -100,7 +100,9 @@ def default_config() -> dict[str, Any]:
                                   ``"10y"`` (preset's if ``None``)
     ``gamma_c``                   acceptable error, used for the default lambda*
     ``max_samples``               cap on the attack length N (truncation); required when one
-                                  break reveals every sample (static; token vs server)
+                                  break reveals every sample (static; token vs server);
+                                  ``None``: N is what the budget buys within ``tau_c``, at most
+                                  ``MAX_DEFAULT_HORIZON`` = 2^20 (then truncated, with a warning)
     ``decipher_delay``            0 (adaptive), an integer number of steps, or ``"end"``
     ``warmup_steps``              steps of normal encrypted LQR control before the attack
     ``estimator``                 the attacker's identification method behind ``info["epsilon"]``
@@ -207,6 +209,19 @@ class AttackParams:
     tr_psi_w: float
     sources: dict[str, str] = field(default_factory=dict)  # where A, B, the variances and design values came from
     defender: Any = "fixed"  # the defender policy specification (a name or a policy object), checked
+    horizon_capped: bool = False  # no max_samples and a budget beyond MAX_DEFAULT_HORIZON: N is that cap
+
+    def warn_if_capped(self) -> None:
+        """Warn (once per environment, when it is made) that the attack length is the default cap
+        :data:`MAX_DEFAULT_HORIZON`, not what the budget buys."""
+        if self.horizon_capped:
+            warnings.warn(
+                f"the deciphering budget buys N = {format_value(self.budget_samples)} samples within tau_c = "
+                f"{self.tau_c:g} s (k = {self.key_length} bits); without max_samples the attack is capped at "
+                f"N = {self.horizon} (MAX_DEFAULT_HORIZON) and truncated there: set max_samples for another length",
+                UserWarning,
+                stacklevel=3,
+            )
 
     @property
     def n(self) -> int:
@@ -256,6 +271,12 @@ MAX_INPUT_HISTORY = 64
 #: values ``round(Delta x)`` in float64 and int64, exact only up to 2^53.
 MAX_DELTA = 2**53
 
+#: Attack length N when ``max_samples`` is not given and the deciphering budget buys more
+#: samples (short keys: ``key_length=64`` buys about 9e18): the episode is truncated there. One
+#: copy holds N (n + m) floats of data, about 100 MB at n = m = 4, and every one of the N
+#: samples is a key to break when a real breaker is set.
+MAX_DEFAULT_HORIZON = 2**20
+
 #: Values taken from the preset, the package's defaults or the configuration, by key
 #: (:attr:`AttackParams.sources`).
 SOURCE_KEYS = ("A", "B", "sigma_w2", "sigma_x2", "sigma_u2", "upsilon", "tau_c", "gamma_c")
@@ -283,13 +304,35 @@ def _breaking(cfg: Mapping[str, Any], crypto: str) -> tuple[str | None, str, flo
     return breaker, clock, parse_duration(cfg["breaker_time_limit"], "breaker_time_limit")
 
 
+def completion_preset(config: Mapping[str, Any]) -> Any:
+    """The preset whose values complete a plant given by ``A`` and ``B``.
+
+    One rule for the environment and ``encctl-gym train --system``: the configuration's
+    ``preset`` when it has that key (``None``: nothing is completed, every design value must be
+    given), else the default's (``default_config()["preset"]``, the paper's example).
+
+    Parameters
+    ----------
+    config : mapping
+        The user's configuration (before it is merged over :func:`default_config`).
+
+    Returns
+    -------
+    str or None
+        The preset name, or ``None``; not checked here (:func:`resolve_params` checks it).
+    """
+    return config["preset"] if "preset" in config else default_config()["preset"]
+
+
 def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> AttackParams:
     """Merge ``config`` and ``kwargs`` over :func:`default_config` and validate everything.
 
-    A plant given by ``A`` and ``B`` without a ``preset`` key is not completed from the default
-    preset: then every variance and design value must be given (all missing ones are named at
-    once). With an explicit preset and ``A``/``B``, the other values come from the preset and a
-    warning says which. :attr:`AttackParams.sources` records where each value came from.
+    A plant given by ``A`` and ``B`` is completed from a preset (:func:`completion_preset`: the
+    configuration's ``preset``, else the default ``"paper-example"``): the variances and design
+    values it does not give come from that preset, and a warning names them. With
+    ``preset=None`` nothing is completed: every variance and design value must then be given
+    (all missing ones are named at once). :attr:`AttackParams.sources` records where each value
+    came from.
 
     Raises
     ------
@@ -311,9 +354,7 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     if unknown:
         raise ParameterError(f"unknown configuration key(s) {format_value(unknown)}; known keys: {sorted(cfg)}")
     cfg.update(merged)
-    if ("A" in merged or "B" in merged) and "preset" not in merged:
-        cfg["preset"] = None  # a plant of the user's is not silently completed from the default preset
-    name = cfg["preset"]
+    name = cfg["preset"] = completion_preset(merged)
     if name is not None and not isinstance(name, str):
         raise ParameterError(f"preset must be a preset name or None, got {format_value(name)}")
     preset = get_preset(name) if name is not None else None
@@ -422,6 +463,8 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         )
     if max_samples is not None and max_samples < budget:
         horizon, budget_limited = max_samples, False
+    elif max_samples is None and budget > MAX_DEFAULT_HORIZON:
+        horizon, budget_limited = MAX_DEFAULT_HORIZON, False  # the environment warns (AttackParams.warn_if_capped)
     else:
         horizon, budget_limited = int(budget), True
     if horizon < n + m + 1:
@@ -502,4 +545,5 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         tr_psi_w=tr_psi_w,
         sources=sources,
         defender=defender,
+        horizon_capped=max_samples is None and horizon < budget,
     )

@@ -133,7 +133,10 @@ class EncryptedLTIAttackEnv(gym.Env):
     ``terminated`` when the next sample can no longer be paid for within ``tau_c``: the
     deciphering budget is part of the environment's state (its spent fraction is observed) and
     no reward can follow, so this is a true terminal state. ``truncated`` when ``max_samples``
-    ends the attack first: a cap from outside the attacker's problem. Either way all paid
+    ends the attack first: a cap from outside the attacker's problem. Without ``max_samples``, a
+    budget that buys more than ``MAX_DEFAULT_HORIZON`` = 2^20 samples (short keys: 64 bits buy
+    about 9e18) is capped there, with a warning when the environment is made
+    (``params.horizon_capped``), and the episode is truncated at that length. Either way all paid
     samples are delivered in the final observation. ``N`` samples mean ``N`` actions.
 
     ## Arguments
@@ -142,6 +145,10 @@ class EncryptedLTIAttackEnv(gym.Env):
     **overrides)``. See :func:`encctl_gym.envs.config.default_config` for every key
     (preset, A, B, variances, scheme, adversary, security_parameter or key_length, upsilon,
     tau_c, max_samples, decipher_delay, warmup_steps, reward, crypto, delta, ...).
+    A plant of one's own, ``config={"A": A, "B": B}``, takes the values it does not give
+    (variances, ``gamma_c``, ``tau_c``, ``upsilon``) from ``preset`` (default
+    ``"paper-example"``) with a warning naming them; ``preset=None`` completes nothing, and
+    every value must then be given (the same rule as ``encctl-gym train --system FILE``).
     ``schedule`` (:class:`~encctl_gym.envs.episode.EpisodeSchedule`) sets how the work is
     batched (noise chunks, exact-refresh period); the default is what the benchmarks measure.
 
@@ -182,6 +189,7 @@ class EncryptedLTIAttackEnv(gym.Env):
         **kwargs: Any,
     ) -> None:
         self.params: AttackParams = resolve_params(config, **kwargs)
+        self.params.warn_if_capped()
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ParameterError(
                 f"unknown render_mode {format_value(render_mode)}; choose one of {self.metadata['render_modes']}"

@@ -640,7 +640,7 @@ class EpisodeCore:
 
     def info_arrays(self) -> dict[str, np.ndarray]:
         """Info of every copy as new arrays of shape (K,) (:func:`~encctl_gym.envs.layout.info_dict`)."""
-        return info_dict(self.eps.copy(), self.state.energy.copy(), self._shared_info(), self.has_gamma_opt, self.K)
+        return info_dict(self.eps.copy(), self.state.energy.copy(), self._shared_info(), self.has_gamma_opt, self.K, self.stopped)
 
     def info(self) -> dict[str, Any]:
         """Info of copy 0 as Python scalars (single environment).
@@ -648,4 +648,6 @@ class EpisodeCore:
         ``epsilon`` is the error (Definition def:error) of the attacker's current estimate: the
         least squares estimate once ``n + m`` columns are delivered, ``[A B] = 0`` before.
         """
-        return info_dict(float(self.eps[0]), float(self.state.energy[0]), self._shared_info(), self.has_gamma_opt)
+        return info_dict(
+            float(self.eps[0]), float(self.state.energy[0]), self._shared_info(), self.has_gamma_opt, detected=self.stopped
+        )

@@ -141,7 +141,9 @@ class ObservationLayout:
 
 
 # ----------------------------------------------------------------------------- info
-def info_dict(eps: Any, energy: Any, shared: tuple, with_gamma_opt: bool, num_envs: int | None = None) -> dict[str, Any]:
+def info_dict(
+    eps: Any, energy: Any, shared: tuple, with_gamma_opt: bool, num_envs: int | None = None, detected: bool = False
+) -> dict[str, Any]:
     """The info of the attack environment, defined once for the single and the vector environment.
 
     Parameters
@@ -156,6 +158,9 @@ def info_dict(eps: Any, energy: Any, shared: tuple, with_gamma_opt: bool, num_en
         Include ``gamma_opt`` (computed only when the environment was asked to).
     num_envs : int, optional
         ``K`` for the vector environment: every shared entry becomes an array of shape (K,).
+    detected : bool
+        The defender stopped the attack (:mod:`encctl_gym.loop.defenses`; the copies of a batch
+        stop together).
 
     Returns
     -------
@@ -171,6 +176,7 @@ def info_dict(eps: Any, energy: Any, shared: tuple, with_gamma_opt: bool, num_en
         "deciphering_time": time,
         "input_energy": energy,
         "average_power": energy / power_den,
+        "detected": bool(detected),
     }
     if with_gamma_opt:
         info["gamma_opt"] = gamma_opt
@@ -182,7 +188,7 @@ def info_dict(eps: Any, energy: Any, shared: tuple, with_gamma_opt: bool, num_en
 
 
 #: The info entries all copies share (arrays of one value in the vector environment).
-SHARED_INFO = ("gamma", "samples_collected", "samples_delivered", "deciphering_time", "gamma_opt")
+SHARED_INFO = ("gamma", "samples_collected", "samples_delivered", "deciphering_time", "gamma_opt", "detected")
 #: The keys of the info dict, in order (:func:`info_dict`).
 INFO_KEYS: tuple[str, ...] = tuple(info_dict(0.0, 0.0, (0.0, 0.0, 1.0, 0.0, 0, 0), True))
 

@@ -77,6 +77,7 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
     ) -> None:
         self.num_envs = check_int("num_envs", num_envs, minimum=1)
         self.params: AttackParams = resolve_params(config, **kwargs)
+        self.params.warn_if_capped()
         if self.params.crypto != "ideal":
             raise ParameterError(
                 f"the vector environment batches the ideal backend only, got crypto={format_value(self.params.crypto)}"

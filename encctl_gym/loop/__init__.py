@@ -9,6 +9,9 @@ Backends implement :class:`~encctl_gym.loop.backend.LoopBackend` and are picked 
 * ``"elgamal"`` (:class:`~encctl_gym.loop.elgamal.ElGamalLoop`): real dynamic-key ElGamal
   ciphertexts, one copy.
 
+The defender policies with real levers (input noise, audits, a chi-squared detector) are in
+:mod:`encctl_gym.loop.defenses`.
+
 Both use the group the defender picks (:mod:`encctl_gym.loop.defender`; by default that of
 :func:`~encctl_gym.loop.backend.loop_group` for the key length), so their trajectories agree
 bit for bit up to the largest shipped group (2048 bits). Above it, with the default defender,
@@ -26,6 +29,7 @@ from ..crypto.group import SHIPPED_BITS
 from ..errors import ParameterError
 from .backend import LoopBackend, loop_group, lqr_gain, table_limit
 from .defender import DEFENDERS, DefenderAction, DefenderPolicy, FixedDefender, PlantView, make_defender
+from .defenses import AuditDefender, DetectorDefender, NoiseDefender  # registers "noise", "audit", "chi2"
 from .elgamal import ElGamalLoop
 from .ideal import IdealLoop
 from .quantize import Quantization
@@ -44,6 +48,9 @@ __all__ = [
     "DefenderAction",
     "DefenderPolicy",
     "FixedDefender",
+    "NoiseDefender",
+    "AuditDefender",
+    "DetectorDefender",
     "PlantView",
     "make_defender",
 ]

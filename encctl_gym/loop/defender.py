@@ -27,7 +27,7 @@ every step path.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol, overload, runtime_checkable
 
@@ -185,15 +185,26 @@ DEFENDERS: dict[str, type] = {"fixed": FixedDefender}
 
 
 def make_defender(spec: Any = None) -> DefenderPolicy:
-    """A defender policy from a name of :data:`DEFENDERS` (``None``: ``"fixed"``) or a policy object.
+    """A defender policy from a name of :data:`DEFENDERS` (``None``: ``"fixed"``), a mapping with
+    a ``name`` and that policy's options (``{"name": "audit", "rate": 5e-4}``), or a policy object.
 
     Raises
     ------
     ParameterError
-        For an unknown name, or an object that does not implement :class:`DefenderPolicy`.
+        For an unknown name or option, a bad option value, or an object that does not implement
+        :class:`DefenderPolicy`.
     """
     if spec is None:
         spec = "fixed"
+    if isinstance(spec, Mapping):
+        options = dict(spec)
+        name = options.pop("name", None)
+        if not isinstance(name, str) or name not in DEFENDERS:
+            raise ParameterError(f"unknown defender {format_value(name)}; choose one of {', '.join(DEFENDERS)}")
+        try:
+            return DEFENDERS[name](**options)
+        except TypeError as exc:
+            raise ParameterError(f"the defender {name!r} takes no such options {sorted(options)} ({exc})") from None
     if isinstance(spec, str):
         try:
             return DEFENDERS[spec]()

@@ -18,7 +18,7 @@ module                 holds
 =====================  =====================================================================
 """
 
-from .attackers import ATTACKERS, learned_attackers, make_attackers, run_applies
+from .attackers import ATTACKERS, learned_players, left_out, make_attackers, run_applies, run_setting
 from .protocol import compute, elgamal_check, evaluate, planned_steps
 from .records import Curve, Result
 from .report import comparison_table, findings, summary_markdown
@@ -27,7 +27,7 @@ from .statistics import PairedRatio, fit_rate, mean_se, paired_ratio, samples_to
 from .tables import CURVE_COLUMNS, EPISODE_COLUMNS, SECURITY_COLUMNS, bound_rows, security_row, write_csvs
 
 __all__ = [
-    "ATTACKERS", "learned_attackers", "make_attackers", "run_applies",
+    "ATTACKERS", "learned_players", "left_out", "make_attackers", "run_applies", "run_setting",
     "Curve", "Result", "compute", "elgamal_check", "evaluate", "planned_steps",
     "comparison_table", "findings", "summary_markdown",
     "DEFAULT_CAP", "DEFAULT_SYSTEMS", "DELAYS", "Setting", "length_grid", "make_setting", "parse_delays",

@@ -27,12 +27,12 @@ from agents.runs import MODEL_FILES, check_output_dir, find_runs
 from encctl_gym._validation import format_value
 from encctl_gym.errors import ConfigError
 
-from .attackers import ATTACKERS
+from .attackers import ATTACKERS, left_out
 from .plots import plot
 from .protocol import compute
 from .records import Result
 from .report import summary_markdown
-from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, parse_delays
+from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, make_setting, parse_delays, system_entry
 from .tables import write_csvs
 
 __all__ = ["QUICK_SYSTEMS", "QUICK_CAP", "QUICK_EPISODES", "MAX_COUNT", "add_arguments", "run", "main", "write_outputs", "positive", "names"]
@@ -73,7 +73,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"small smoke test ({QUICK_SYSTEMS[0]}, N <= {QUICK_CAP}, {QUICK_EPISODES} episodes, {QUICK_POINTS} lengths)")
     parser.add_argument("--seed", type=int, default=0, help="environment seeds seed, seed + 1, ... (default 0)")
     parser.add_argument("--episodes", type=int, default=None, help=f"episodes per attacker, setting and attack length (default {FULL_EPISODES})")
-    parser.add_argument("--systems", default=None, help=f"comma-separated presets (default {','.join(DEFAULT_SYSTEMS)})")
+    parser.add_argument("--systems", default=None, help=f"comma-separated presets or plant files (as train --system reads; default {','.join(DEFAULT_SYSTEMS)})")
     parser.add_argument("--delays", default=None, help="comma-separated decipher delays: integers >= 0 or end (default 0,end)")
     parser.add_argument("--attackers", default=None,
                         help=f"comma-separated registered attackers (default all: {','.join(ATTACKERS)}); learned ones come from --runs")
@@ -114,10 +114,16 @@ def run(args: argparse.Namespace) -> int:
     positive("elgamal-episodes", args.elgamal_episodes, 0)
     check_output_dir(args.out)  # before the work, not after it
     roots = args.runs or (["results/train"] if Path("results/train").exists() and not quick else [])
-    runs = find_runs(roots)
+    skipped: list[tuple[Path, str]] = []
+    runs = find_runs(roots, left_out=skipped)
     for r in runs:  # every model that may play is a readable archive, checked before the work
         r.model_path(args.which if args.which == "final" or (r.path / MODEL_FILES["best"]).exists() else "final")
-    result = compute(systems, delays=delays, episodes=episodes, seed=args.seed, cap=cap, points=points, runs=runs,
+    configs = dict(system_entry(s) for s in systems)  # presets and plant files, by label
+    settings = [make_setting(label, d, cap, config=cfg) for label, cfg in configs.items() for d in delays]
+    skipped += [(r.path, why) for r, why in left_out(runs, settings)]
+    for path, why in skipped:
+        print(f"encctl-gym compare: leaving out the run {path}: {why}", file=sys.stderr)
+    result = compute(settings=settings, episodes=episodes, seed=args.seed, points=points, runs=runs,
                      which=args.which, elgamal_episodes=args.elgamal_episodes, elgamal_N=min(40, cap),
                      progress=not args.no_progress, attackers=attackers)
     cmd = ["encctl-gym compare", f"--seed {args.seed}", f"--episodes {episodes}", f"--systems {','.join(systems)}",

@@ -13,7 +13,7 @@ system's lambda), 100
 episodes per attack length, the best model, and the *stochastic* policy: its noise is its
 excitation, and the mean action of a state-feedback policy leaves the regressor ``[x; u]``
 nearly rank deficient, so ``--deterministic`` is allowed but warned about. ``--systems`` plays
-the run on other presets too (same observation layout needed). Outputs (CSV, PNG,
+the run on other presets or plant files too (same observation layout needed). Outputs (CSV, PNG,
 ``summary.md``) go to ``RUN_DIR/evaluation`` unless ``--out`` is given; a new evaluation
 replaces the files of the previous one there.
 """
@@ -31,10 +31,11 @@ from agents.sb3 import load_attacker  # the [rl] extra: without it the CLI says 
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ConfigError
 
+from .attackers import system_config
 from .cli import names, positive, write_outputs
 from .protocol import compute
 from .report import comparison_table, design_efficiencies
-from .settings import Setting, make_setting, parse_delays
+from .settings import Setting, make_setting, parse_delays, system_entry
 
 __all__ = ["BASELINES", "EPISODES", "run_settings", "system_config", "add_arguments", "run"]
 
@@ -42,39 +43,22 @@ __all__ = ["BASELINES", "EPISODES", "run_settings", "system_config", "add_argume
 BASELINES = ("gaussian", "colored", "optimal")
 #: Default episodes per attacker and attack length.
 EPISODES = 100
-#: Environment keys that define the system and its budget (not carried to another system).
-_SYSTEM_KEYS = frozenset({"preset", "A", "B", "sigma_w2", "sigma_x2", "sigma_u2", "upsilon", "gamma_c"})
-#: Keys that set the attack length or the backend of the training episodes (dropped: the
-#: evaluation sets its own length).
-_LENGTH_KEYS = frozenset({"tau_c", "max_samples", "security_parameter", "key_length", "crypto", "crypto_seed", "gamma_opt"})
-
-
-def system_config(run: RunInfo, system: str | None = None) -> dict[str, Any]:
-    """The environment configuration the run is evaluated in: its own system (``system`` None or
-    the run's label), or the preset ``system`` with the run's other settings (observation
-    layout, reward, encoder) carried over."""
-    rest = {k: v for k, v in run.env.items() if k not in _LENGTH_KEYS}
-    if system is None or system == run.system:
-        # the system's own defense period (before the training shortened it) sets the full budget
-        own = (run.meta.get("config") or {}).get("env") or {}
-        if own.get("tau_c") is not None:
-            rest["tau_c"] = own["tau_c"]
-        return rest
-    return {**{k: v for k, v in rest.items() if k not in _SYSTEM_KEYS}, "preset": system}
-
-
 def run_settings(run: RunInfo, systems: tuple[str, ...] | None, delays: tuple[Any, ...] | None, length: int | None) -> list[Setting]:
     """The settings of an evaluation (module docstring); ``length`` None: each system's full budget."""
     if delays is None:
         own = run.env.get("decipher_delay", 0)
         delays = (own,) + (("end",) if run.observation == "blind" and own != "end" else ())
     out = []
-    for system in systems or (run.system,):
+    for entry in systems or (run.system,):
+        label, plant = system_entry(entry) if entry != run.system else (entry, None)
+        if plant is not None and label == run.system and any(plant[k] != run.env.get(k) for k in ("A", "B")):
+            label = entry  # a plant file of the run's label but another plant: a system of its own
+        config = system_config(run, label, plant)
         for d in delays:
             if d == "end" and run.observation != "blind":
                 raise ConfigError(f"the {run.observation!r} policy of {run.path} reads delivered states; it cannot play with "
                                   "decipher_delay 'end' (only a blind policy can)")
-            out.append(make_setting(system, d, None, config=system_config(run, system), length=length))
+            out.append(make_setting(label, d, None, config=config, length=length))
     return out
 
 
@@ -82,7 +66,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``encctl-gym evaluate``."""
     parser.add_argument("run_dir", metavar="RUN_DIR", help="a training run directory (written by encctl-gym train)")
     parser.add_argument("--episodes", type=int, default=None, help=f"episodes per attacker and attack length (default {EPISODES})")
-    parser.add_argument("--systems", default=None, help="comma-separated presets to play on (default: the run's own system)")
+    parser.add_argument("--systems", default=None,
+                        help="comma-separated presets or plant files (as train --system reads) to play on (default: the run's own system)")
     parser.add_argument("--delays", default=None,
                         help="comma-separated decipher delays: integers >= 0 or end (default: the run's; a blind policy also end)")
     parser.add_argument("--deterministic", action="store_true",

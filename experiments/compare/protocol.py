@@ -37,13 +37,13 @@ from encctl_gym.envs.config import resolve_params
 from encctl_gym.resources import check_memory
 from encctl_gym.sim.montecarlo import log_grid
 
-from .attackers import ATTACKERS, learned_attackers, make_attackers
+from .attackers import ATTACKERS, learned_players, make_attackers
 from .records import Curve, Result
 from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, Setting, length_grid, make_setting
 from .statistics import mean_se
 from .tables import bound_rows, security_row
 
-__all__ = ["evaluate", "planned_steps", "record_bytes", "elgamal_check", "compute"]
+__all__ = ["evaluate", "planned_steps", "record_bytes", "elgamal_check", "warm_up", "compute"]
 
 #: The name the Gaussian baseline plays under (the reference of the paired ratios).
 GAUSSIAN_NAME = GaussianAttacker.name
@@ -98,7 +98,7 @@ def planned_steps(setting: Setting, n_attackers: int, episodes: int, points: int
     return n_attackers * per * padded
 
 
-def record_bytes(plan: Sequence[tuple[Setting, Sequence[Attacker]]], episodes: int, points: int) -> int:
+def record_bytes(plan: Sequence[tuple[Setting, Sequence[Any]]], episodes: int, points: int) -> int:
     """Estimated bytes of what :func:`compute` keeps per episode (float64): each curve's errors at
     every grid point and its finals, and, with delivered states, the largest running record of one
     full-length attack (error and energy at every step)."""
@@ -127,6 +127,26 @@ def elgamal_check(setting: Setting, attacker: Attacker, *, episodes: int, N: int
             "error_ideal_same_seed": float(r_id.final_epsilon[0]), "seconds_elgamal": round(r_el.seconds, 3),
         })
     return rows
+
+
+def warm_up(plan: Sequence[tuple[Setting, Sequence[Attacker]]], *, points: int, elgamal: bool = False) -> float:
+    """Play one short episode of each setting's first attacker (and one through ElGamal), so that
+    the compiled kernels are compiled (or loaded from numba's cache) before a progress bar
+    starts; returns the seconds it took. The episodes are discarded; the attackers are reset by
+    every rollout, so nothing of this reaches the results."""
+    t0 = time.perf_counter()
+    seen: set[tuple[int, int, int, Any]] = set()
+    for setting, atts in plan:
+        p = setting.params
+        key = (p.n, p.m, p.input_history, p.decipher_delay is None)
+        if not atts or key in seen:
+            continue
+        seen.add(key)
+        N = int(length_grid(p, points)[0])
+        rollout(atts[0], budget_config(setting.config, N), episodes=1, seed=0, record=True, covariance=True)
+        if elgamal:
+            rollout(atts[0], elgamal_config(setting.config, N, crypto_seed=0), episodes=1, seed=0, record=False)
+    return time.perf_counter() - t0
 
 
 def compute(
@@ -164,7 +184,8 @@ def compute(
         Attack lengths per curve (:func:`length_grid`).
     runs : sequence
         Training runs (directories or :class:`agents.runs.RunInfo`) whose learned attackers play
-        where they apply.
+        where they apply, each in the environment it was trained in
+        (:func:`~experiments.compare.attackers.run_setting`).
     which : {"best", "final"}
         Which model of a run.
     elgamal_episodes, elgamal_N : int
@@ -197,11 +218,13 @@ def compute(
     settings = list(settings)
     for s in settings:  # the grid of every setting is checked before any attacker is built or loaded
         length_grid(s.params, points)
-    plan = [(s, [*make_attackers(s, attackers), *learned_attackers(s, infos, which, deterministic=deterministic),
-                 *(players(s) if players is not None else ())]) for s in settings]
+    # every attacker with the setting it plays in: a learned one in the environment it was trained in
+    plan = [(s, [*((a, s) for a in make_attackers(s, attackers)), *learned_players(s, infos, which, deterministic=deterministic),
+                 *((a, s) for a in (players(s) if players is not None else ()))]) for s in settings]
     total = sum(planned_steps(s, len(a), episodes, points) for s, a in plan)
     check_memory(f"keeping the per-episode records of episodes = {format_value(episodes)} over {len(plan)} setting(s) at points = "
                  f"{format_value(points)}", record_bytes(plan, episodes, points), advice="use fewer episodes")
+    warm_up(plan, points=points, elgamal=elgamal_episodes > 0)  # the bar's rate (its ETA) counts no compile time
     bar = None
     if progress:
         from tqdm import tqdm
@@ -215,12 +238,12 @@ def compute(
     try:
         for setting, atts in plan:
             curves[setting.key] = []
-            for att in atts:
+            for att, play in atts:
                 if bar is not None:
                     bar.set_postfix_str(f"{setting.system} d={setting.delay} {att.name}")
-                curves[setting.key].append(evaluate(setting, att, episodes=episodes, seed=seed, points=points, progress=bar))
+                curves[setting.key].append(evaluate(play, att, episodes=episodes, seed=seed, points=points, progress=bar))
                 if elgamal_episodes > 0:
-                    elgamal.extend(elgamal_check(setting, att, episodes=elgamal_episodes, N=elgamal_N, seed=seed))
+                    elgamal.extend(elgamal_check(play, att, episodes=elgamal_episodes, N=elgamal_N, seed=seed))
             cs = curves[setting.key]
             gauss = next((c for c in cs if c.attacker == GAUSSIAN_NAME), None)
             oracle = next((c for c in cs if c.oracle), None)

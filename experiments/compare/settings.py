@@ -24,7 +24,7 @@ from encctl_gym.errors import ConfigError
 from encctl_gym.security.attack_design import AttackDesign, gaussian_attack_design, optimal_attack_design
 from encctl_gym.sim.montecarlo import log_grid
 
-__all__ = ["DEFAULT_SYSTEMS", "DELAYS", "DEFAULT_CAP", "Setting", "make_setting", "length_grid", "parse_delays"]
+__all__ = ["DEFAULT_SYSTEMS", "DELAYS", "DEFAULT_CAP", "Setting", "make_setting", "system_entry", "length_grid", "parse_delays"]
 
 #: The design example and two Figure 1 panels at the extremes of R_sigma (100 and 0.01).
 DEFAULT_SYSTEMS = ("paper-example", "fig1-c", "fig1-g")
@@ -106,6 +106,41 @@ def make_setting(system: str, delay: Any, cap: int | None, *, config: dict[str, 
     design = optimal_attack_design(p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, feedback=p.decipher_delay is not None)
     gauss = gaussian_attack_design(p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2)
     return Setting(system, delay, cfg, p, base, design, gauss, capped)
+
+
+def system_entry(entry: str) -> tuple[str, dict[str, Any] | None]:
+    """A system named on the command line (``--systems``): a preset name, or a plant file.
+
+    A name of :data:`encctl_gym.presets.PRESETS` is that preset (configuration ``None``: the
+    preset's own); anything else that is an existing path or ends like a plant file
+    (:data:`encctl_gym.plant_file.SUFFIXES`) is read as a plant file by the reader of ``train
+    --system`` (:func:`agents.config.plant_config`; the values the file does not give are the
+    design example's), labelled by the file's stem as ``train`` labels its runs.
+
+    Returns
+    -------
+    (label, config)
+        The system's label and its environment configuration (``None`` for a preset).
+
+    Raises
+    ------
+    ConfigError
+        A plant file that cannot be read (naming the file), or a name that is neither a preset
+        nor a plant file.
+    """
+    from pathlib import Path
+
+    from agents.config import plant_config
+    from encctl_gym.plant_file import SUFFIXES
+    from encctl_gym.presets import PRESETS, preset_names
+
+    if entry in PRESETS:
+        return entry, None
+    path = Path(entry)
+    if path.exists() or path.suffix.lower() in SUFFIXES:
+        return path.stem, plant_config(path)
+    raise ConfigError(f"unknown preset {entry!r}, and no plant file of that name; choose a preset ({', '.join(preset_names())}) "
+                      f"or a plant file ({', '.join(SUFFIXES)})")
 
 
 def length_grid(params: AttackParams, points: int) -> np.ndarray:

@@ -1,0 +1,178 @@
+"""Defender policies with real levers: input noise, random audits and a chi-squared detector.
+
+Each is a :class:`~encctl_gym.loop.defender.DefenderPolicy` (registered in ``DEFENDERS`` by name,
+with its options from a mapping such as ``{"name": "audit", "rate": 5e-4}``) built on the
+analysis of :mod:`encctl_gym.security.defenses` and the checks of :mod:`encctl_gym.loop.detection`:
+
+* ``"noise"`` (:class:`NoiseDefender`): adds ``d ~ N(0, sigma_d2 I)`` to the input the plant
+  applies at every attack step; to the attacker it is extra process noise ``B d`` (the episode
+  applies it so), which :func:`~encctl_gym.security.defenses.sic_with_input_noise` accounts for.
+* ``"audit"`` (:class:`AuditDefender`): with probability ``rate`` per step the plant side compares
+  the input it decoded last step with its own ``Phi x`` and stops the attack on a difference
+  beyond the encoding's error (:func:`audit_tolerance`).
+* ``"chi2"`` (:class:`DetectorDefender`): the window chi-squared test on the closed-loop
+  innovation with a false-alarm rate per step; it needs no controller computation of its own.
+
+The plant side knows ``A``, ``B`` and the controller ``Phi`` (the loop's LQR gain,
+:func:`~encctl_gym.loop.backend.lqr_gain`): the policies take them from the resolved parameters in
+:meth:`group`. Every copy of a batch runs in lockstep, so an alarm in one copy ends the attack
+of all (the environment's ``info["detected"]``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from .._validation import check_int, check_nonnegative, check_positive
+from ..crypto.residue_table import residue_table
+from ..errors import ParameterError
+from .backend import loop_group, lqr_gain, table_limit
+from .defender import DEFENDERS, DefenderAction, PlantView
+from .detection import ChiSquaredDetector
+
+__all__ = ["AuditDefender", "DetectorDefender", "NoiseDefender", "audit_tolerance"]
+
+
+def audit_tolerance(Phi: np.ndarray, x: np.ndarray, delta: float, max_shift: int = 0) -> np.ndarray:
+    """The largest ``|u_i - (Phi x)_i|`` the encoding explains, per copy and input, shape (K, m).
+
+    The loop encodes ``Phi`` and ``x`` as the subgroup elements nearest ``round(Delta .)``: each
+    integer is off by at most ``e = 1/2 + max_shift`` (the residue table's largest shift). It
+    decodes ``sum_j (Delta Phi_ij + e1)(Delta x_j + e2) / Delta^2``, which differs from
+    ``(Phi x)_i`` by at most ``e (sum_j |Phi_ij| + sum_j |x_j|) / Delta + n e^2 / Delta^2``.
+    """
+    n = Phi.shape[1]
+    e = 0.5 + max_shift
+    row = np.abs(Phi).sum(axis=1)  # (m,)
+    col = np.abs(x).sum(axis=1, keepdims=True)  # (K, 1)
+    return e * (row[None, :] + col) / delta + n * e * e / (delta * delta)
+
+
+class _PlantSidePolicy:
+    """What every policy here shares: the plant's matrices and controller from ``group``."""
+
+    name = "plant-side"
+
+    def group(self, params: Any) -> Any:
+        self.A = np.asarray(params.A, dtype=float)
+        self.B = np.asarray(params.B, dtype=float)
+        self.Phi = -lqr_gain(self.A, self.B)
+        self.delta = float(params.delta)
+        self.sigma_w2 = float(params.sigma_w2)
+        group = loop_group(params.key_length)
+        self.max_shift = residue_table(group, table_limit(params, self.Phi)).max_shift  # cached: the loop's own table
+        return group
+
+    def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
+        self.K, self.rngs = K, rngs
+        self._x_prev: np.ndarray | None = None
+
+
+class NoiseDefender(_PlantSidePolicy):
+    """Input noise ``N(0, sigma_d2 I)`` at every attack step (registry name ``"noise"``).
+
+    Parameters
+    ----------
+    sigma_d2 : float
+        Variance of the noise (>= 0).
+    """
+
+    name = "noise"
+
+    def __init__(self, sigma_d2: float = 0.0) -> None:
+        self.sigma_d2 = check_nonnegative("sigma_d2", sigma_d2)
+
+    def act(self, view: PlantView) -> DefenderAction | None:
+        if self.sigma_d2 == 0.0:
+            return None
+        m = self.B.shape[1]
+        d = np.stack([rng.normal(scale=np.sqrt(self.sigma_d2), size=m) for rng in self.rngs[: self.K]])
+        return DefenderAction(input_noise=d)
+
+    def __repr__(self) -> str:
+        return f"NoiseDefender(sigma_d2={self.sigma_d2!r})"
+
+
+class AuditDefender(_PlantSidePolicy):
+    """Random audits of the decoded input against the plant side's own ``Phi x`` (``"audit"``).
+
+    Parameters
+    ----------
+    rate : float
+        Audit probability per step and copy, in [0, 1] (``minimum_audit_rate`` gives the rate
+        that stops an attacker before ``N*``).
+    """
+
+    name = "audit"
+
+    def __init__(self, rate: float = 5e-4) -> None:
+        rate = check_nonnegative("rate", rate)
+        if rate > 1:
+            raise ParameterError(f"rate must lie in [0, 1], got {rate}")
+        self.rate = rate
+        self.audits = 0
+
+    def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
+        super().reset(K, n, m, rngs)
+        self.audits = 0
+
+    def act(self, view: PlantView) -> DefenderAction | None:
+        x_prev, self._x_prev = self._x_prev, np.array(view.state, dtype=float)
+        if x_prev is None or self.rate == 0.0:
+            return None
+        audited = np.array([rng.random() < self.rate for rng in self.rngs[: self.K]])
+        if not audited.any():
+            return None
+        self.audits += int(audited.sum())
+        diff = np.abs(view.last_input - x_prev @ self.Phi.T)
+        caught = audited & np.any(diff > audit_tolerance(self.Phi, x_prev, self.delta, self.max_shift), axis=1)
+        return DefenderAction(end=True) if caught.any() else None
+
+    def __repr__(self) -> str:
+        return f"AuditDefender(rate={self.rate!r})"
+
+
+class DetectorDefender(_PlantSidePolicy):
+    """The window chi-squared test on ``x[t+1] - (A + B Phi) x[t]`` (registry name ``"chi2"``).
+
+    Parameters
+    ----------
+    window : int
+        Innovations per window.
+    false_alarm_rate : float
+        Target probability of an alarm per step without an attack.
+    """
+
+    name = "chi2"
+
+    def __init__(self, window: int = 10, false_alarm_rate: float = 1e-4) -> None:
+        self.window = check_int("window", window, minimum=1, maximum=10**6)
+        self.false_alarm_rate = check_positive("false_alarm_rate", false_alarm_rate)
+        if self.false_alarm_rate >= 1:
+            raise ParameterError(f"false_alarm_rate must lie in (0, 1), got {false_alarm_rate}")
+
+    def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
+        super().reset(K, n, m, rngs)
+        self.detector = ChiSquaredDetector(
+            self.A + self.B @ self.Phi,
+            self.sigma_w2 * np.eye(n),
+            window=self.window,
+            false_alarm_rate=self.false_alarm_rate,
+            num_loops=K,
+        )
+
+    def act(self, view: PlantView) -> DefenderAction | None:
+        x, x_prev = np.array(view.state, dtype=float), self._x_prev
+        self._x_prev = x
+        if x_prev is None:
+            return None
+        return DefenderAction(end=True) if self.detector.update(x_prev, x).any() else None
+
+    def __repr__(self) -> str:
+        return f"DetectorDefender(window={self.window!r}, false_alarm_rate={self.false_alarm_rate!r})"
+
+
+DEFENDERS.update({"noise": NoiseDefender, "audit": AuditDefender, "chi2": DetectorDefender})
