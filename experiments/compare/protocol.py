@@ -69,8 +69,15 @@ def evaluate(setting: Setting, attacker: Attacker, *, episodes: int, seed: int, 
             r = along  # the same attack, same seeds
         else:
             last = N == grid[-1]
-            r = rollout(attacker, budget_config(setting.config, int(N)), episodes=episodes, seed=seed, record=False, progress=progress,
-                        covariance=bool(last))
+            r = rollout(
+                attacker,
+                budget_config(setting.config, int(N)),
+                episodes=episodes,
+                seed=seed,
+                record=False,
+                progress=progress,
+                covariance=bool(last),
+            )
             t += r.seconds
         cov = r.covariance
         cols.append(r.final_epsilon)
@@ -111,7 +118,9 @@ def record_bytes(plan: Sequence[tuple[Setting, Sequence[Any]]], episodes: int, p
     return kept + along
 
 
-def elgamal_check(setting: Setting, attacker: Attacker, *, episodes: int, N: int, seed: int, key_length: int = 64) -> list[dict[str, Any]]:
+def elgamal_check(
+    setting: Setting, attacker: Attacker, *, episodes: int, N: int, seed: int, key_length: int = 64
+) -> list[dict[str, Any]]:
     """A few short episodes through real ElGamal ciphertexts (small key), each next to the same
     episode on the ideal backend (same environment and attacker seeds): the attacker works
     through real ciphertexts and the ideal backend computes the same arithmetic."""
@@ -121,31 +130,42 @@ def elgamal_check(setting: Setting, attacker: Attacker, *, episodes: int, N: int
     for e in range(episodes):
         r_el = rollout(attacker, el_cfg, episodes=1, seed=seed + e, record=False)
         r_id = rollout(attacker, ideal_cfg, episodes=1, seed=seed + e, record=False, batch=1)
-        rows.append({
-            "system": setting.system, "delay": setting.delay, "attacker": attacker.name, "episode": e, "N": N,
-            "key_length": resolve_params(el_cfg).key_length, "error_elgamal": float(r_el.final_epsilon[0]),
-            "error_ideal_same_seed": float(r_id.final_epsilon[0]), "seconds_elgamal": round(r_el.seconds, 3),
-        })
+        rows.append(
+            {
+                "system": setting.system,
+                "delay": setting.delay,
+                "attacker": attacker.name,
+                "episode": e,
+                "N": N,
+                "key_length": resolve_params(el_cfg).key_length,
+                "error_elgamal": float(r_el.final_epsilon[0]),
+                "error_ideal_same_seed": float(r_id.final_epsilon[0]),
+                "seconds_elgamal": round(r_el.seconds, 3),
+            }
+        )
     return rows
 
 
-def warm_up(plan: Sequence[tuple[Setting, Sequence[Attacker]]], *, points: int, elgamal: bool = False) -> float:
-    """Play one short episode of each setting's first attacker (and one through ElGamal), so that
-    the compiled kernels are compiled (or loaded from numba's cache) before a progress bar
-    starts; returns the seconds it took. The episodes are discarded; the attackers are reset by
-    every rollout, so nothing of this reaches the results."""
+def warm_up(plan: Sequence[tuple[Setting, Sequence[tuple[Attacker, Setting]]]], *, points: int, elgamal: bool = False) -> float:
+    """Play one short episode of each setting's first attacker in the setting it plays in (and
+    one through ElGamal), so that the compiled kernels are compiled (or loaded from numba's
+    cache) before a progress bar starts; returns the seconds it took. The episodes are
+    discarded; the attackers are reset by every rollout, so nothing of this reaches the results."""
     t0 = time.perf_counter()
     seen: set[tuple[int, int, int, Any]] = set()
-    for setting, atts in plan:
-        p = setting.params
+    for _, plays in plan:
+        if not plays:
+            continue
+        att, played = plays[0]
+        p = played.params
         key = (p.n, p.m, p.input_history, p.decipher_delay is None)
-        if not atts or key in seen:
+        if key in seen:
             continue
         seen.add(key)
         N = int(length_grid(p, points)[0])
-        rollout(atts[0], budget_config(setting.config, N), episodes=1, seed=0, record=True, covariance=True)
+        rollout(att, budget_config(played.config, N), episodes=1, seed=0, record=True, covariance=True)
         if elgamal:
-            rollout(atts[0], elgamal_config(setting.config, N, crypto_seed=0), episodes=1, seed=0, record=False)
+            rollout(att, elgamal_config(played.config, N, crypto_seed=0), episodes=1, seed=0, record=False)
     return time.perf_counter() - t0
 
 
@@ -219,11 +239,24 @@ def compute(
     for s in settings:  # the grid of every setting is checked before any attacker is built or loaded
         length_grid(s.params, points)
     # every attacker with the setting it plays in: a learned one in the environment it was trained in
-    plan = [(s, [*((a, s) for a in make_attackers(s, attackers)), *learned_players(s, infos, which, deterministic=deterministic),
-                 *((a, s) for a in (players(s) if players is not None else ()))]) for s in settings]
+    plan = [
+        (
+            s,
+            [
+                *((a, s) for a in make_attackers(s, attackers)),
+                *learned_players(s, infos, which, deterministic=deterministic),
+                *((a, s) for a in (players(s) if players is not None else ())),
+            ],
+        )
+        for s in settings
+    ]
     total = sum(planned_steps(s, len(a), episodes, points) for s, a in plan)
-    check_memory(f"keeping the per-episode records of episodes = {format_value(episodes)} over {len(plan)} setting(s) at points = "
-                 f"{format_value(points)}", record_bytes(plan, episodes, points), advice="use fewer episodes")
+    check_memory(
+        f"keeping the per-episode records of episodes = {format_value(episodes)} over {len(plan)} setting(s) at points = "
+        f"{format_value(points)}",
+        record_bytes(plan, episodes, points),
+        advice="use fewer episodes",
+    )
     warm_up(plan, points=points, elgamal=elgamal_episodes > 0)  # the bar's rate (its ETA) counts no compile time
     bar = None
     if progress:

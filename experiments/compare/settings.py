@@ -77,7 +77,9 @@ class Setting:
         return (self.system, self.delay)
 
 
-def make_setting(system: str, delay: Any, cap: int | None, *, config: dict[str, Any] | None = None, length: int | None = None) -> Setting:
+def make_setting(
+    system: str, delay: Any, cap: int | None, *, config: dict[str, Any] | None = None, length: int | None = None
+) -> Setting:
     """The configuration and bounds of one system in one observation setting.
 
     Parameters
@@ -131,6 +133,7 @@ def system_entry(entry: str) -> tuple[str, dict[str, Any] | None]:
     from pathlib import Path
 
     from agents.config import plant_config
+    from encctl_gym.envs.config import completion_preset
     from encctl_gym.plant_file import SUFFIXES
     from encctl_gym.presets import PRESETS, preset_names
 
@@ -138,9 +141,11 @@ def system_entry(entry: str) -> tuple[str, dict[str, Any] | None]:
         return entry, None
     path = Path(entry)
     if path.exists() or path.suffix.lower() in SUFFIXES:
-        return path.stem, plant_config(path)
-    raise ConfigError(f"unknown preset {entry!r}, and no plant file of that name; choose a preset ({', '.join(preset_names())}) "
-                      f"or a plant file ({', '.join(SUFFIXES)})")
+        return path.stem, plant_config(path, completion_preset({}))  # the environment's rule for the missing values
+    raise ConfigError(
+        f"unknown preset {entry!r}, and no plant file of that name; choose a preset ({', '.join(preset_names())}) "
+        f"or a plant file ({', '.join(SUFFIXES)})"
+    )
 
 
 def length_grid(params: AttackParams, points: int) -> np.ndarray:
@@ -153,8 +158,10 @@ def length_grid(params: AttackParams, points: int) -> np.ndarray:
         points (and a larger request would allocate its float grid before merging it).
     """
     if isinstance(points, (int, np.integer)) and not isinstance(points, bool) and points > params.horizon:
-        raise ConfigError(f"points = {format_value(points)} attack lengths exceed the horizon N = {params.horizon}: "
-                          f"a grid of distinct lengths up to N has at most N points")
+        raise ConfigError(
+            f"points = {format_value(points)} attack lengths exceed the horizon N = {params.horizon}: "
+            f"a grid of distinct lengths up to N has at most N points"
+        )
     return log_grid(min(2 * (params.n + params.m) + 1, params.horizon), params.horizon, points)
 
 
