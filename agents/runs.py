@@ -12,14 +12,16 @@ file                     content
                          configuration, timing, and (after it ran) the final evaluation
 ``model.zip``            the model at the end of training
 ``best_model.zip``       the best model of the evaluation callback
-``vecnormalize.pkl``     observation statistics (when observations are normalised)
+``vecnormalize.npz``     observation statistics (when observations are normalised; arrays)
 ``learning_curve.npz``   the evaluation callback's record (:mod:`agents.curves`)
 ``learning_curve.png``   its plot
 ``evaluations.npz``      stable-baselines3's own evaluation log (returns, lengths)
 ``tb/``                  TensorBoard logs
 =======================  ==================================================================
 
-``model.zip`` and ``vecnormalize.pkl`` are unpickled when loaded: load only runs you trust.
+stable-baselines3 unpickles parts of ``model.zip`` when it loads it: load only runs you trust.
+Older runs hold ``vecnormalize.pkl`` instead of ``vecnormalize.npz``; it is unpickled only on
+request (``load_attacker(..., allow_pickle=True)``, ``encctl-gym evaluate --allow-pickle``).
 """
 
 from __future__ import annotations

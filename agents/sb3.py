@@ -10,6 +10,9 @@
 * :class:`SB3Attacker` wraps a trained model (PPO, SAC, RecurrentPPO; with its
   ``VecNormalize`` statistics) as an :class:`~agents.base.Attacker`.
 * :func:`load_attacker` loads a training run written by :mod:`agents.train`.
+* :func:`save_vecnormalize` / :func:`load_vecnormalize` store the ``VecNormalize`` statistics
+  as plain arrays (``vecnormalize.npz``, loaded without pickles); an older run's
+  ``vecnormalize.pkl`` is unpickled only when the caller opts in (``allow_pickle=True``).
 * :data:`ALGORITHMS`: the learning algorithms by name (one table for training, loading and the
   command line).
 """
@@ -25,9 +28,10 @@ import numpy as np
 from sb3_contrib import RecurrentPPO
 from stable_baselines3 import PPO, SAC
 from stable_baselines3.common.base_class import BaseAlgorithm
+from stable_baselines3.common.vec_env import VecEnv
 
 from encctl_gym.envs.config import AttackParams, resolve_params
-from encctl_gym.errors import ConfigError, ParameterError
+from encctl_gym.errors import ConfigError, EncctlError, ParameterError
 from encctl_gym.registry import Registry
 
 from .ars import PairedARS
@@ -35,7 +39,22 @@ from .base import Attacker, observation_indices
 from .features import FeatureSet
 from .vec_env import INFO_KEYS, SB3VecEnv
 
-__all__ = ["SB3VecEnv", "SB3Attacker", "load_attacker", "ALGORITHMS", "algorithm_class", "INFO_KEYS"]
+__all__ = [
+    "SB3VecEnv",
+    "SB3Attacker",
+    "load_attacker",
+    "save_vecnormalize",
+    "load_vecnormalize",
+    "VECNORMALIZE_FILE",
+    "ALGORITHMS",
+    "algorithm_class",
+    "INFO_KEYS",
+]
+
+#: The run file of the observation statistics (arrays only, no pickles).
+VECNORMALIZE_FILE = "vecnormalize.npz"
+#: The pickle older runs hold instead (unpickled only with ``allow_pickle=True``).
+VECNORMALIZE_PICKLE = "vecnormalize.pkl"
 
 #: The learning algorithms by name: ``train``, :func:`load_attacker` and the command line's
 #: choices all read this one table (a new algorithm is a row here and a default config in
@@ -166,6 +185,61 @@ class SB3Attacker(Attacker):
         return np.asarray(a, dtype=np.float64).reshape(obs.shape[0], -1)
 
 
+def save_vecnormalize(vecnorm: Any, path: str | Path) -> Path:
+    """Write a ``VecNormalize``'s statistics and settings as arrays (``numpy.savez``, no pickles).
+
+    Stored: ``obs_rms`` and ``ret_rms`` (mean, var, count), ``clip_obs``, ``clip_reward``,
+    ``gamma``, ``epsilon``, ``norm_obs`` and ``norm_reward``; :func:`load_vecnormalize` reads them.
+    """
+    path = Path(path)
+    arrays = {
+        "obs_mean": vecnorm.obs_rms.mean, "obs_var": vecnorm.obs_rms.var, "obs_count": vecnorm.obs_rms.count,
+        "ret_mean": vecnorm.ret_rms.mean, "ret_var": vecnorm.ret_rms.var, "ret_count": vecnorm.ret_rms.count,
+        "clip_obs": vecnorm.clip_obs, "clip_reward": vecnorm.clip_reward, "gamma": vecnorm.gamma,
+        "epsilon": vecnorm.epsilon, "norm_obs": vecnorm.norm_obs, "norm_reward": vecnorm.norm_reward,
+    }  # fmt: skip
+    values: dict[str, Any] = {k: np.asarray(v, dtype=np.float64) for k, v in arrays.items()}
+    with path.open("wb") as fh:
+        np.savez(fh, **values)
+    return path
+
+
+def load_vecnormalize(path: str | Path, venv: VecEnv) -> Any:
+    """A ``VecNormalize`` over ``venv`` with the statistics of :func:`save_vecnormalize` (no pickles).
+
+    Raises
+    ------
+    ConfigError
+        If the file cannot be read as such arrays, or its observation statistics do not have
+        the shape of ``venv``'s observations.
+    """
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    path = Path(path)
+    keys = ("obs_mean", "obs_var", "obs_count", "ret_mean", "ret_var", "ret_count",
+            "clip_obs", "clip_reward", "gamma", "epsilon", "norm_obs", "norm_reward")  # fmt: skip
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            v = {k: np.array(z[k], dtype=np.float64) for k in keys}
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
+        raise ConfigError(f"cannot load {path} as VecNormalize statistics: {type(exc).__name__}: {_first_line(exc)}") from None
+    shape = venv.observation_space.shape
+    if v["obs_mean"].shape != shape or v["obs_var"].shape != shape or not all(np.isfinite(a).all() for a in v.values()):
+        raise ConfigError(
+            f"{path}: observation statistics of shape {v['obs_mean'].shape} (finite: "
+            f"{all(np.isfinite(a).all() for a in v.values())}) do not fit the run's observations of shape {shape}"
+        )
+    vecnorm = VecNormalize(
+        venv, training=False, norm_obs=bool(v["norm_obs"]), norm_reward=bool(v["norm_reward"]),
+        clip_obs=float(v["clip_obs"]), clip_reward=float(v["clip_reward"]), gamma=float(v["gamma"]),
+        epsilon=float(v["epsilon"]),
+    )  # fmt: skip
+    obs_rms: Any = vecnorm.obs_rms  # one RunningMeanStd: the observations are a Box
+    obs_rms.mean, obs_rms.var, obs_rms.count = v["obs_mean"], v["obs_var"], float(v["obs_count"])
+    vecnorm.ret_rms.mean, vecnorm.ret_rms.var, vecnorm.ret_rms.count = v["ret_mean"], v["ret_var"], float(v["ret_count"])
+    return vecnorm
+
+
 def load_attacker(
     run_dir: str | Path,
     *,
@@ -174,6 +248,7 @@ def load_attacker(
     deterministic: bool = False,
     name: str | None = None,
     torch_threads: int | None = 1,
+    allow_pickle: bool = False,
 ) -> SB3Attacker:
     """Load a training run written by :mod:`agents.train` as an attacker.
 
@@ -181,8 +256,8 @@ def load_attacker(
     ----------
     run_dir : path
         The run's directory (:mod:`agents.runs`: ``run.json``, ``model.zip``,
-        ``best_model.zip`` and, when the observations were normalised, ``vecnormalize.pkl``).
-        Loading unpickles these files: load only runs you trust.
+        ``best_model.zip`` and, when the observations were normalised, ``vecnormalize.npz``).
+        stable-baselines3 unpickles parts of the model archives: load only runs you trust.
     which : {"final", "best"}
         The model at the end of training or the best one of the evaluation callback.
     params : AttackParams, optional
@@ -195,6 +270,9 @@ def load_attacker(
         Sets torch's (process-wide) number of threads, 1 by default: the policies are small,
         and on a shared 2-core machine a second thread made one RecurrentPPO step 4 to 40 times
         slower (1.1 ms on one thread). ``None`` leaves it as it is.
+    allow_pickle : bool, default False
+        Unpickle a ``vecnormalize.pkl`` (written by older versions; a pickle can run any code
+        when loaded). Without it such a run is refused, saying how to opt in.
 
     Raises
     ------
@@ -220,14 +298,26 @@ def load_attacker(
     if params is None:
         params = resolve_params(env_cfg)
     vecnorm = None
-    vn_path = run.path / "vecnormalize.pkl"
-    if vn_path.exists():
-        from stable_baselines3.common.vec_env import VecNormalize
+    vn_path, pkl_path = run.path / VECNORMALIZE_FILE, run.path / VECNORMALIZE_PICKLE
+    if vn_path.exists() or pkl_path.exists():
+        try:  # a bad env is the run.json's fault, not the statistics'
+            venv = SB3VecEnv(env_cfg, 1, run.observation, features=run.features)
+        except EncctlError as exc:
+            raise ConfigError(f"{run.path / 'run.json'}: its env does not make an environment: {exc}") from exc
+        if vn_path.exists():
+            vecnorm = load_vecnormalize(vn_path, venv)
+        elif not allow_pickle:
+            raise ConfigError(
+                f"{pkl_path} is a pickle, and unpickling can run any code; load it only from a run you trust, with "
+                f"allow_pickle=True (encctl-gym evaluate --allow-pickle); runs written now store {VECNORMALIZE_FILE} instead"
+            )
+        else:
+            from stable_baselines3.common.vec_env import VecNormalize
 
-        try:
-            vecnorm = VecNormalize.load(str(vn_path), SB3VecEnv(env_cfg, 1, run.observation, features=run.features))
-        except (EOFError, OSError, ValueError, KeyError, AttributeError, pickle.UnpicklingError) as exc:
-            raise ConfigError(f"cannot load {vn_path}: {type(exc).__name__}: {_first_line(exc)}") from exc
+            try:
+                vecnorm = VecNormalize.load(str(pkl_path), venv)
+            except (EOFError, OSError, ValueError, KeyError, AttributeError, pickle.UnpicklingError) as exc:
+                raise ConfigError(f"cannot load {pkl_path}: {type(exc).__name__}: {_first_line(exc)}") from exc
     try:
         return SB3Attacker(
             model, vecnorm, deterministic, params=params, observation=run.observation, features=run.features,

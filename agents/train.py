@@ -8,7 +8,7 @@ or a plant file ``--system FILE``), a ``quick:`` section for smoke tests (``--qu
 the native vector environment through :class:`agents.sb3.SB3VecEnv` on the fast ideal backend.
 
 A run directory (:mod:`agents.runs`) holds ``model.zip`` (final), ``best_model.zip`` (best
-evaluation), ``vecnormalize.pkl`` (when observations are normalised), ``learning_curve.npz``
+evaluation), ``vecnormalize.npz`` (when observations are normalised), ``learning_curve.npz``
 and ``learning_curve.png`` (evaluation ``E[epsilon] / gamma_opt(N)`` against training steps,
 :mod:`agents.curves`), ``evaluations.npz``, TensorBoard logs under ``tb/`` and ``run.json``
 (configuration, timing, and the final evaluation: the learned policy against the Gaussian
@@ -46,7 +46,7 @@ from .config import CONFIG_DIR, apply_override, env_config, load_config, run_nam
 from .curves import CURVE_FILE, curve_for, plot_learning_curves
 from .hyperparams import make_schedules, network_bytes, policy_kwargs
 from .runs import RUN_FILE, new_run_dir, read_run
-from .sb3 import ALGORITHMS, SB3VecEnv, algorithm_class, load_attacker
+from .sb3 import ALGORITHMS, VECNORMALIZE_FILE, SB3VecEnv, algorithm_class, load_attacker, save_vecnormalize
 
 __all__ = ["CONFIG_DIR", "load_config", "apply_override", "train", "final_evaluation", "add_arguments", "run"]
 
@@ -175,7 +175,7 @@ def train(
     seconds = time.perf_counter() - t0
     model.save(str(run_dir / "model.zip"))
     if hasattr(env, "obs_rms"):
-        env.save(str(run_dir / "vecnormalize.pkl"))
+        save_vecnormalize(env, run_dir / VECNORMALIZE_FILE)
     if len(curve.timesteps):
         plot_learning_curves([curve], run_dir / "learning_curve.png", title=f"{run_dir.name}: evaluation error over the optimum")
     stopped = int(model.num_timesteps) < total

@@ -15,19 +15,22 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
+import stat
 import sys
 from fractions import Fraction
 from typing import Any
 
 import numpy as np
 
-from .errors import ParameterError, ShapeError, UnstableSystemError
+from .errors import ConfigError, ParameterError, ShapeError, UnstableSystemError
 
 __all__ = [
     "one_line",
     "format_value",
     "check_positive",
     "check_nonnegative",
+    "check_real",
     "check_int",
     "check_bool",
     "parse_number",
@@ -35,6 +38,7 @@ __all__ = [
     "check_system",
     "spectral_radius",
     "check_schur_stable",
+    "check_regular_file",
     "FLOAT_MAX",
 ]
 
@@ -135,6 +139,12 @@ def _as_float(name: str, value: Any) -> float:
     if not math.isfinite(v):
         raise ParameterError(f"{name} must be finite, got {format_value(value)}")
     return v
+
+
+def check_real(name: str, value: Any) -> float:
+    """Return ``value`` as a float, raising :class:`ParameterError` unless it is a finite real
+    number (not a bool, not complex, not a string, within the float64 range)."""
+    return _as_float(name, value)
 
 
 def check_positive(name: str, value: Any) -> float:
@@ -264,3 +274,27 @@ def check_schur_stable(A: np.ndarray) -> float:
     if not rho < 1.0:
         raise UnstableSystemError(f"A must be Schur stable (spectral radius < 1), got spectral radius {rho:.6g}")
     return rho
+
+
+_FILE_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+               (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))  # fmt: skip
+
+
+def check_regular_file(what: str, path: Any) -> str:
+    """Return ``path`` as a string, raising :class:`ConfigError` unless it names an existing
+    regular file; the message says what it is instead ("does not exist", "is a directory",
+    "is not a regular file: a FIFO (named pipe)", ...). Only ``os.stat`` is called: a FIFO is
+    never opened, so the check cannot block."""
+    name = os.fspath(path)
+    try:
+        mode = os.stat(name).st_mode
+    except FileNotFoundError:
+        raise ConfigError(f"{what} {name!r} does not exist") from None
+    except (OSError, ValueError) as exc:  # permission, a name too long, an embedded NUL
+        raise ConfigError(f"{what} {name!r} cannot be examined: {getattr(exc, 'strerror', None) or exc}") from None
+    if stat.S_ISREG(mode):
+        return name
+    if stat.S_ISDIR(mode):
+        raise ConfigError(f"{what} {name!r} is a directory, not a file")
+    kind = next((label for test, label in _FILE_KINDS if test(mode)), "a special file")
+    raise ConfigError(f"{what} {name!r} is not a regular file: it is {kind}")

@@ -44,7 +44,15 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import FLOAT_MAX, as_finite_array, check_nonnegative, check_positive, check_system, format_value
+from ._validation import (
+    FLOAT_MAX,
+    as_finite_array,
+    check_nonnegative,
+    check_positive,
+    check_regular_file,
+    check_system,
+    format_value,
+)
 from .errors import ConfigError, ParameterError, ResourceLimitError
 from .presets import DESIGN_FIELDS, SystemPreset, design_defaults
 from .units import parse_duration
@@ -350,9 +358,7 @@ def load_plant_file(path: str | Path, *, defaults: Mapping[str, Any] | SystemPre
         For values out of their domain (a negative variance), shapes that do not fit, or
         ``defaults`` that is not a mapping of design values (or holds unknown fields).
     """
-    p = Path(path)
-    if not p.is_file():
-        raise ConfigError(f"system file {str(p)!r} does not exist")
+    p = Path(check_regular_file("system file", path))
     data = _decode(p)
     if not isinstance(data, Mapping):
         raise _fail(p, f"must hold a mapping with 'A' and 'B', got {format_value(data)}")

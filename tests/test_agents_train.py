@@ -88,7 +88,7 @@ def ppo_run(tmp_path_factory) -> Path:
 
 
 def test_train_quick_writes_a_complete_run(ppo_run, capsys):
-    for f in ("model.zip", "best_model.zip", "vecnormalize.pkl", "evaluations.npz", "run.json", "learning_curve.npz",
+    for f in ("model.zip", "best_model.zip", "vecnormalize.npz", "evaluations.npz", "run.json", "learning_curve.npz",
               "learning_curve.png"):
         assert (ppo_run / f).exists(), f
     assert (ppo_run / "learning_curve.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -289,3 +289,91 @@ def test_evaluate_prints_the_compare_table_on_paired_seeds(ppo_run, tmp_path, ca
     assert "warning: --deterministic" in capsys.readouterr().err
     assert cli.main(["evaluate", str(ppo_run), "--delays", "end"]) == 2
     assert "cannot play with decipher_delay 'end'" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ normalisation statistics without pickles
+def _copy_run(src: Path, dst: Path) -> Path:
+    import shutil
+
+    return Path(shutil.copytree(src, dst, ignore=shutil.ignore_patterns("tb", "evaluation")))
+
+
+def test_the_normalisation_statistics_are_arrays_and_load_as_sb3_saved_them(ppo_run, tmp_path):
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    from agents.sb3 import load_vecnormalize, save_vecnormalize
+
+    run = read_run(ppo_run)
+    with np.load(ppo_run / "vecnormalize.npz", allow_pickle=False) as z:  # plain arrays: loads without pickles
+        assert z["obs_mean"].shape == z["obs_var"].shape and z["obs_count"] > 0
+    venv = SB3VecEnv(run.env, 1, run.observation, features=run.features)
+    ours = load_vecnormalize(ppo_run / "vecnormalize.npz", venv)
+    ours.save(str(tmp_path / "vn.pkl"))  # SB3's own pickle of the same statistics
+    theirs = VecNormalize.load(str(tmp_path / "vn.pkl"), venv)
+    obs = np.random.default_rng(0).normal(size=(3, *venv.observation_space.shape)) * 10
+    assert np.array_equal(ours.normalize_obs(obs), theirs.normalize_obs(obs))
+    for attr in ("clip_obs", "clip_reward", "gamma", "epsilon", "norm_obs", "norm_reward"):
+        assert getattr(ours, attr) == getattr(theirs, attr), attr
+    again = load_vecnormalize(save_vecnormalize(theirs, tmp_path / "again.npz"), venv)
+    assert np.array_equal(again.obs_rms.var, theirs.obs_rms.var) and again.ret_rms.count == theirs.ret_rms.count
+
+
+class _RunsCode:
+    """A pickle payload that leaves a marker file when it is unpickled."""
+
+    def __init__(self, marker: Path) -> None:
+        self.marker = marker
+
+    def __reduce__(self):  # type: ignore[no-untyped-def]
+        return (Path.write_text, (self.marker, "ran"))
+
+
+def test_an_old_run_with_a_pickle_is_refused_unless_the_caller_opts_in(ppo_run, tmp_path, capsys):
+    import pickle
+
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    from agents.sb3 import load_vecnormalize
+
+    old = _copy_run(ppo_run, tmp_path / "old")
+    run = read_run(old)
+    vn = load_vecnormalize(old / "vecnormalize.npz", SB3VecEnv(run.env, 1, run.observation, features=run.features))
+    (old / "vecnormalize.npz").unlink()
+    vn.save(str(old / "vecnormalize.pkl"))  # what older versions wrote
+    with pytest.raises(ConfigError, match="allow_pickle=True"):
+        load_attacker(old)
+    assert isinstance(load_attacker(old, allow_pickle=True).vecnormalize, VecNormalize)
+
+    marker = tmp_path / "marker"
+    (old / "vecnormalize.pkl").write_bytes(pickle.dumps(_RunsCode(marker)))
+    with pytest.raises(ConfigError, match="--allow-pickle"):
+        load_attacker(old)
+    assert cli.main(["evaluate", str(old), "--episodes", "2", "--points", "1", "--no-progress",
+                     "--out", str(tmp_path / "ev")]) == 2  # fmt: skip
+    err = capsys.readouterr().err.strip()
+    assert "--allow-pickle" in err and len(err.splitlines()) == 1
+    assert not marker.exists()  # nothing was unpickled
+
+
+def test_a_bad_env_in_run_json_is_blamed_on_run_json(ppo_run, tmp_path):
+    bad = _copy_run(ppo_run, tmp_path / "bad")
+    meta = json.loads((bad / "run.json").read_text())
+    meta["env"]["sigma_w2"] = -1.0
+    (bad / "run.json").write_text(json.dumps(meta))
+    params = resolve_params(read_run(ppo_run).env)  # the caller's own, valid environment
+    with pytest.raises(ConfigError, match=r"run\.json: its env does not make an environment: sigma_w2") as info:
+        load_attacker(bad, params=params)
+    assert "vecnormalize" not in str(info.value)
+
+
+@pytest.mark.parametrize("lags", [10**5, 4096])
+def test_evaluate_refuses_a_run_whose_estimator_does_not_fit_in_one_line(ppo_run, tmp_path, capsys, lags):
+    big = _copy_run(ppo_run, tmp_path / "iv")
+    meta = json.loads((big / "run.json").read_text())
+    meta["env"]["estimator"] = {"name": "iv", "lags": lags}
+    (big / "run.json").write_text(json.dumps(meta))
+    rc = cli.main(["evaluate", str(big), "--episodes", "64", "--points", "1", "--no-progress", "--out", str(tmp_path / "ev")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2, err
+    assert "lags" in err or "iv(lags=4096) estimator's moments" in err
+    assert len(err.splitlines()) == 1 and "Traceback" not in err

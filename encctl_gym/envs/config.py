@@ -456,7 +456,7 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
                 "keys are broken: set max_samples (the episode terminates earlier if the measured time passes tau_c)"
             )
         budget = math.inf  # the measured clock, not the model, ends the episode within tau_c
-    if math.isinf(budget) and max_samples is None:
+    if budget == math.inf and max_samples is None:  # budget may be an int beyond float range
         raise ParameterError(
             f"with scheme={scheme!r} and adversary={adversary!r} one break reveals every sample, so the "
             "deciphering budget does not bound the attack: set max_samples"

@@ -98,6 +98,13 @@ class BayesianLeastSquares(MomentEstimator):
             raise ParameterError(f"prior_mean must be a number or an (n, n + m) array, got {prior_mean!r}") from None
         if m0.ndim not in (0, 2) or not np.all(np.isfinite(m0)):
             raise ShapeError(f"prior_mean must be a finite scalar or an (n, n + m) array, got {prior_mean!r}")
+        with np.errstate(over="ignore"):
+            square = float(np.square(m0).sum())
+        if not math.isfinite(square):  # the prior's own error (Definition def:error) would overflow
+            raise ParameterError(
+                f"prior_mean's squared entries overflow float64 (sum of squares {square}, largest entry "
+                f"{float(np.abs(m0).max()):.4g}): its estimation error cannot be measured (entries must stay below about 1e154)"
+            )
         self.prior_mean = m0
         if (prior_variance is None) != (noise_variance is None):
             missing = "noise_variance" if noise_variance is None else "prior_variance"

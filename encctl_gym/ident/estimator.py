@@ -35,6 +35,7 @@ import numpy as np
 
 from .._validation import check_int, check_system
 from ..errors import ParameterError, ShapeError
+from ..resources import check_memory
 from .error import estimation_error
 from .least_squares import check_runs, check_sample_sizes, check_trajectory
 
@@ -296,6 +297,11 @@ class MomentEstimator(ABC):
         m = check_int("m", m, minimum=1)
         self.check_dimensions(n, m)
         p = self.features(n, m)
+        check_memory(
+            f"the {self.label} estimator's moments for K = {K} copies of an n = {n}, m = {m} plant ({p} features)",
+            self.online_bytes(K, n, m),
+            advice="use fewer copies or an estimator with fewer features",
+        )
         self._K, self._n, self._m = K, n, m
         self._M = np.zeros((K, p, p))
         self._buf = np.empty((K, self.BLOCK, p))
@@ -303,6 +309,12 @@ class MomentEstimator(ABC):
         self._count = 0
         self._cache = None
         self.reset_history(K, n, m)
+
+    def online_bytes(self, K: int, n: int, m: int) -> int:
+        """Bytes :meth:`start` allocates and one estimate uses: per copy, the ``p x p`` moments,
+        a block of ``BLOCK`` rows of ``p`` features and a ``p x p`` solve (float64)."""
+        p = self.features(n, m)
+        return 8 * K * (2 * p * p + self.BLOCK * p + p)
 
     def _started(self) -> None:
         if self._M is None:

@@ -11,11 +11,11 @@ falling once ``N`` exceeds the memory. ``lambda = 1`` is ordinary least squares.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 
+from .._validation import check_real, format_value
 from ..errors import ParameterError
 from .estimator import MomentEstimator
 from .ordinary import gram_solve
@@ -45,12 +45,9 @@ class ForgettingLeastSquares(MomentEstimator):
 
     def __init__(self, forgetting_factor: float = DEFAULT_FORGETTING_FACTOR) -> None:
         super().__init__()
-        try:
-            lam = float(forgetting_factor)
-        except (TypeError, ValueError):
-            raise ParameterError(f"forgetting_factor must be a number in (0, 1], got {forgetting_factor!r}") from None
-        if isinstance(forgetting_factor, bool) or not (math.isfinite(lam) and 0.0 < lam <= 1.0):
-            raise ParameterError(f"forgetting_factor must lie in (0, 1], got {forgetting_factor!r}")
+        lam = check_real("forgetting_factor", forgetting_factor)  # a finite real number: no str, no bool
+        if not 0.0 < lam <= 1.0:
+            raise ParameterError(f"forgetting_factor must lie in (0, 1], got {format_value(forgetting_factor)}")
         self.forgetting_factor = lam
         self.decay = lam
 

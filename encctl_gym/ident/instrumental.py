@@ -27,9 +27,13 @@ from .._validation import check_int
 from ..errors import ParameterError
 from .estimator import MomentEstimator
 
-__all__ = ["InstrumentalVariables"]
+__all__ = ["InstrumentalVariables", "MAX_LAGS"]
 
 _EPS = np.finfo(np.float64).eps
+
+#: Largest ``lags``, so that a mistyped value is refused at once rather than sized: ``(L + 1) m``
+#: instruments make ``p^2`` moments per copy (about 0.5 GiB at L = MAX_LAGS, m = 2).
+MAX_LAGS = 4096
 
 
 class InstrumentalVariables(MomentEstimator):
@@ -38,7 +42,7 @@ class InstrumentalVariables(MomentEstimator):
     Parameters
     ----------
     lags : int, optional
-        ``L >= 1``: instruments ``u_j, u_{j-1}, ..., u_{j-L}``. Default ``ceil(n / m)``, the
+        ``1 <= L <= MAX_LAGS``: instruments ``u_j, u_{j-1}, ..., u_{j-L}``. Default ``ceil(n / m)``, the
         fewest that give at least ``n + m`` instruments.
 
     Notes
@@ -53,7 +57,7 @@ class InstrumentalVariables(MomentEstimator):
     Raises
     ------
     ParameterError
-        For ``lags < 1``, and (at :meth:`fit` / :meth:`start`) when ``(L + 1) m < n + m``:
+        For ``lags`` outside ``[1, MAX_LAGS]``, and (at :meth:`fit` / :meth:`start`) when ``(L + 1) m < n + m``:
         fewer instruments than unknowns per row, an under-determined problem.
     """
 
@@ -61,7 +65,7 @@ class InstrumentalVariables(MomentEstimator):
 
     def __init__(self, lags: int | None = None) -> None:
         super().__init__()
-        self.lags = None if lags is None else check_int("lags", lags, minimum=1)
+        self.lags = None if lags is None else check_int("lags", lags, minimum=1, maximum=MAX_LAGS)
         self._hist: np.ndarray | None = None
 
     @property

@@ -14,13 +14,18 @@ The defender policies with real levers (input noise, audits, a chi-squared detec
 
 Both use the group the defender picks (:mod:`encctl_gym.loop.defender`; by default that of
 :func:`~encctl_gym.loop.backend.loop_group` for the key length), so their trajectories agree
-bit for bit.
+bit for bit up to the largest shipped group (2048 bits). Above it, with the default defender,
+the ElGamal backend generates a safe-prime group of the key length (minutes at 2500 bits), while
+the ideal backend, which needs the group only for the residue pattern of its quantisation, stays
+on the 2048-bit group: it generates nothing, and its trajectories then differ from ElGamal's in
+the rounding pattern only.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
+from ..crypto.group import SHIPPED_BITS
 from ..errors import ParameterError
 from .backend import LoopBackend, loop_group, lqr_gain, table_limit
 from .defender import DEFENDERS, DefenderAction, DefenderPolicy, FixedDefender, PlantView, make_defender
@@ -57,10 +62,16 @@ BACKENDS: dict[str, type] = {"ideal": IdealLoop, "elgamal": ElGamalLoop}
 def make_loop(params: Any, defender: DefenderPolicy | None = None) -> LoopBackend:
     """The backend selected by ``params.crypto``, on the group the defender picks
     (``defender``, else the policy of ``params.defender``; by default :func:`loop_group` of the
-    key length)."""
+    key length).
+
+    With the default defender, a backend without ciphertexts (``needs_key_length_group = False``:
+    the ideal one) gets the group of ``min(key_length, max(SHIPPED_BITS))`` bits, so it never
+    generates a group."""
     try:
         backend = BACKENDS[params.crypto]
     except KeyError:
         raise ParameterError(f"unknown crypto backend {params.crypto!r}; choose one of {', '.join(BACKENDS)}") from None
     policy = defender if defender is not None else make_defender(params.defender)
+    if not getattr(backend, "needs_key_length_group", True) and isinstance(policy, FixedDefender):
+        return backend(params, loop_group(min(params.key_length, max(SHIPPED_BITS))))
     return backend(params, policy.group(params))

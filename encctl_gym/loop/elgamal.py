@@ -74,6 +74,8 @@ class ElGamalLoop:
     """
 
     batched = False
+    #: ciphertexts live in the group of the key length (generated above the shipped sizes)
+    needs_key_length_group = True
     quantization = None
 
     def __init__(self, params: Any, group: Any) -> None:

@@ -41,6 +41,8 @@ class IdealLoop:
     """
 
     batched = True
+    #: the group serves the quantisation's residue pattern only: no group of the key length is needed
+    needs_key_length_group = False
     #: nothing is broken: the time charged is the cost model's
     deciphering_seconds = 0.0
 

@@ -72,6 +72,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="comma-separated decipher delays: integers >= 0 or end (default: the run's; a blind policy also end)")
     parser.add_argument("--deterministic", action="store_true",
                         help="play the policy's mean action (not recommended: the policy's noise is its excitation)")
+    parser.add_argument("--allow-pickle", action="store_true",
+                        help="unpickle an older run's vecnormalize.pkl (a pickle can run any code: only for runs you trust)")
     parser.add_argument("--which", choices=("best", "final"), default="best", help="the best model of the training's evaluations (default) or the final one")
     parser.add_argument("--samples", type=int, default=None,
                         help="attack length N to evaluate at, set through the deciphering budget (default: the training attack length)")
@@ -104,7 +106,8 @@ def run(args: argparse.Namespace) -> int:
 
     def learned(setting: Setting) -> list[Attacker]:
         label = info.algo + ("-blind" if info.observation == "blind" else "")
-        return [load_attacker(info.path, which=which, params=setting.params, name=label, deterministic=args.deterministic)]
+        return [load_attacker(info.path, which=which, params=setting.params, name=label, deterministic=args.deterministic,
+                              allow_pickle=args.allow_pickle)]
 
     result = compute(settings=settings, episodes=episodes, seed=args.seed, points=args.points, attackers=BASELINES,
                      elgamal_episodes=args.elgamal_episodes, elgamal_N=min(40, min(s.params.horizon for s in settings)),

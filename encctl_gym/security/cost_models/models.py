@@ -62,6 +62,12 @@ class PaperModel(CostModel):
         c = pow2(lam_v)
         return KeyBreakCost("paper", c, c, security_parameter=lam_v, gnfs_correction=self.gnfs_correction)
 
+    def security_parameter_range(self) -> tuple[float, float]:
+        """``(low, high)``: :meth:`key_length_for_security_parameter` answers for ``low < lam <= high``,
+        the formula's ``log2 Omega(k) - c`` at the ends of :attr:`key_length_range` (eq:opt_key)."""
+        lo, hi = self.key_length_range
+        return self.security_parameter_of_key_length(lo), self.security_parameter_of_key_length(hi)
+
     def key_length_for_security_parameter(self, lam: Any) -> int:
         """eq:opt_key: the smallest ``k`` with ``log2 Omega(k) - c >= lam``.
 
@@ -84,8 +90,9 @@ class PaperModel(CostModel):
             )
         if self.security_parameter_of_key_length(hi) < lam_v:
             raise ModelRangeError(
-                f"security parameter lam = {format_value(lam)} needs more than the {hi}-bit limit on key lengths "
-                f"(log2 Omega({hi}) - c = {self.security_parameter_of_key_length(hi):.3f} bits)"
+                f"security parameter lam = {format_value(lam)} has no key length under the GNFS formula: keys end at "
+                f"{hi} bits (MAX_KEY_LENGTH), which reach lam <= log2 Omega({hi}) - c = "
+                f"{self.security_parameter_of_key_length(hi):.3f} bits"
             )
         while hi - lo > 1:
             mid = (lo + hi) // 2
@@ -218,7 +225,11 @@ def minimum_key_length(lam: Any, gnfs_correction: Any = 0.0) -> int:
     Parameters
     ----------
     lam : int or float
-        Security parameter (integer in ``[1, 2048]`` or real in ``(0, 2048]``).
+        Security parameter in bits. The key lengths of the formula's range, 40 to 65536 bits
+        (:data:`MAX_KEY_LENGTH`), reach ``log2 Omega(40) - c < lam <= log2 Omega(65536) - c``,
+        i.e. ``18.70 - c < lam <= 481.38 - c`` bits
+        (:meth:`PaperModel.security_parameter_range`); a larger ``lam``, though a valid security
+        parameter elsewhere (up to :data:`LAMBDA_MAX` = 2048), has no key length here.
     gnfs_correction : float, default 0.0
         o(1) correction in bits.
 
