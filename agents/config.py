@@ -230,12 +230,7 @@ def plant_config(path: str | Path, preset: str | None) -> dict[str, Any]:
 
 
 def load_config(
-    algo: str,
-    preset: str | None = None,
-    *,
-    path: str | Path | None = None,
-    system: str | Path | None = None,
-    quick: bool = False,
+    algo: str, preset: str | None = None, *, path: str | Path | None = None, system: str | Path | None = None, quick: bool = False
 ) -> dict[str, Any]:
     """The configuration of one training run, merged in the layers of the module docstring.
 
@@ -344,6 +339,7 @@ def _features(name: str, v: Any) -> Any:
 
     return check_features(v, name)
 
+
 _str = _typed(str, "a string")
 
 #: Checks of every entry but ``env`` and ``hyperparams`` (checked against the environment and
@@ -418,7 +414,9 @@ def validate_config(cfg: dict[str, Any]) -> None:
     hp = cfg.get("hyperparams", {})
     if not isinstance(hp, dict):
         raise ConfigError(f"hyperparams must be a mapping, got {hp!r}")
-    check_kwargs("hyperparams", {k: v for k, v in hp.items() if k != "policy_kwargs"}, algo_cls.__init__, RESERVED - {"policy_kwargs"})
+    check_kwargs(
+        "hyperparams", {k: v for k, v in hp.items() if k != "policy_kwargs"}, algo_cls.__init__, RESERVED - {"policy_kwargs"}
+    )
     policy_kwargs(algo_cls, cfg.get("policy", "MlpPolicy"), hp.get("policy_kwargs"))
 
 
@@ -432,8 +430,10 @@ def _check_elgamal_evaluation(cfg: dict[str, Any]) -> None:
     try:
         resolve_params(elgamal_config(env_config(cfg), int(el["max_samples"]), key_length=int(el["key_length"]), crypto_seed=0))
     except EncctlError as exc:
-        raise ConfigError(f"eval.elgamal (max_samples = {format_value(el['max_samples'])}, key_length = "
-                          f"{format_value(el['key_length'])}): {exc}") from None
+        raise ConfigError(
+            f"eval.elgamal (max_samples = {format_value(el['max_samples'])}, key_length = "
+            f"{format_value(el['key_length'])}): {exc}"
+        ) from None
 
 
 # --------------------------------------------------------------------------- overrides
@@ -443,7 +443,9 @@ def _yaml_value(text: str) -> Any:
         _check_yaml_tokens(text, f"override value {format_value(text)}")
         v = yaml.safe_load(text)
     except (ValueError, yaml.YAMLError) as exc:  # ValueError: an integer of over 4300 digits
-        raise ConfigError(f"override value {format_value(text)} is not valid YAML: {format_value(str(exc).splitlines()[0])}") from None
+        raise ConfigError(
+            f"override value {format_value(text)} is not valid YAML: {format_value(str(exc).splitlines()[0])}"
+        ) from None
     if isinstance(v, str):
         try:
             return float(v)

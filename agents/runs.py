@@ -37,7 +37,16 @@ from typing import Any
 from encctl_gym._validation import format_value
 from encctl_gym.errors import ConfigError
 
-__all__ = ["RUN_FILE", "MAX_RUN_FILE_BYTES", "RunInfo", "read_run", "check_model_file", "find_runs", "new_run_dir", "check_output_dir"]
+__all__ = [
+    "RUN_FILE",
+    "MAX_RUN_FILE_BYTES",
+    "RunInfo",
+    "read_run",
+    "check_model_file",
+    "find_runs",
+    "new_run_dir",
+    "check_output_dir",
+]
 
 #: The metadata file that makes a directory a training run.
 RUN_FILE = "run.json"
@@ -121,7 +130,9 @@ def check_model_file(path: str | Path) -> None:
     except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
         raise ConfigError(f"cannot load {p}: not a readable model archive (a zip file): {format_value(str(exc))}") from None
     if "data" not in names:
-        raise ConfigError(f"cannot load {p}: not a stable-baselines3 model archive (no 'data' member among {format_value(names)})")
+        raise ConfigError(
+            f"cannot load {p}: not a stable-baselines3 model archive (no 'data' member among {format_value(names)})"
+        )
 
 
 def read_run(run_dir: str | Path) -> RunInfo:
@@ -149,7 +160,11 @@ def read_run(run_dir: str | Path) -> RunInfo:
     meta_path = path / RUN_FILE
     if not path.exists():
         quick = path.with_name(path.name + "-quick") if path.name else None
-        hint = f"; a smoke-test run (--quick) of that name is {str(quick)!r}" if quick is not None and (quick / RUN_FILE).is_file() else ""
+        hint = (
+            f"; a smoke-test run (--quick) of that name is {str(quick)!r}"
+            if quick is not None and (quick / RUN_FILE).is_file()
+            else ""
+        )
         raise ConfigError(f"the run directory {str(path)!r} does not exist{hint}")
     if not meta_path.is_file():
         raise ConfigError(f"{str(path)!r} is not a training run (no {RUN_FILE})")
@@ -159,7 +174,11 @@ def read_run(run_dir: str | Path) -> RunInfo:
     try:
         meta = json.loads(meta_path.read_text())
     except (OSError, ValueError, RecursionError) as exc:  # ValueError: bad JSON, bad UTF-8, an integer of over 4300 digits
-        what = "nests too deeply" if isinstance(exc, RecursionError) else format_value(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+        what = (
+            "nests too deeply"
+            if isinstance(exc, RecursionError)
+            else format_value(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
+        )
         raise ConfigError(f"cannot read {meta_path}: {what}") from None
     if not isinstance(meta, dict):
         raise ConfigError(f"{meta_path} must hold a JSON object, got {type(meta).__name__}")
@@ -174,12 +193,21 @@ def read_run(run_dir: str | Path) -> RunInfo:
     seed = meta.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int):
         raise ConfigError(f"{meta_path}: field 'seed' must be an integer, got {seed!r}")
-    return RunInfo(path=path, algo=meta["algo"], observation=meta["observation"], env=env, system=str(system),
-                   seed=seed, quick=bool(config.get("quick", False)), meta=meta)
+    return RunInfo(
+        path=path,
+        algo=meta["algo"],
+        observation=meta["observation"],
+        env=env,
+        system=str(system),
+        seed=seed,
+        quick=bool(config.get("quick", False)),
+        meta=meta,
+    )
 
 
-def find_runs(roots: Sequence[str | Path], *, include_quick: bool = False,
-              left_out: list[tuple[Path, str]] | None = None) -> list[RunInfo]:
+def find_runs(
+    roots: Sequence[str | Path], *, include_quick: bool = False, left_out: list[tuple[Path, str]] | None = None
+) -> list[RunInfo]:
     """The training runs (a ``run.json`` and a ``model.zip``) under ``roots``.
 
     A root that is itself a run is taken as given; under any other root every direct

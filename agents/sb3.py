@@ -178,7 +178,9 @@ class SB3Attacker(Attacker):
         if self.vecnormalize is not None:
             o = self.vecnormalize.normalize_obs(o)
         if self.recurrent:
-            a, self._state = self.model.predict(o, state=self._state, episode_start=self._episode_start, deterministic=self.deterministic)
+            a, self._state = self.model.predict(
+                o, state=self._state, episode_start=self._episode_start, deterministic=self.deterministic
+            )
             self._episode_start = np.zeros(obs.shape[0], dtype=bool)
         else:
             a, _ = self.model.predict(o, deterministic=self.deterministic)
@@ -320,15 +322,24 @@ def load_attacker(
                 raise ConfigError(f"cannot load {pkl_path}: {type(exc).__name__}: {_first_line(exc)}") from exc
     try:
         return SB3Attacker(
-            model, vecnorm, deterministic, params=params, observation=run.observation, features=run.features,
+            model,
+            vecnorm,
+            deterministic,
+            params=params,
+            observation=run.observation,
+            features=run.features,
             name=name or run.algo,
         )
     except ParameterError as exc:  # an environment other than the run's: name the run and the difference
         trained = resolve_params(env_cfg)
-        diff = [f"{k} = {getattr(trained, k)} in training, {getattr(params, k)} here" for k in ("n", "m", "input_history")
-                if getattr(trained, k) != getattr(params, k)]
-        raise ConfigError(f"the run {run.path} cannot play in this environment: {exc}"
-                          + (f" ({'; '.join(diff)})" if diff else "")) from None
+        diff = [
+            f"{k} = {getattr(trained, k)} in training, {getattr(params, k)} here"
+            for k in ("n", "m", "input_history")
+            if getattr(trained, k) != getattr(params, k)
+        ]
+        raise ConfigError(
+            f"the run {run.path} cannot play in this environment: {exc}" + (f" ({'; '.join(diff)})" if diff else "")
+        ) from None
 
 
 def _first_line(exc: BaseException) -> str:

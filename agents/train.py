@@ -57,8 +57,12 @@ def _make_env(cfg: dict[str, Any], env_cfg: dict[str, Any], num_envs: int, rewar
     venv: Any = VecMonitor(SB3VecEnv(env_cfg, num_envs, cfg["observation"], reward_scaling, features=cfg.get("features") or ()))
     norm = cfg.get("normalize") or {}
     if norm.get("norm_obs") or norm.get("norm_reward"):
-        venv = VecNormalize(venv, norm_obs=bool(norm.get("norm_obs", True)), norm_reward=bool(norm.get("norm_reward", False)),
-                            gamma=float(cfg["hyperparams"].get("gamma", 0.99)))
+        venv = VecNormalize(
+            venv,
+            norm_obs=bool(norm.get("norm_obs", True)),
+            norm_reward=bool(norm.get("norm_reward", False)),
+            gamma=float(cfg["hyperparams"].get("gamma", 0.99)),
+        )
     return venv
 
 
@@ -140,21 +144,33 @@ def train(
     n_in = int(np.prod(env.observation_space.shape))
     n_out = int(np.prod(env.action_space.shape))
     net_arch = (cfg["hyperparams"].get("policy_kwargs") or {}).get("net_arch")
-    check_memory(f"training the policy networks of net_arch = {format_value(net_arch)} ({n_in} inputs, {n_out} outputs)",
-                 network_bytes(net_arch, n_in, n_out), advice="use smaller layers (hyperparams.policy_kwargs.net_arch)")
+    check_memory(
+        f"training the policy networks of net_arch = {format_value(net_arch)} ({n_in} inputs, {n_out} outputs)",
+        network_bytes(net_arch, n_in, n_out),
+        advice="use smaller layers (hyperparams.policy_kwargs.net_arch)",
+    )
     try:
         model = algo_cls(cfg["policy"], env, seed=seed, verbose=verbose, device="cpu", **hp)
     except (AssertionError, ValueError, TypeError) as exc:  # stable-baselines3's own checks of the values
         raise ConfigError(f"{cfg['algo']} rejected the hyperparameters {format_value(cfg['hyperparams'])}: {exc}") from exc
     except (RuntimeError, MemoryError) as exc:  # PyTorch could not allocate the networks
         first = str(exc).strip().splitlines()
-        raise ConfigError(f"{cfg['algo']} could not build its model with the hyperparameters {format_value(cfg['hyperparams'])}: "
-                          f"{type(exc).__name__}: {format_value(first[0] if first else '')}") from None
+        raise ConfigError(
+            f"{cfg['algo']} could not build its model with the hyperparameters {format_value(cfg['hyperparams'])}: "
+            f"{type(exc).__name__}: {format_value(first[0] if first else '')}"
+        ) from None
     run_dir = new_run_dir(out, name or run_name(cfg, seed), overwrite=overwrite)
     model.tensorboard_log = str(run_dir / "tb") if tensorboard else None
     meta: dict[str, Any] = {
-        "status": "training", "algo": cfg["algo"], "observation": cfg["observation"], "system": cfg["system"],
-        "env": env_cfg, "seed": seed, "n_timesteps": int(cfg["n_timesteps"]), "n_envs": n_envs, "config": cfg,
+        "status": "training",
+        "algo": cfg["algo"],
+        "observation": cfg["observation"],
+        "system": cfg["system"],
+        "env": env_cfg,
+        "seed": seed,
+        "n_timesteps": int(cfg["n_timesteps"]),
+        "n_envs": n_envs,
+        "config": cfg,
     }
     _write_meta(run_dir, meta)
     curve = curve_for(params, cfg["observation"], algo=cfg["algo"], system=cfg["system"], seed=seed)
@@ -162,9 +178,16 @@ def train(
     callbacks: list[Any] = [
         AttackMetricsCallback(),
         LearningCurveCallback(
-            eval_env, curve=curve, curve_path=run_dir / CURVE_FILE, eval_seed=int(ev["seed"]),
-            n_eval_episodes=n_eval, eval_freq=max(int(ev["freq"]) // n_envs, 1),
-            log_path=str(run_dir), best_model_save_path=str(run_dir), deterministic=False, verbose=verbose,
+            eval_env,
+            curve=curve,
+            curve_path=run_dir / CURVE_FILE,
+            eval_seed=int(ev["seed"]),
+            n_eval_episodes=n_eval,
+            eval_freq=max(int(ev["freq"]) // n_envs, 1),
+            log_path=str(run_dir),
+            best_model_save_path=str(run_dir),
+            deterministic=False,
+            verbose=verbose,
             on_evaluation=on_evaluation,
         ),
     ]
@@ -180,11 +203,20 @@ def train(
         plot_learning_curves([curve], run_dir / "learning_curve.png", title=f"{run_dir.name}: evaluation error over the optimum")
     stopped = int(model.num_timesteps) < total
     meta.update(
-        status="stopped" if stopped else "finished", timesteps_done=int(model.num_timesteps), train_seconds=round(seconds, 1),
-        steps_per_second=round(model.num_timesteps / seconds, 1), torch_threads=torch.get_num_threads(),
-        learning_curve={"N": curve.N, "gamma": curve.gamma, "gamma_gauss": curve.gamma_gauss, "gamma_opt": curve.gamma_opt, "design": curve.design_kind,
-                        "evaluations": int(len(curve.timesteps)),
-                        "last_ratio_to_gamma_opt": float(curve.ratio()[0][-1]) if len(curve.timesteps) else None},
+        status="stopped" if stopped else "finished",
+        timesteps_done=int(model.num_timesteps),
+        train_seconds=round(seconds, 1),
+        steps_per_second=round(model.num_timesteps / seconds, 1),
+        torch_threads=torch.get_num_threads(),
+        learning_curve={
+            "N": curve.N,
+            "gamma": curve.gamma,
+            "gamma_gauss": curve.gamma_gauss,
+            "gamma_opt": curve.gamma_opt,
+            "design": curve.design_kind,
+            "evaluations": int(len(curve.timesteps)),
+            "last_ratio_to_gamma_opt": float(curve.ratio()[0][-1]) if len(curve.timesteps) else None,
+        },
     )
     _write_meta(run_dir, meta)
     env.close()
@@ -240,8 +272,12 @@ def final_evaluation(run_dir: str | Path, *, seed: int = 10_000) -> dict[str, An
         el_params = resolve_params(el_cfg)
         att = load_attacker(run.path, which="final", params=el_params)
         r = rollout(att, el_cfg, episodes=int(el["episodes"]), seed=seed, record=False)
-        out["elgamal"] = {**_summary(r), "key_length": el_params.key_length, "N": el_params.horizon,
-                          "seconds_per_step": r.seconds / (r.episodes * max(el_params.horizon - 1, 1))}
+        out["elgamal"] = {
+            **_summary(r),
+            "key_length": el_params.key_length,
+            "N": el_params.horizon,
+            "seconds_per_step": r.seconds / (r.episodes * max(el_params.horizon - 1, 1)),
+        }
     meta["final_evaluation"] = out
     _write_meta(run.path, meta)
     return out
@@ -269,40 +305,64 @@ def system_summary(cfg: dict[str, Any], plant: str | Path) -> str:
     period ``tau_c``, then the training attack length and the shortened defense period that sets
     it (``horizon``, :func:`agents.evaluate.budget_config`), which is not the system's."""
     p = resolve_params({**cfg["env"], "gamma_opt": False})
-    text = (f"plant A ({p.n} x {p.n}), B ({p.n} x {p.m}) from {plant}; sigma_w2 = {p.sigma_w2:g}, sigma_u2 = {p.sigma_u2:g}, "
-            f"sigma_x2 = {p.sigma_x2:g}, gamma_c = {p.gamma_c:g}, defense period tau_c = {p.tau_c:g} s, Upsilon = {p.upsilon:g} "
-            f"(the values the file does not give are preset {cfg['env'].get('preset')}'s unless set with --set env.KEY=VALUE)")
+    text = (
+        f"plant A ({p.n} x {p.n}), B ({p.n} x {p.m}) from {plant}; sigma_w2 = {p.sigma_w2:g}, sigma_u2 = {p.sigma_u2:g}, "
+        f"sigma_x2 = {p.sigma_x2:g}, gamma_c = {p.gamma_c:g}, defense period tau_c = {p.tau_c:g} s, Upsilon = {p.upsilon:g} "
+        f"(the values the file does not give are preset {cfg['env'].get('preset')}'s unless set with --set env.KEY=VALUE)"
+    )
     t = resolve_params(env_config(cfg))
     if t.horizon != p.horizon:
-        text += (f"; training attacks of N = {t.horizon} samples (horizon), through a defense period shortened to "
-                 f"{t.tau_c:g} s at lambda = {t.security_parameter:g} (the system's tau_c allows N = {p.horizon})")
+        text += (
+            f"; training attacks of N = {t.horizon} samples (horizon), through a defense period shortened to "
+            f"{t.tau_c:g} s at lambda = {t.security_parameter:g} (the system's tau_c allows N = {p.horizon})"
+        )
     return text
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``encctl-gym train``."""
     parser.add_argument("--algo", required=True, choices=list(ALGORITHMS), help="learning algorithm")
-    parser.add_argument("--preset", default=None,
-                        help="system preset (default: the config's, else paper-example); its tuned config "
-                        "agents/configs/{algo}_{preset}.yaml is merged over the algorithm's default when it exists")
-    parser.add_argument("--system", default=None, metavar="FILE",
-                        help="plant file (JSON/YAML {A: ..., B: ...} or NPZ, as `design` reads) replacing the preset's A and B; "
-                        "the values the file does not give (noise variances, gamma_c, tau_c, Upsilon) come from the config's env.preset "
-                        "(default paper-example; env.preset=null: the file must give them), as for the environment's "
-                        "config={'A': A, 'B': B}; --set env.KEY=VALUE overrides any")
-    parser.add_argument("--config", default=None, metavar="FILE",
-                        help="config file merged over the algorithm's default (instead of the preset's tuned file)")
+    parser.add_argument(
+        "--preset",
+        default=None,
+        help="system preset (default: the config's, else paper-example); its tuned config "
+        "agents/configs/{algo}_{preset}.yaml is merged over the algorithm's default when it exists",
+    )
+    parser.add_argument(
+        "--system",
+        default=None,
+        metavar="FILE",
+        help="plant file (JSON/YAML {A: ..., B: ...} or NPZ, as `design` reads) replacing the preset's A and B; "
+        "the values the file does not give (noise variances, gamma_c, tau_c, Upsilon) come from the config's env.preset "
+        "(default paper-example; env.preset=null: the file must give them), as for the environment's "
+        "config={'A': A, 'B': B}; --set env.KEY=VALUE overrides any",
+    )
+    parser.add_argument(
+        "--config",
+        default=None,
+        metavar="FILE",
+        help="config file merged over the algorithm's default (instead of the preset's tuned file)",
+    )
     parser.add_argument("--quick", action="store_true", help="smoke test: the configs' quick sections (a few thousand steps)")
     parser.add_argument("--seed", type=int, default=None, help="seed (default: the config's)")
     parser.add_argument("--n-timesteps", type=int, default=None, help="override the training budget (environment steps)")
     parser.add_argument("--n-envs", type=int, default=None, help="override the number of parallel copies")
-    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                        help="override a config entry: dotted keys, YAML values (e.g. env.max_samples=512, "
-                        "hyperparams.gamma=0.99); checked like the files; repeatable")
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a config entry: dotted keys, YAML values (e.g. env.max_samples=512, "
+        "hyperparams.gamma=0.99); checked like the files; repeatable",
+    )
     parser.add_argument("--out", default="results/train", help="parent directory of the run (default results/train)")
     parser.add_argument("--name", default=None, help="run directory name (default {algo}_{system}_d{delay}_{obs}_s{seed})")
-    parser.add_argument("--overwrite", action="store_true",
-                        help="replace an earlier run of the same name (default: a new directory NAME-2, NAME-3, ...)")
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace an earlier run of the same name (default: a new directory NAME-2, NAME-3, ...)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--no-tensorboard", action="store_true", help="no TensorBoard logs")
     parser.add_argument("--no-final-eval", action="store_true", help="skip the final evaluation (ideal and ElGamal)")
@@ -320,30 +380,48 @@ def run(args: argparse.Namespace) -> int:
         apply_override(cfg, item)
     if args.system is not None:
         print(system_summary(cfg, args.system))
-    run_dir = train(cfg, out=args.out, seed=args.seed, progress=not args.no_progress, tensorboard=not args.no_tensorboard,
-                    verbose=args.verbose, name=args.name, overwrite=args.overwrite)
+    run_dir = train(
+        cfg,
+        out=args.out,
+        seed=args.seed,
+        progress=not args.no_progress,
+        tensorboard=not args.no_tensorboard,
+        verbose=args.verbose,
+        name=args.name,
+        overwrite=args.overwrite,
+    )
     meta = read_run(run_dir).meta
-    print(f"trained {cfg['algo']} for {meta['timesteps_done']} steps in {meta['train_seconds']} s "
-          f"({meta['steps_per_second']} steps/s); saved to {run_dir}")
+    print(
+        f"trained {cfg['algo']} for {meta['timesteps_done']} steps in {meta['train_seconds']} s "
+        f"({meta['steps_per_second']} steps/s); saved to {run_dir}"
+    )
     lc = meta["learning_curve"]
     if lc["last_ratio_to_gamma_opt"] is not None:
-        print(f"learning curve ({lc['evaluations']} evaluations, N = {lc['N']}): last E[eps] / gamma_opt(N) = "
-              f"{lc['last_ratio_to_gamma_opt']:.3f} (Gaussian attack {lc['gamma_gauss'] / lc['gamma_opt']:.3f}, "
-              f"paper's gamma {lc['gamma'] / lc['gamma_opt']:.3f}); "
-              f"{run_dir / 'learning_curve.png'}")
+        print(
+            f"learning curve ({lc['evaluations']} evaluations, N = {lc['N']}): last E[eps] / gamma_opt(N) = "
+            f"{lc['last_ratio_to_gamma_opt']:.3f} (Gaussian attack {lc['gamma_gauss'] / lc['gamma_opt']:.3f}, "
+            f"paper's gamma {lc['gamma'] / lc['gamma_opt']:.3f}); "
+            f"{run_dir / 'learning_curve.png'}"
+        )
     if not args.no_final_eval:
         ev = final_evaluation(run_dir)
         g = ev["gaussian"]
-        print(f"evaluation ({ev['episodes']} episodes, N = {ev['N']}): gaussian mean epsilon {g['mean_epsilon']:.4g} "
-              f"(power {g['mean_average_power']:.3g})")
+        print(
+            f"evaluation ({ev['episodes']} episodes, N = {ev['N']}): gaussian mean epsilon {g['mean_epsilon']:.4g} "
+            f"(power {g['mean_average_power']:.3g})"
+        )
         for which in ("final", "best"):
             if which in ev:
                 s = ev[which]
-                print(f"  {which:5s} model: mean epsilon {s['mean_epsilon']:.4g} +- {s['se_epsilon']:.2g}, "
-                      f"ratio to gaussian {s['ratio_to_gaussian']:.3f} (paired log ratio {s['mean_log_ratio']:+.3f} "
-                      f"+- {s['se_log_ratio']:.3f}), power {s['mean_average_power']:.3g}")
+                print(
+                    f"  {which:5s} model: mean epsilon {s['mean_epsilon']:.4g} +- {s['se_epsilon']:.2g}, "
+                    f"ratio to gaussian {s['ratio_to_gaussian']:.3f} (paired log ratio {s['mean_log_ratio']:+.3f} "
+                    f"+- {s['se_log_ratio']:.3f}), power {s['mean_average_power']:.3g}"
+                )
         el = ev.get("elgamal")
         if el:
-            print(f"  elgamal ({el['episodes']} episodes, N = {el['N']}, {el['key_length']}-bit key): mean epsilon "
-                  f"{el['mean_epsilon']:.4g}, {1000 * el['seconds_per_step']:.1f} ms/step")
+            print(
+                f"  elgamal ({el['episodes']} episodes, N = {el['N']}, {el['key_length']}-bit key): mean epsilon "
+                f"{el['mean_epsilon']:.4g}, {1000 * el['seconds_per_step']:.1f} ms/step"
+            )
     return 0

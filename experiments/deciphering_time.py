@@ -99,11 +99,36 @@ __all__ = [
 ]
 
 #: Columns of ``deciphering_time.csv`` (see the module docstring).
-COLUMNS = ("breaker", "bits", "kind", "group", "N", "tau", "precompute", "key_seconds",
-           "tau_wall", "precompute_wall", "key_wall", "operations", "p")
+COLUMNS = (
+    "breaker",
+    "bits",
+    "kind",
+    "group",
+    "N",
+    "tau",
+    "precompute",
+    "key_seconds",
+    "tau_wall",
+    "precompute_wall",
+    "key_wall",
+    "operations",
+    "p",
+)
 #: Columns of ``deciphering_time_fit.csv``.
-FIT_COLUMNS = ("breaker", "bits", "T_first", "T_0", "T_1", "ratio", "N_max", "precompute", "fresh",
-               "T_first_wall", "T_1_wall", "ratio_wall")
+FIT_COLUMNS = (
+    "breaker",
+    "bits",
+    "T_first",
+    "T_0",
+    "T_1",
+    "ratio",
+    "N_max",
+    "precompute",
+    "fresh",
+    "T_first_wall",
+    "T_1_wall",
+    "ratio_wall",
+)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -126,17 +151,19 @@ FULL_PLAN: tuple[Plan, ...] = (
     _plans("bsgs", ((32, 64, 8), (36, 64, 8), (40, 64, 8), (44, 64, 8), (48, 8, 2)))
     + _plans("rho", ((32, 64, 8), (36, 64, 8), (40, 64, 8), (44, 64, 8), (48, 8, 6)))
     + _plans("rho-multi", ((32, 64, 8), (36, 64, 8), (40, 64, 8), (44, 64, 8), (48, 64, 4)))
-    + _plans("pari", ((32, 64, 3), (40, 64, 3), (48, 64, 3), (56, 64, 3), (64, 64, 3), (72, 64, 3),
-                      (80, 64, 3), (88, 32, 2), (96, 8, 2)))
-    + _plans("index-calculus", ((32, 64, 3), (40, 64, 3), (48, 64, 3), (56, 64, 3), (64, 64, 3),
-                                (72, 64, 3), (80, 64, 3), (88, 64, 2), (96, 64, 1)))
+    + _plans(
+        "pari",
+        ((32, 64, 3), (40, 64, 3), (48, 64, 3), (56, 64, 3), (64, 64, 3), (72, 64, 3), (80, 64, 3), (88, 32, 2), (96, 8, 2)),
+    )
+    + _plans(
+        "index-calculus",
+        ((32, 64, 3), (40, 64, 3), (48, 64, 3), (56, 64, 3), (64, 64, 3), (72, 64, 3), (80, 64, 3), (88, 64, 2), (96, 64, 1)),
+    )
     + _plans("token-chain", ((32, 64, 1), (48, 64, 1), (64, 64, 1), (80, 64, 1)))
 )
 #: A smoke test of a few seconds (``--quick``; run by ``reproduce --quick`` in the tests).
 QUICK_PLAN: tuple[Plan, ...] = tuple(
-    Plan(b, bits, 8, 1)
-    for b in ("bsgs", "rho", "rho-multi", "pari", "index-calculus", "token-chain")
-    for bits in (24, 32)
+    Plan(b, bits, 8, 1) for b in ("bsgs", "rho", "rho-multi", "pari", "index-calculus", "token-chain") for bits in (24, 32)
 )
 
 
@@ -165,10 +192,23 @@ def _rows(plan: Plan, kind: str, index: int, report: Any, grid: Sequence[int]) -
     rows = []
     for n in grid:
         cost = report.keys[n - 1].cost
-        rows.append({"breaker": plan.breaker, "bits": plan.bits, "kind": kind, "group": index, "N": n,
-                     "tau": float(tau[n - 1]), "precompute": pre.cpu_seconds, "key_seconds": cost.cpu_seconds,
-                     "tau_wall": float(tau_wall[n - 1]), "precompute_wall": pre.seconds, "key_wall": cost.seconds,
-                     "operations": _ops(cost.operations), "p": hex(report.group.p)})
+        rows.append(
+            {
+                "breaker": plan.breaker,
+                "bits": plan.bits,
+                "kind": kind,
+                "group": index,
+                "N": n,
+                "tau": float(tau[n - 1]),
+                "precompute": pre.cpu_seconds,
+                "key_seconds": cost.cpu_seconds,
+                "tau_wall": float(tau_wall[n - 1]),
+                "precompute_wall": pre.seconds,
+                "key_wall": cost.seconds,
+                "operations": _ops(cost.operations),
+                "p": hex(report.group.p),
+            }
+        )
     return rows
 
 
@@ -198,12 +238,7 @@ def measure(plan: Plan, seed: np.random.SeedSequence) -> list[dict[str, Any]]:
 
 
 def compute(
-    plan: Sequence[Plan] = FULL_PLAN,
-    *,
-    seed: int = 0,
-    n_jobs: int = -1,
-    scheduler: Any = None,
-    progress: bool = False,
+    plan: Sequence[Plan] = FULL_PLAN, *, seed: int = 0, n_jobs: int = -1, scheduler: Any = None, progress: bool = False
 ) -> list[dict[str, Any]]:
     """Run every plan (one task each, the longest first) and return the rows of the CSV.
 
@@ -222,15 +257,24 @@ def compute(
     if not plan:
         raise ParameterError("the plan is empty")
     if not pari_available() and any(p.breaker == "pari" for p in plan):
-        print("deciphering_time: cypari is not installed, the 'pari' breaker is skipped "
-              "(pip install 'encctl-gym[cryptanalysis]')", file=sys.stderr)
+        print(
+            "deciphering_time: cypari is not installed, the 'pari' breaker is skipped (pip install 'encctl-gym[cryptanalysis]')",
+            file=sys.stderr,
+        )
         plan = [p for p in plan if p.breaker != "pari"]
     # Largest sizes first, so that the long tasks do not end up last on one worker; plan i keeps
     # child seed i of the original order whatever the order of execution.
     order = sorted(range(len(plan)), key=lambda i: -plan[i].bits)
     seeds = child_seeds(seed, len(plan))
-    done = run_tasks(_measure_task, [(plan[i], seeds[i]) for i in order], seed=seed, n_jobs=n_jobs,
-                     scheduler=scheduler, progress=progress, desc="deciphering time")
+    done = run_tasks(
+        _measure_task,
+        [(plan[i], seeds[i]) for i in order],
+        seed=seed,
+        n_jobs=n_jobs,
+        scheduler=scheduler,
+        progress=progress,
+        desc="deciphering time",
+    )
     rows_per_plan: list[list[dict[str, Any]]] = [[] for _ in plan]
     for i, rows in zip(order, done):
         rows_per_plan[i] = rows
@@ -270,12 +314,22 @@ def fit(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
         fresh = [r for r in mine if r["kind"] == "fresh"]
         t_first, t0, t1 = _fit_one(seq, fresh, "tau")
         w_first, _, w1 = _fit_one(seq, fresh, "tau_wall")
-        out.append({"breaker": breaker, "bits": bits, "T_first": t_first, "T_0": t0, "T_1": t1,
-                    "ratio": t1 / t_first if t_first > 0 else float("nan"),
-                    "N_max": max((int(r["N"]) for r in seq), default=0),
-                    "precompute": float(seq[0]["precompute"]) if seq else float("nan"), "fresh": len(fresh),
-                    "T_first_wall": w_first, "T_1_wall": w1,
-                    "ratio_wall": w1 / w_first if w_first > 0 else float("nan")})
+        out.append(
+            {
+                "breaker": breaker,
+                "bits": bits,
+                "T_first": t_first,
+                "T_0": t0,
+                "T_1": t1,
+                "ratio": t1 / t_first if t_first > 0 else float("nan"),
+                "N_max": max((int(r["N"]) for r in seq), default=0),
+                "precompute": float(seq[0]["precompute"]) if seq else float("nan"),
+                "fresh": len(fresh),
+                "T_first_wall": w_first,
+                "T_1_wall": w1,
+                "ratio_wall": w1 / w_first if w_first > 0 else float("nan"),
+            }
+        )
     return out
 
 
@@ -327,8 +381,21 @@ def read_csv(path: str | Path) -> list[dict[str, Any]]:
     with Path(path).open(newline="") as fh:
         rows = list(csv.DictReader(fh))
     ints = {"bits", "group", "N", "N_max", "fresh"}
-    floats = {"tau", "precompute", "key_seconds", "tau_wall", "precompute_wall", "key_wall", "T_first", "T_0",
-              "T_1", "ratio", "T_first_wall", "T_1_wall", "ratio_wall"}
+    floats = {
+        "tau",
+        "precompute",
+        "key_seconds",
+        "tau_wall",
+        "precompute_wall",
+        "key_wall",
+        "T_first",
+        "T_0",
+        "T_1",
+        "ratio",
+        "T_first_wall",
+        "T_1_wall",
+        "ratio_wall",
+    }
     for r in rows:
         for k in list(r):
             if k in ints:
@@ -358,8 +425,10 @@ def plot(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
         sizes = sorted({f["bits"] for f in fits if f["breaker"] == breaker})
         colors = plt.cm.viridis(np.linspace(0, 0.9, max(len(sizes), 1)))
         for color, bits in zip(colors, sizes):
-            seq = sorted((r for r in rows if r["breaker"] == breaker and r["bits"] == bits and r["kind"] == "sequence"),
-                         key=lambda r: r["N"])
+            seq = sorted(
+                (r for r in rows if r["breaker"] == breaker and r["bits"] == bits and r["kind"] == "sequence"),
+                key=lambda r: r["N"],
+            )
             n = np.array([r["N"] for r in seq])
             t_first = next(f["T_first"] for f in fits if f["breaker"] == breaker and f["bits"] == bits)
             ax.loglog(n, [r["tau"] for r in seq], "o-", color=color, ms=3, lw=1.4, label=f"{bits} bits")
@@ -387,7 +456,9 @@ def plot(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
     return path
 
 
-def model_curves(bits: Sequence[int] | np.ndarray, n: Sequence[int] | np.ndarray, *, model_bits: int) -> dict[str, dict[str, np.ndarray]]:
+def model_curves(
+    bits: Sequence[int] | np.ndarray, n: Sequence[int] | np.ndarray, *, model_bits: int
+) -> dict[str, dict[str, np.ndarray]]:
     """What each deciphering-cost model of :mod:`encctl_gym.security.cost_models` predicts, in the
     units the measurements can be compared with (ratios: the models count abstract operations):
 
@@ -444,10 +515,18 @@ def plot_models(rows: Sequence[dict[str, Any]], path: str | Path, *, model_bits:
         ax1.semilogy([f["bits"] for f in mine], np.where(ratio > 0, ratio, np.nan), "o", ms=5, label=f"measured: {breaker}")
         bits = max(f["bits"] for f in mine)
         t_first = next(f["T_first"] for f in mine if f["bits"] == bits)
-        seq = sorted((r for r in rows if r["breaker"] == breaker and int(r["bits"]) == bits and r["kind"] == "sequence"),
-                     key=lambda r: int(r["N"]))
-        ax2.loglog([int(r["N"]) for r in seq], [float(r["tau"]) / t_first for r in seq], "o-", ms=3, lw=1.2,
-                   label=f"{breaker}, {bits} bits")
+        seq = sorted(
+            (r for r in rows if r["breaker"] == breaker and int(r["bits"]) == bits and r["kind"] == "sequence"),
+            key=lambda r: int(r["N"]),
+        )
+        ax2.loglog(
+            [int(r["N"]) for r in seq],
+            [float(r["tau"]) / t_first for r in seq],
+            "o-",
+            ms=3,
+            lw=1.2,
+            label=f"{breaker}, {bits} bits",
+        )
     for name, (color, ls) in styles.items():
         if name not in curves:
             continue
@@ -475,11 +554,12 @@ def format_table(fits: Sequence[dict[str, Any]]) -> str:
     largest: dict[str, int] = {}
     for f in fits:
         largest[f["breaker"]] = max(largest.get(f["breaker"], 0), f["bits"])
-    lines = [f"{'bits':>5}  {'breaker':<15} {'T_first (s)':>12} {'T_1 (s)':>12} {'T_1/T_first':>12} {'N_max':>6} "
-             f"{'largest':>8}"]
+    lines = [f"{'bits':>5}  {'breaker':<15} {'T_first (s)':>12} {'T_1 (s)':>12} {'T_1/T_first':>12} {'N_max':>6} {'largest':>8}"]
     for f in sorted(fits, key=lambda f: (f["breaker"], f["bits"])):
-        lines.append(f"{f['bits']:>5}  {f['breaker']:<15} {f['T_first']:12.4g} {f['T_1']:12.4g} {f['ratio']:12.3g} "
-                     f"{f['N_max']:>6} {largest[f['breaker']]:>8}")
+        lines.append(
+            f"{f['bits']:>5}  {f['breaker']:<15} {f['T_first']:12.4g} {f['T_1']:12.4g} {f['ratio']:12.3g} "
+            f"{f['N_max']:>6} {largest[f['breaker']]:>8}"
+        )
     return "\n".join(lines)
 
 
@@ -487,7 +567,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Command-line options (``--out --quick --seed --n-jobs --scheduler --no-progress --from-csv``)."""
     add_common_arguments(parser)
     parser.add_argument(
-        "--from-csv", default=None, metavar="PATH",
+        "--from-csv",
+        default=None,
+        metavar="PATH",
         help="redraw the figures and the table from a recorded deciphering_time.csv instead of measuring",
     )
 
@@ -503,8 +585,13 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError(f"--from-csv: no such file {source!r}")
         rows = read_csv(source)
     else:
-        rows = compute(QUICK_PLAN if args.quick else FULL_PLAN, seed=args.seed, n_jobs=args.n_jobs,
-                       scheduler=args.scheduler, progress=not args.no_progress)
+        rows = compute(
+            QUICK_PLAN if args.quick else FULL_PLAN,
+            seed=args.seed,
+            n_jobs=args.n_jobs,
+            scheduler=args.scheduler,
+            progress=not args.no_progress,
+        )
     elapsed = time.perf_counter() - t0
     fits = fit(rows)
     csv_path = _write_csv_if_changed(rows, out / "deciphering_time.csv", COLUMNS)

@@ -120,7 +120,9 @@ ONE_OVER_N_SLOPE = -0.8
 
 
 # --------------------------------------------------------------------------- data
-def collect(attacker: Attacker, config: dict[str, Any], *, episodes: int, seed: int, batch: int = 64) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def collect(
+    attacker: Attacker, config: dict[str, Any], *, episodes: int, seed: int, batch: int = 64
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Play ``episodes`` attacks through the vector environment; return what was delivered.
 
     Episode ``e`` is reset with ``seed + e`` and the attacker is seeded per batch as in
@@ -307,8 +309,12 @@ def compute(
         for att, play in atts:
             errs = {est.label: np.full((replicates * episodes, grid.size), np.nan) for est in ests}  # type: ignore[attr-defined]
             if progress:
-                print(f"identification strategies: {system}, {att.name}, {grid.size} attack lengths up to {grid[-1]}, "
-                      f"{replicates} replicate(s)", file=sys.stderr, flush=True)
+                print(
+                    f"identification strategies: {system}, {att.name}, {grid.size} attack lengths up to {grid[-1]}, "
+                    f"{replicates} replicate(s)",
+                    file=sys.stderr,
+                    flush=True,
+                )
             for r in range(replicates):
                 rows = slice(r * episodes, (r + 1) * episodes)
                 for k, N in enumerate(grid):
@@ -322,8 +328,10 @@ def compute(
                             worst = max(worst, float(np.max(np.abs(e - eps_env) / eps_env)))
             density = isinstance(att, (GaussianAttacker, ColoredGaussianAttacker))  # inputs with a joint density
             for est in ests:
-                tail = [error_tail_exponent(p.n, p.m, int(N), est) if density and N >= est.min_sample_size(p.n, p.m) else None
-                        for N in grid]
+                tail = [
+                    error_tail_exponent(p.n, p.m, int(N), est) if density and N >= est.min_sample_size(p.n, p.m) else None
+                    for N in grid
+                ]
                 curves[system].append(Curve(att.name, att.oracle, est.label, grid, errs[est.label], replicates, tail))  # type: ignore[attr-defined]
         checks[system] = worst
     res = Result(settings, ests, curves, checks, sizes, time.perf_counter() - t0)
@@ -368,16 +376,30 @@ def security_rows(result: Result) -> list[dict[str, Any]]:
             if c.tail is not None and any(a is not None and a <= 1.0 for a, f in zip(c.tail, fitted) if f):
                 how += ", no mean by the tail rule"
             reps = [_to_gamma_c(c.N, rm, b.gamma_c)[2] for rm in c.replicate_means()] if c.replicates > 1 else []
-            rc, rlo, rhi = replicate_interval([v for v in reps if v is not None]) if reps and None not in reps else (None, None, None)
+            rc, rlo, rhi = (
+                replicate_interval([v for v in reps if v is not None]) if reps and None not in reps else (None, None, None)
+            )
             lam = optimal_security_parameter(N_c, tau_c=b.tau_c, upsilon=b.upsilon) if N_c else None
-            rows.append({
-                "system": s.system, "attacker": c.attacker, "oracle": c.oracle, "estimator": c.estimator,
-                "gamma_c": b.gamma_c, "slope": slope, "rate_c": rate, "first_below": first,
-                "N_to_gamma_c": N_c, "N_how": how, "lambda_needed": lam,
-                "k_needed": minimum_key_length(lam) if lam else None,
-                "N_to_gamma_c_replicates": " ".join(str(v) for v in reps), "N_to_gamma_c_mean": rc,
-                "N_to_gamma_c_low": rlo, "N_to_gamma_c_high": rhi,
-            })
+            rows.append(
+                {
+                    "system": s.system,
+                    "attacker": c.attacker,
+                    "oracle": c.oracle,
+                    "estimator": c.estimator,
+                    "gamma_c": b.gamma_c,
+                    "slope": slope,
+                    "rate_c": rate,
+                    "first_below": first,
+                    "N_to_gamma_c": N_c,
+                    "N_how": how,
+                    "lambda_needed": lam,
+                    "k_needed": minimum_key_length(lam) if lam else None,
+                    "N_to_gamma_c_replicates": " ".join(str(v) for v in reps),
+                    "N_to_gamma_c_mean": rc,
+                    "N_to_gamma_c_low": rlo,
+                    "N_to_gamma_c_high": rhi,
+                }
+            )
     return rows
 
 
@@ -397,11 +419,43 @@ def _to_gamma_c(N: np.ndarray, mean: np.ndarray, gamma_c: float) -> tuple[float,
 
 
 # --------------------------------------------------------------------------- outputs
-CURVE_COLUMNS = ("system", "attacker", "oracle", "estimator", "N", "mean_error", "se", "ci95_low", "ci95_high",
-                 "episodes", "gamma", "gamma_opt", "median", "q10", "q90", "tail_exponent", "mean_status")
-SECURITY_COLUMNS = ("system", "attacker", "oracle", "estimator", "gamma_c", "slope", "rate_c", "first_below", "N_to_gamma_c",
-                    "N_how", "lambda_needed", "k_needed", "N_to_gamma_c_replicates", "N_to_gamma_c_mean", "N_to_gamma_c_low",
-                    "N_to_gamma_c_high")
+CURVE_COLUMNS = (
+    "system",
+    "attacker",
+    "oracle",
+    "estimator",
+    "N",
+    "mean_error",
+    "se",
+    "ci95_low",
+    "ci95_high",
+    "episodes",
+    "gamma",
+    "gamma_opt",
+    "median",
+    "q10",
+    "q90",
+    "tail_exponent",
+    "mean_status",
+)
+SECURITY_COLUMNS = (
+    "system",
+    "attacker",
+    "oracle",
+    "estimator",
+    "gamma_c",
+    "slope",
+    "rate_c",
+    "first_below",
+    "N_to_gamma_c",
+    "N_how",
+    "lambda_needed",
+    "k_needed",
+    "N_to_gamma_c_replicates",
+    "N_to_gamma_c_mean",
+    "N_to_gamma_c_low",
+    "N_to_gamma_c_high",
+)
 
 
 def _fmt(v: Any) -> str:
@@ -424,10 +478,28 @@ def write_csvs(result: Result, out: Path) -> list[Path]:
                 tails = c.tail or [None] * c.N.size
                 for N, m, se, sm, a in zip(c.N, c.mean, c.se, c.summaries, tails):
                     q = sm.quantiles if sm is not None else {0.1: None, 0.5: None, 0.9: None}
-                    w.writerow(_fmt(v) for v in (system, c.attacker, c.oracle, c.estimator, int(N), m, se, m - 1.96 * se,
-                                                 m + 1.96 * se, c.errors.shape[0], float(s.params.gamma(int(N))),
-                                                 float(s.design.gamma(int(N))), q[0.5], q[0.1], q[0.9], a,
-                                                 sm.status if sm is not None else ""))
+                    w.writerow(
+                        _fmt(v)
+                        for v in (
+                            system,
+                            c.attacker,
+                            c.oracle,
+                            c.estimator,
+                            int(N),
+                            m,
+                            se,
+                            m - 1.96 * se,
+                            m + 1.96 * se,
+                            c.errors.shape[0],
+                            float(s.params.gamma(int(N))),
+                            float(s.design.gamma(int(N))),
+                            q[0.5],
+                            q[0.1],
+                            q[0.9],
+                            a,
+                            sm.status if sm is not None else "",
+                        )
+                    )
     with (out / "episodes.csv").open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(("system", "attacker", "estimator", "N", "replicate", "episode", "error"))
@@ -448,8 +520,9 @@ def write_csvs(result: Result, out: Path) -> list[Path]:
 def _grid_axes(plt: Any, result: Result) -> tuple[Any, Any, list[str], list[str]]:
     systems = [s.system for s in result.settings]
     attackers = list(dict.fromkeys(c.attacker for cs in result.curves.values() for c in cs))
-    fig, axes = plt.subplots(len(systems), len(attackers), figsize=(3.6 * len(attackers), 3.0 * len(systems)),
-                             squeeze=False, sharex="row")
+    fig, axes = plt.subplots(
+        len(systems), len(attackers), figsize=(3.6 * len(attackers), 3.0 * len(systems)), squeeze=False, sharex="row"
+    )
     return fig, axes, systems, attackers
 
 
@@ -485,8 +558,17 @@ def plot(result: Result, out: Path) -> list[Path]:
                 bare = np.array([sm is not None and not sm.mean_ok for sm in sms])
                 med = np.array([sm.median if sm is not None else np.nan for sm in sms])
                 y = np.where(bare, med, mean)
-                ax.plot(c.N[ok], y[ok], color=color[c.estimator], lw=2.0 if top else 1.2, marker="o", ms=2,
-                        label=c.estimator, zorder=3 if top else 2, ls="--" if top else "-")
+                ax.plot(
+                    c.N[ok],
+                    y[ok],
+                    color=color[c.estimator],
+                    lw=2.0 if top else 1.2,
+                    marker="o",
+                    ms=2,
+                    label=c.estimator,
+                    zorder=3 if top else 2,
+                    ls="--" if top else "-",
+                )
                 if bare.any():
                     ax.plot(c.N[bare], med[bare], ls="none", marker="o", ms=5, mfc="none", color=color[c.estimator], zorder=4)
                 band = ok & ~bare
@@ -502,7 +584,9 @@ def plot(result: Result, out: Path) -> list[Path]:
                 ax.set_ylabel(f"{system}\nE[eps(N)]", fontsize=9)
             if i == len(systems) - 1:
                 ax.set_xlabel("attack length N", fontsize=9)
-            shown = [np.array([(sm.mean if sm.mean_ok else sm.median) if sm is not None else np.nan for sm in c.summaries]) for c in cs]
+            shown = [
+                np.array([(sm.mean if sm.mean_ok else sm.median) if sm is not None else np.nan for sm in c.summaries]) for c in cs
+            ]
             lo_y = float(np.nanmin([np.nanmin(v) for v in shown] + [float(np.min(s.design.gamma(Nl)))]))
             hi_y = float(np.nanmax([np.nanmax(v[np.isfinite(v)]) if np.isfinite(v).any() else lo_y for v in shown]))
             ax.set_ylim(0.5 * lo_y, 2.0 * max(hi_y, lo_y))
@@ -510,10 +594,16 @@ def plot(result: Result, out: Path) -> list[Path]:
                 ax.axhline(s.base.gamma_c, color="0.5", lw=0.7, ls="-.", label="gamma_c")
     bottom = legend_below(fig, axes)
     E = result.curves[systems[0]][0].errors.shape[0]
-    fig.suptitle("\n".join(textwrap.wrap(
-        f"Identification strategies: mean error (95 % band; open circles: the median where the mean does not exist "
-        f"or is unreliable), {E} attacks per N at energy m sigma_u2 N, each estimator on the same delivered data",
-        int(13 * fig.get_figwidth()))), fontsize=9)
+    fig.suptitle(
+        "\n".join(
+            textwrap.wrap(
+                f"Identification strategies: mean error (95 % band; open circles: the median where the mean does not exist "
+                f"or is unreliable), {E} attacks per N at energy m sigma_u2 N, each estimator on the same delivered data",
+                int(13 * fig.get_figwidth()),
+            )
+        ),
+        fontsize=9,
+    )
     fig.tight_layout(rect=(0, bottom, 1, 1))
     path = out / "identification_strategies.png"
     save_figure(fig, path, dpi=100)
@@ -575,16 +665,25 @@ def replicate_table(result: Result) -> list[str]:
     for s in result.settings:
         _, _, top, capped = result.sizes[s.system]
         sec = {(r["attacker"], r["estimator"]): r for r in result.security if r["system"] == s.system}
-        lines += [f"#### {s.system}: {R} replicates (mean of the replicate values [95 % t interval])", "",
-                  f"| attacker | estimator | replicate means at N = {top} | E[eps] at N = {top} | N to gamma_c |", "|---|---|---|---|---|"]
+        lines += [
+            f"#### {s.system}: {R} replicates (mean of the replicate values [95 % t interval])",
+            "",
+            f"| attacker | estimator | replicate means at N = {top} | E[eps] at N = {top} | N to gamma_c |",
+            "|---|---|---|---|---|",
+        ]
         for c in result.curves[s.system]:
             k = int(np.searchsorted(c.N, top))
             vals = c.replicate_means()[:, k]
             m, lo, hi = replicate_interval(vals)
             r = sec[(c.attacker, c.estimator)]
-            Nc = (f"{r['N_to_gamma_c_mean']:.0f} [{r['N_to_gamma_c_low']:.0f}, {r['N_to_gamma_c_high']:.0f}]"
-                  if r["N_to_gamma_c_mean"] is not None else r["N_how"])
-            lines.append(f"| {c.attacker} | {c.estimator} | {' '.join(f'{v:.3g}' for v in vals)} | {m:.3g} [{lo:.3g}, {hi:.3g}] | {Nc} |")
+            Nc = (
+                f"{r['N_to_gamma_c_mean']:.0f} [{r['N_to_gamma_c_low']:.0f}, {r['N_to_gamma_c_high']:.0f}]"
+                if r["N_to_gamma_c_mean"] is not None
+                else r["N_how"]
+            )
+            lines.append(
+                f"| {c.attacker} | {c.estimator} | {' '.join(f'{v:.3g}' for v in vals)} | {m:.3g} [{lo:.3g}, {hi:.3g}] | {Nc} |"
+            )
         lines.append("")
     return lines
 
@@ -611,44 +710,60 @@ def findings(result: Result) -> list[str]:
         if rows:
             r = min(steady or rows, key=lambda r: r["N_to_gamma_c"])
             paper = bound_rows(s)[0]
-            text = (f"{s.system}: fewest samples to reach gamma_c = {s.base.gamma_c:g}: {r['N_to_gamma_c']} "
-                    f"({r['attacker']} + {r['estimator']}, {r['N_how']}) against the paper's N* = {paper['N_to_gamma_c']}; "
-                    f"lambda {r['lambda_needed']} against lambda* = {paper['lambda_needed']}")
+            text = (
+                f"{s.system}: fewest samples to reach gamma_c = {s.base.gamma_c:g}: {r['N_to_gamma_c']} "
+                f"({r['attacker']} + {r['estimator']}, {r['N_how']}) against the paper's N* = {paper['N_to_gamma_c']}; "
+                f"lambda {r['lambda_needed']} against lambda* = {paper['lambda_needed']}"
+            )
             lower = [q for q in rows if q["N_to_gamma_c"] < r["N_to_gamma_c"]]
             if steady and lower:
                 q = min(lower, key=lambda q: q["N_to_gamma_c"])
-                text += (f" (fewer, {q['N_to_gamma_c']}, only from an extrapolation of a transient curve: "
-                         f"{q['attacker']} + {q['estimator']}, {q['N_how']})")
+                text += (
+                    f" (fewer, {q['N_to_gamma_c']}, only from an extrapolation of a transient curve: "
+                    f"{q['attacker']} + {q['estimator']}, {q['N_how']})"
+                )
             out.append(text + ".")
     return out
 
 
 def summary_markdown(result: Result, *, command: str, plots: Sequence[Path]) -> str:
     """The tables (errors at small, medium N and N*; samples to gamma_c) and the findings."""
-    lines = ["## Identification strategies (`experiments/identification_strategies.py`)", "",
-             f"Reproduce: `{command}` ({result.seconds / 60:.1f} min on this machine).", ""]
+    lines = [
+        "## Identification strategies (`experiments/identification_strategies.py`)",
+        "",
+        f"Reproduce: `{command}` ({result.seconds / 60:.1f} min on this machine).",
+        "",
+    ]
     lines += [f"![{p.stem}]({p.as_posix()})" for p in plots] + [""]
     for s in result.settings:
         small, medium, top, capped = result.sizes[s.system]
-        lines.append(f"### {s.system} (gamma_c = {s.base.gamma_c:g}; least squares of this script vs the environment's "
-                     f"info['epsilon'] for N >= 2 (n + m) + 1: max relative difference {result.env_check[s.system]:.1e})")
+        lines.append(
+            f"### {s.system} (gamma_c = {s.base.gamma_c:g}; least squares of this script vs the environment's "
+            f"info['epsilon'] for N >= 2 (n + m) + 1: max relative difference {result.env_check[s.system]:.1e})"
+        )
         lines.append("")
-        lines.append(f"| attacker | estimator | E[eps] at N = {small} | N = {medium} | N = {top}{' (cap)' if capped else ' (N*)'} "
-                     "| N to gamma_c | lambda | k |")
+        lines.append(
+            f"| attacker | estimator | E[eps] at N = {small} | N = {medium} | N = {top}{' (cap)' if capped else ' (N*)'} "
+            "| N to gamma_c | lambda | k |"
+        )
         lines.append("|---|---|---|---|---|---|---|---|")
         sec = {(r["attacker"], r["estimator"]): r for r in result.security if r["system"] == s.system}
         for c in result.curves[s.system]:
             r = sec[(c.attacker, c.estimator)]
             Nc = f"{r['N_to_gamma_c']} ({r['N_how']})" if r["N_to_gamma_c"] else r["N_how"]
-            lines.append(f"| {c.attacker}{' (oracle)' if c.oracle else ''} | {c.estimator} | {_cell(c, small)} | {_cell(c, medium)} | "
-                         f"{_cell(c, top)} | {Nc} | {r['lambda_needed'] or '—'} | {r['k_needed'] or '—'} |")
+            lines.append(
+                f"| {c.attacker}{' (oracle)' if c.oracle else ''} | {c.estimator} | {_cell(c, small)} | {_cell(c, medium)} | "
+                f"{_cell(c, top)} | {Nc} | {r['lambda_needed'] or '—'} | {r['k_needed'] or '—'} |"
+            )
         for b in bound_rows(s):
             lines.append(f"| *{b['attacker']}* | | | | | {b['N_to_gamma_c']} | {b['lambda_needed']} | {b['k_needed']} |")
         lines.append("")
     lines += replicate_table(result)
-    lines.append("Cells: mean ± standard error where the mean exists (tail rule of encctl_gym.ident.tails for inputs with a "
-                 "density, and the Hill check); elsewhere the median [10 %, 90 %] with the tail exponent a. 'extrapolated' "
-                 "marks a sample size beyond the grid, from the 1/N fit.")
+    lines.append(
+        "Cells: mean ± standard error where the mean exists (tail rule of encctl_gym.ident.tails for inputs with a "
+        "density, and the Hill check); elsewhere the median [10 %, 90 %] with the tail exponent a. 'extrapolated' "
+        "marks a sample size beyond the grid, from the 1/N fit."
+    )
     lines.append("")
     lines.append("Findings: " + " ".join(findings(result)))
     return "\n".join(lines) + "\n"
@@ -663,16 +778,33 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def add_own_arguments(parser: argparse.ArgumentParser) -> None:
     """The options that ``encctl-gym reproduce`` does not have (their defaults apply there)."""
-    parser.add_argument("--episodes", type=int, default=None, help=f"attacks per attacker and N (default {DEFAULT_EPISODES}; quick {QUICK_EPISODES})")
+    parser.add_argument(
+        "--episodes",
+        type=int,
+        default=None,
+        help=f"attacks per attacker and N (default {DEFAULT_EPISODES}; quick {QUICK_EPISODES})",
+    )
     parser.add_argument("--replicates", type=int, default=1, help="independent repetitions on disjoint seeds (default 1)")
-    parser.add_argument("--systems", default=None,
-                        help=f"comma-separated presets or plant files (as train --system reads; default {','.join(DEFAULT_SYSTEMS)})")
-    parser.add_argument("--estimators", default=None, help=f"comma-separated registry names (default {','.join(DEFAULT_ESTIMATORS)}; "
-                        f"known: {', '.join(estimator_names())})")
-    parser.add_argument("--max-samples", type=int, default=None, help=f"cap on the attack length (default {DEFAULT_CAP}; quick {QUICK_CAP})")
+    parser.add_argument(
+        "--systems",
+        default=None,
+        help=f"comma-separated presets or plant files (as train --system reads; default {','.join(DEFAULT_SYSTEMS)})",
+    )
+    parser.add_argument(
+        "--estimators",
+        default=None,
+        help=f"comma-separated registry names (default {','.join(DEFAULT_ESTIMATORS)}; known: {', '.join(estimator_names())})",
+    )
+    parser.add_argument(
+        "--max-samples", type=int, default=None, help=f"cap on the attack length (default {DEFAULT_CAP}; quick {QUICK_CAP})"
+    )
     parser.add_argument("--points", type=int, default=None, help=f"grid points (default {DEFAULT_POINTS}; quick {QUICK_POINTS})")
-    parser.add_argument("--runs", action="append", default=[], help="training run directory or a parent of runs: its learned "
-                        "attackers join (repeatable; needs the [rl] extra)")
+    parser.add_argument(
+        "--runs",
+        action="append",
+        default=[],
+        help="training run directory or a parent of runs: its learned attackers join (repeatable; needs the [rl] extra)",
+    )
     parser.add_argument("--which", choices=("best", "final"), default="best", help="learned model: best (default) or final")
 
 
@@ -693,17 +825,39 @@ def run(args: argparse.Namespace) -> int:
     runs = find_runs(roots, left_out=skipped)
     if runs:  # the runs that play in none of the systems, said before the work
         entries = [system_entry(e) for e in systems]
-        skipped += [(r.path, why) for r, why in left_out(runs, [make_setting(label, 0, cap, config=cfg) for label, cfg in entries])]
+        skipped += [
+            (r.path, why) for r, why in left_out(runs, [make_setting(label, 0, cap, config=cfg) for label, cfg in entries])
+        ]
     for path, why in skipped:
         print(f"identification strategies: leaving out the run {path}: {why}", file=sys.stderr)
-    result = compute(systems, estimators=estimators, episodes=episodes, seed=args.seed, cap=cap, points=points,
-                     runs=runs, which=which, progress=not getattr(args, "no_progress", True),
-                     replicates=getattr(args, "replicates", 1) or 1)
+    result = compute(
+        systems,
+        estimators=estimators,
+        episodes=episodes,
+        seed=args.seed,
+        cap=cap,
+        points=points,
+        runs=runs,
+        which=which,
+        progress=not getattr(args, "no_progress", True),
+        replicates=getattr(args, "replicates", 1) or 1,
+    )
     files = write_csvs(result, out)
     plots = plot(result, out)
-    cmd = ["python -m experiments.identification_strategies", f"--seed {args.seed}", f"--episodes {episodes}", f"--replicates {getattr(args, 'replicates', 1) or 1}",
-           f"--systems {','.join(systems)}", f"--estimators {','.join(estimators)}", f"--max-samples {cap}",
-           f"--points {points}"] + [f"--runs {r}" for r in roots] + (["--quick"] if quick else [])
+    cmd = (
+        [
+            "python -m experiments.identification_strategies",
+            f"--seed {args.seed}",
+            f"--episodes {episodes}",
+            f"--replicates {getattr(args, 'replicates', 1) or 1}",
+            f"--systems {','.join(systems)}",
+            f"--estimators {','.join(estimators)}",
+            f"--max-samples {cap}",
+            f"--points {points}",
+        ]
+        + [f"--runs {r}" for r in roots]
+        + (["--quick"] if quick else [])
+    )
     md = summary_markdown(result, command=" ".join(cmd), plots=[Path(p.name) for p in plots])
     (out / "summary.md").write_text(md)
     print(md)

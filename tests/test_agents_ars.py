@@ -10,7 +10,6 @@ import pytest
 pytest.importorskip("sb3_contrib")  # the rl extra; torch comes with it
 
 import torch as th  # noqa: E402
-
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.vec_env import VecNormalize
 

@@ -41,7 +41,9 @@ def test_every_algorithm_has_a_default_and_every_file_resolves():
             venv = SB3VecEnv(env_config(cfg), 1, cfg["observation"])
             assert venv.observation_space.shape[0] >= 1
     for path in CONFIG_DIR.glob("*_*.yaml"):
-        algo, preset = next((a, path.stem[len(a) + 1:]) for a in sorted(ALGORITHMS, key=len, reverse=True) if path.stem.startswith(a + "_"))
+        algo, preset = next(
+            (a, path.stem[len(a) + 1 :]) for a in sorted(ALGORITHMS, key=len, reverse=True) if path.stem.startswith(a + "_")
+        )
         cfg = load_config(algo, preset)
         assert cfg["config_files"][-1] == str(path) and cfg["env"]["preset"] == preset
 
@@ -77,7 +79,13 @@ def test_system_file_replaces_a_and_b(tmp_path):
     assert np.array_equal(p.A, np.array(A)) and np.array_equal(p.B, np.array(B))
     assert cfg["system"] == "plant" and run_name(cfg, 3) == "ppo_plant_d0_full_s3"
     base = get_preset("paper-example")  # the rest from the preset
-    assert (p.sigma_w2, p.sigma_u2, p.sigma_x2, p.gamma_c, p.upsilon) == (base.sigma_w2, base.sigma_u2, base.sigma_x2, base.gamma_c, base.upsilon)
+    assert (p.sigma_w2, p.sigma_u2, p.sigma_x2, p.gamma_c, p.upsilon) == (
+        base.sigma_w2,
+        base.sigma_u2,
+        base.sigma_x2,
+        base.gamma_c,
+        base.upsilon,
+    )
     assert p.horizon == cfg["horizon"] == 256
     bomb = tmp_path / "bomb.yaml"  # 484 bytes whose aliases expand to 9^9 numbers
     levels = ["x0: &x0 [1, 1, 1, 1, 1, 1, 1, 1, 1]"] + [f"x{i}: &x{i} [{', '.join([f'*x{i - 1}'] * 9)}]" for i in range(1, 9)]
@@ -215,9 +223,16 @@ def test_billion_laughs_is_refused_before_expansion(tmp_path):
 def test_cli_train_reports_bad_input_in_one_line(capsys, tmp_path):
     out = str(tmp_path / "o")
     _one_line_error(capsys, ["train", "--algo", "ppo", "--preset", "no-such-preset", "--out", out], "no-such-preset")
-    _one_line_error(capsys, ["train", "--algo", "ppo", "--out", out, "--set", "hyperparams.policy_kwargs.activation_fn=bogus"],
-                    "activation_fn 'bogus'")
-    _one_line_error(capsys, ["train", "--algo", "sac", "--out", out, "--set", "hyperparams.n_epochs=3"], "unknown hyperparams key 'n_epochs' for SAC")
+    _one_line_error(
+        capsys,
+        ["train", "--algo", "ppo", "--out", out, "--set", "hyperparams.policy_kwargs.activation_fn=bogus"],
+        "activation_fn 'bogus'",
+    )
+    _one_line_error(
+        capsys,
+        ["train", "--algo", "sac", "--out", out, "--set", "hyperparams.n_epochs=3"],
+        "unknown hyperparams key 'n_epochs' for SAC",
+    )
     _one_line_error(capsys, ["train", "--algo", "ppo", "--out", out, "--n-envs", "0"], "n_envs must be >= 1")
     f = tmp_path / "hostile.yaml"
     f.write_text("!!python/object/apply:os.system ['echo pwned']\n")
@@ -289,8 +304,11 @@ def test_corrupt_or_missing_model_is_a_config_error(tmp_path, capsys):
     with pytest.raises(ConfigError, match="cannot load"):
         load_attacker(d)
     _one_line_error(capsys, ["evaluate", str(d), "--no-progress"], "cannot load")
-    _one_line_error(capsys, ["compare", "--quick", "--systems", "small", "--runs", str(d), "--no-progress",
-                                  "--out", str(tmp_path / "c")], "cannot load")
+    _one_line_error(
+        capsys,
+        ["compare", "--quick", "--systems", "small", "--runs", str(d), "--no-progress", "--out", str(tmp_path / "c")],
+        "cannot load",
+    )
     meta["algo"] = "dqn"
     d = _run_dir(tmp_path, meta)
     _one_line_error(capsys, ["evaluate", str(d)], "unknown algorithm 'dqn'")
@@ -333,8 +351,15 @@ def test_integers_of_more_than_4300_digits_are_one_config_error(tmp_path):
 
 @pytest.mark.parametrize(
     "key, largest",
-    [("n_timesteps", 2**53), ("eval.freq", 2**53), ("horizon", 2**53), ("n_envs", 2**53), ("eval.final_episodes", 2**53),
-     ("seed", 2**32 - 1), ("eval.seed", 2**32 - 1)],
+    [
+        ("n_timesteps", 2**53),
+        ("eval.freq", 2**53),
+        ("horizon", 2**53),
+        ("n_envs", 2**53),
+        ("eval.final_episodes", 2**53),
+        ("seed", 2**32 - 1),
+        ("eval.seed", 2**32 - 1),
+    ],
 )
 def test_counts_and_seeds_have_an_upper_bound(key, largest):
     from agents.config import SCHEMA
@@ -354,10 +379,16 @@ def test_a_seed_numpy_cannot_take_is_refused_in_one_line(capsys, tmp_path):
     with pytest.raises(ValueError):
         np.random.seed(2**32)
     out = str(tmp_path / "o")
-    _one_line_error(capsys, ["train", "--algo", "ppo", "--preset", "small", "--quick", "--out", out, "--seed", str(2**32)],
-                    "seed must be <= 4294967295, got 4294967296")
-    _one_line_error(capsys, ["train", "--algo", "ppo", "--preset", "small", "--quick", "--out", out, "--n-timesteps", "9" * 401],
-                    "n_timesteps must be <= 9007199254740992")
+    _one_line_error(
+        capsys,
+        ["train", "--algo", "ppo", "--preset", "small", "--quick", "--out", out, "--seed", str(2**32)],
+        "seed must be <= 4294967295, got 4294967296",
+    )
+    _one_line_error(
+        capsys,
+        ["train", "--algo", "ppo", "--preset", "small", "--quick", "--out", out, "--n-timesteps", "9" * 401],
+        "n_timesteps must be <= 9007199254740992",
+    )
     with pytest.raises(SystemExit) as exc:  # argparse's own error, one line through the CLI's parser
         cli.main(["train", "--algo", "ppo", "--preset", "small", "--quick", "--out", out, "--verbose", "7"])
     err = capsys.readouterr().err.strip().splitlines()
@@ -397,9 +428,27 @@ def test_network_bytes_by_hand():
 
 def test_huge_policy_networks_are_refused_before_pytorch_allocates(capsys, tmp_path):
     out = str(tmp_path / "o")
-    line = _one_line_error(capsys, ["train", "--algo", "ppo", "--preset", "small", "--quick", "--n-timesteps", "64", "--no-progress",
-                                    "--no-tensorboard", "--no-final-eval", "--out", out, "--set",
-                                    "hyperparams.policy_kwargs.net_arch=[100000000]"], "net_arch = [100000000]")
+    line = _one_line_error(
+        capsys,
+        [
+            "train",
+            "--algo",
+            "ppo",
+            "--preset",
+            "small",
+            "--quick",
+            "--n-timesteps",
+            "64",
+            "--no-progress",
+            "--no-tensorboard",
+            "--no-final-eval",
+            "--out",
+            out,
+            "--set",
+            "hyperparams.policy_kwargs.net_arch=[100000000]",
+        ],
+        "net_arch = [100000000]",
+    )
     assert "GiB" in line and "memory_limit" in line
 
 

@@ -81,12 +81,44 @@ def test_compare_plays_a_run_in_the_environment_it_was_trained_in(ars_run, tmp_p
     assert not isinstance(play, str) and play.params.input_history == 0 and play.params.horizon == setting.params.horizon
     [(att, where)] = learned_players(setting, [run])
     assert where.params.input_history == 0
-    res = compute(("small",), delays=(0,), episodes=2, cap=24, points=2, runs=[run], elgamal_episodes=1, elgamal_N=8,
-                  attackers=("gaussian",))
+    res = compute(
+        ("small",),
+        delays=(0,),
+        episodes=2,
+        cap=24,
+        points=2,
+        runs=[run],
+        elgamal_episodes=1,
+        elgamal_N=8,
+        attackers=("gaussian",),
+    )
     assert [c.attacker for c in res.curves[("small", 0)]] == ["gaussian", "ars"]
-    assert cli.main(["compare", "--quick", "--systems", "small", "--delays", "0", "--runs", str(ars_run), "--points", "2",
-                     "--episodes", "2", "--elgamal-episodes", "0", "--no-progress", "--out", str(tmp_path / "c"),
-                     "--attackers", "gaussian"]) == 0
+    assert (
+        cli.main(
+            [
+                "compare",
+                "--quick",
+                "--systems",
+                "small",
+                "--delays",
+                "0",
+                "--runs",
+                str(ars_run),
+                "--points",
+                "2",
+                "--episodes",
+                "2",
+                "--elgamal-episodes",
+                "0",
+                "--no-progress",
+                "--out",
+                str(tmp_path / "c"),
+                "--attackers",
+                "gaussian",
+            ]
+        )
+        == 0
+    )
     assert "| ars |" in capsys.readouterr().out
 
 
@@ -122,9 +154,34 @@ def test_compare_says_which_runs_it_leaves_out_and_why(ars_run, tmp_path, capsys
     (other / "run.json").write_text(json.dumps(meta))
     [(r, why)] = left_out([read_run(other)], [make_setting("small", 0, 24)])
     assert "sigma_w2 = 0.5" in why
-    assert cli.main(["compare", "--quick", "--systems", "paper-example", "--delays", "0", "--runs", str(ars_run.parent),
-                     "--runs", str(other), "--points", "2", "--episodes", "2", "--elgamal-episodes", "0", "--no-progress",
-                     "--out", str(tmp_path / "c"), "--attackers", "gaussian"]) == 0
+    assert (
+        cli.main(
+            [
+                "compare",
+                "--quick",
+                "--systems",
+                "paper-example",
+                "--delays",
+                "0",
+                "--runs",
+                str(ars_run.parent),
+                "--runs",
+                str(other),
+                "--points",
+                "2",
+                "--episodes",
+                "2",
+                "--elgamal-episodes",
+                "0",
+                "--no-progress",
+                "--out",
+                str(tmp_path / "c"),
+                "--attackers",
+                "gaussian",
+            ]
+        )
+        == 0
+    )
     err = [line for line in capsys.readouterr().err.splitlines() if "leaving out" in line]
     assert len(err) == 2 and str(ars_run) in err[0] and "--quick" in err[0]
     assert str(other) in err[1] and "trained on 'small'" in err[1]
@@ -150,13 +207,59 @@ def test_every_command_that_takes_a_system_takes_a_plant_file(ars_run, tmp_path,
     label, cfg = system_entry(str(plant))
     assert label == "myplant" and cfg is not None and cfg["sigma_w2"] == 0.5 and cfg["A"] == small.A.tolist()
     assert system_entry("small") == ("small", None)
-    _one_line_error(capsys, ["compare", "--quick", "--systems", "no-such-system", "--no-progress", "--out", str(tmp_path / "x")],
-                    "no plant file of that name")
-    _one_line_error(capsys, ["compare", "--quick", "--systems", str(tmp_path / "none.json"), "--no-progress",
-                             "--out", str(tmp_path / "x")], "does not exist")
-    assert cli.main(["compare", "--quick", "--systems", str(plant), "--delays", "0", "--points", "2", "--episodes", "2",
-                     "--elgamal-episodes", "0", "--no-progress", "--out", str(tmp_path / "c"), "--attackers", "gaussian"]) == 0
+    _one_line_error(
+        capsys,
+        ["compare", "--quick", "--systems", "no-such-system", "--no-progress", "--out", str(tmp_path / "x")],
+        "no plant file of that name",
+    )
+    _one_line_error(
+        capsys,
+        ["compare", "--quick", "--systems", str(tmp_path / "none.json"), "--no-progress", "--out", str(tmp_path / "x")],
+        "does not exist",
+    )
+    assert (
+        cli.main(
+            [
+                "compare",
+                "--quick",
+                "--systems",
+                str(plant),
+                "--delays",
+                "0",
+                "--points",
+                "2",
+                "--episodes",
+                "2",
+                "--elgamal-episodes",
+                "0",
+                "--no-progress",
+                "--out",
+                str(tmp_path / "c"),
+                "--attackers",
+                "gaussian",
+            ]
+        )
+        == 0
+    )
     assert "| myplant | 0 | gaussian |" in capsys.readouterr().out
-    assert cli.main(["evaluate", str(ars_run), "--systems", str(plant), "--points", "2", "--episodes", "2", "--samples", "16",
-                     "--no-progress", "--out", str(tmp_path / "e")]) == 0
+    assert (
+        cli.main(
+            [
+                "evaluate",
+                str(ars_run),
+                "--systems",
+                str(plant),
+                "--points",
+                "2",
+                "--episodes",
+                "2",
+                "--samples",
+                "16",
+                "--no-progress",
+                "--out",
+                str(tmp_path / "e"),
+            ]
+        )
+        == 0
+    )
     assert "myplant" in capsys.readouterr().out

@@ -81,15 +81,39 @@ def ppo_run(tmp_path_factory) -> Path:
     tmp = tmp_path_factory.mktemp("train")
     plant = tmp / "plant2.json"
     plant.write_text(json.dumps(PLANT))
-    rc = cli.main(["train", "--algo", "ppo", "--system", str(plant), "--quick", "--out", str(tmp / "runs"), "--no-progress",
-                   "--set", "env.sigma_w2=0.2", "--set", "horizon=64", "--n-timesteps", "1500"])
+    rc = cli.main(
+        [
+            "train",
+            "--algo",
+            "ppo",
+            "--system",
+            str(plant),
+            "--quick",
+            "--out",
+            str(tmp / "runs"),
+            "--no-progress",
+            "--set",
+            "env.sigma_w2=0.2",
+            "--set",
+            "horizon=64",
+            "--n-timesteps",
+            "1500",
+        ]
+    )
     assert rc == 0
     return tmp / "runs" / "ppo_plant2_d0_full_s0-quick"
 
 
 def test_train_quick_writes_a_complete_run(ppo_run, capsys):
-    for f in ("model.zip", "best_model.zip", "vecnormalize.npz", "evaluations.npz", "run.json", "learning_curve.npz",
-              "learning_curve.png"):
+    for f in (
+        "model.zip",
+        "best_model.zip",
+        "vecnormalize.npz",
+        "evaluations.npz",
+        "run.json",
+        "learning_curve.npz",
+        "learning_curve.png",
+    ):
         assert (ppo_run / f).exists(), f
     assert (ppo_run / "learning_curve.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert any((ppo_run / "tb").rglob("events.out.tfevents.*"))
@@ -219,8 +243,24 @@ def test_progress_bar_never_passes_its_total():
 
 @pytest.mark.parametrize("algo", ["sac", "recurrent_ppo"])
 def test_train_quick_sac_and_recurrent_ppo(tmp_path, algo):
-    rc = cli.main(["train", "--algo", algo, "--preset", "small", "--quick", "--out", str(tmp_path), "--no-progress",
-                   "--no-tensorboard", "--set", "eval.elgamal.episodes=0", "--set", "horizon=32"])
+    rc = cli.main(
+        [
+            "train",
+            "--algo",
+            algo,
+            "--preset",
+            "small",
+            "--quick",
+            "--out",
+            str(tmp_path),
+            "--no-progress",
+            "--no-tensorboard",
+            "--set",
+            "eval.elgamal.episodes=0",
+            "--set",
+            "horizon=32",
+        ]
+    )
     assert rc == 0
     (run_dir,) = list(tmp_path.iterdir())
     run = read_run(run_dir)
@@ -241,7 +281,9 @@ def test_recurrent_attacker_keeps_and_resets_its_state():
     from sb3_contrib import RecurrentPPO
 
     venv = SB3VecEnv(SMALL, 2, "blind")
-    model = RecurrentPPO("MlpLstmPolicy", venv, n_steps=8, batch_size=16, policy_kwargs={"lstm_hidden_size": 4}, seed=0, device="cpu")
+    model = RecurrentPPO(
+        "MlpLstmPolicy", venv, n_steps=8, batch_size=16, policy_kwargs={"lstm_hidden_size": 4}, seed=0, device="cpu"
+    )
     att = SB3Attacker(model, params=venv.params, observation="blind", name="rppo")
     cfg = budget_config({"preset": "small", "gamma_opt": False, "decipher_delay": "end"}, 20)
     params = resolve_params(cfg)
@@ -264,7 +306,9 @@ def test_recurrent_attacker_keeps_and_resets_its_state():
 # ------------------------------------------------------------------ evaluate RUN_DIR
 def test_evaluate_prints_the_compare_table_on_paired_seeds(ppo_run, tmp_path, capsys):
     out = tmp_path / "ev"
-    rc = cli.main(["evaluate", str(ppo_run), "--episodes", "6", "--points", "2", "--seed", "7", "--out", str(out), "--no-progress"])
+    rc = cli.main(
+        ["evaluate", str(ppo_run), "--episodes", "6", "--points", "2", "--seed", "7", "--out", str(out), "--no-progress"]
+    )
     assert rc == 0
     text = capsys.readouterr()
     assert "warning" not in text.err
@@ -274,8 +318,11 @@ def test_evaluate_prints_the_compare_table_on_paired_seeds(ppo_run, tmp_path, ca
         rows = {r["attacker"]: r for r in csv.DictReader(fh)}
     cfg = budget_config({k: v for k, v in read_run(ppo_run).env.items() if k not in ("tau_c", "security_parameter")}, 64)
     params = resolve_params(cfg)
-    for name, att in (("gaussian", GaussianAttacker(params)), ("colored(rho=0.5)", ColoredGaussianAttacker(params, 0.5)),
-                      ("optimal-cl", OptimalDesignAttacker(params))):
+    for name, att in (
+        ("gaussian", GaussianAttacker(params)),
+        ("colored(rho=0.5)", ColoredGaussianAttacker(params, 0.5)),
+        ("optimal-cl", OptimalDesignAttacker(params)),
+    ):
         r = rollout(att, cfg, episodes=6, seed=7, record=False)
         assert float(rows[name]["mean_error_at_horizon"]) == pytest.approx(r.mean_final(), rel=1e-12), name
     learned = rollout(load_attacker(ppo_run, which="best", params=params), cfg, episodes=6, seed=7, record=False)
@@ -284,8 +331,12 @@ def test_evaluate_prints_the_compare_table_on_paired_seeds(ppo_run, tmp_path, ca
     ratio = np.exp(np.mean(np.log(learned.final_epsilon) - np.log(g.final_epsilon)))
     assert float(rows["ppo"]["ratio_to_gaussian"]) == pytest.approx(ratio, rel=1e-12)
     assert int(rows["ppo"]["horizon"]) == 64
-    assert cli.main(["evaluate", str(ppo_run), "--episodes", "2", "--points", "1", "--deterministic", "--out", str(out),
-                     "--no-progress"]) == 0
+    assert (
+        cli.main(
+            ["evaluate", str(ppo_run), "--episodes", "2", "--points", "1", "--deterministic", "--out", str(out), "--no-progress"]
+        )
+        == 0
+    )
     assert "warning: --deterministic" in capsys.readouterr().err
     assert cli.main(["evaluate", str(ppo_run), "--delays", "end"]) == 2
     assert "cannot play with decipher_delay 'end'" in capsys.readouterr().err

@@ -8,16 +8,13 @@ import math
 import pickle
 import random
 import sys
-from functools import lru_cache
+from functools import cache
 
 import gmpy2
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from encctl_gym.crypto import arith
-from encctl_gym.crypto.dyn_elgamal import recover_next_secret_key
-from encctl_gym.crypto.elgamal import SecretKey
-from encctl_gym.crypto.group import GroupParams, generate_safe_prime_group, shipped_group
 from encctl_gym.cryptanalysis import (
     BREAKERS,
     BreakReport,
@@ -32,6 +29,10 @@ from encctl_gym.cryptanalysis import (
 from encctl_gym.cryptanalysis import pari as pari_mod
 from encctl_gym.cryptanalysis.base import Deadline, format_seconds
 from encctl_gym.cryptanalysis.keys import key_sequence
+from encctl_gym.crypto import arith
+from encctl_gym.crypto.dyn_elgamal import recover_next_secret_key
+from encctl_gym.crypto.elgamal import SecretKey
+from encctl_gym.crypto.group import GroupParams, generate_safe_prime_group, shipped_group
 from encctl_gym.errors import (
     BreakerError,
     BreakerLimitError,
@@ -56,18 +57,18 @@ def direct_breakers() -> list:
     return [pytest.param(name, marks=needs_pari) if name == "pari" else name for name in DIRECT]
 
 
-@lru_cache(maxsize=None)
+@cache
 def group(bits: int, seed: int = 11) -> GroupParams:
     return generate_safe_prime_group(bits, rng=seed)
 
 
-@lru_cache(maxsize=None)
+@cache
 def sequence(bits: int, n: int, seed: int = 5) -> tuple[tuple[int, ...], tuple[int, ...], tuple]:
     hs, secrets, tokens = key_sequence(group(bits), n, arith.seeded_random(seed))
     return tuple(hs), tuple(secrets), tuple(tokens)
 
 
-@lru_cache(maxsize=None)
+@cache
 def precomputed(name: str, bits: int):
     return get_breaker(name, rng=3).precompute(group(bits) if bits else TOY)
 
@@ -528,7 +529,7 @@ def test_a_pari_failure_is_a_one_line_breaker_error(monkeypatch: pytest.MonkeyPa
 
 
 # ----------------------------------------------------------------------------- small q in a large p
-@lru_cache(maxsize=None)
+@cache
 def small_order_group(q_bits: int, p_bits: int, seed: int = 0) -> GroupParams:
     """A group p = n q + 1 with a q of ``q_bits`` bits and a p of ``p_bits`` bits (not a safe prime)."""
     rnd = random.Random(seed)

@@ -10,7 +10,8 @@ import random
 import mpmath
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from encctl_gym.cli import SUBCOMMANDS, main
 from encctl_gym.cryptanalysis import pari_available
@@ -39,8 +40,10 @@ def test_crack_json_reports_checked_keys(capsys: pytest.CaptureFixture) -> None:
 
 
 def test_crack_table_on_a_shipped_group(capsys: pytest.CaptureFixture) -> None:
-    assert main(["crack", "--bits", "64", "--keys", "3", "--breaker", "token-chain", "--inner", "index-calculus",
-                 "--no-progress"]) == 0
+    assert (
+        main(["crack", "--bits", "64", "--keys", "3", "--breaker", "token-chain", "--inner", "index-calculus", "--no-progress"])
+        == 0
+    )
     out = capsys.readouterr().out
     assert "64-bit shipped group" in out and "T_first" in out and "token" in out
     assert "all 3 keys checked" in out
@@ -92,8 +95,10 @@ def test_deciphering_time_rows_and_fit(quick_rows: list) -> None:
     assert {(f["breaker"], f["bits"]) for f in fits} == {(r["breaker"], r["bits"]) for r in rows}
     for f in fits:
         assert f["N_max"] == 8 and f["fresh"] == 1 and f["T_first"] > 0
-        seq = sorted((r for r in rows if r["breaker"] == f["breaker"] and r["bits"] == f["bits"]
-                      and r["kind"] == "sequence"), key=lambda r: r["N"])
+        seq = sorted(
+            (r for r in rows if r["breaker"] == f["breaker"] and r["bits"] == f["bits"] and r["kind"] == "sequence"),
+            key=lambda r: r["N"],
+        )
         slope, intercept = np.polyfit([r["N"] for r in seq], [r["tau"] for r in seq], 1)
         assert f["T_1"] == pytest.approx(slope) and f["T_0"] == pytest.approx(intercept)
         assert f["ratio"] == pytest.approx(f["T_1"] / f["T_first"])
@@ -465,7 +470,10 @@ def test_lattice_sieve_pairs_satisfy_the_congruence() -> None:
         (i, j)
         for i in range(1, 9)
         for j in range(-256, 256)
-        if math.gcd(i, j) == 1 and fb.is_smooth(i * a1 + j * a2 or 1) and fb.is_smooth(i * b1 + j * b2 or 1)
-        and i * a1 + j * a2 and i * b1 + j * b2
+        if math.gcd(i, j) == 1
+        and fb.is_smooth(i * a1 + j * a2 or 1)
+        and fb.is_smooth(i * b1 + j * b2 or 1)
+        and i * a1 + j * a2
+        and i * b1 + j * b2
     }
     assert smooth and smooth <= set(sieve_candidates(y, p, plan, slack=40.0)[1])

@@ -9,8 +9,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from encctl_gym.crypto.arith import RandomSource, seeded_random
 from encctl_gym.attacks.forgery import forge_injection
+from encctl_gym.crypto.arith import RandomSource, seeded_random
 from encctl_gym.crypto.controller import EncryptedLinearController
 from encctl_gym.crypto.dyn_elgamal import UpdateToken, ciphertext_update, key_update, recover_next_secret_key
 from encctl_gym.crypto.elgamal import Ciphertext, PublicKey, SecretKey, decrypt, encrypt, keygen, mult

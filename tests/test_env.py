@@ -605,7 +605,9 @@ def test_a_quantisation_table_too_large_is_refused_with_its_size(x_bound):
 
 
 # ------------------------------------------------------------------ estimators (beyond least squares)
-@pytest.mark.parametrize("estimator", ["bayes", "forgetting", "iv", {"name": "bayes", "prior_variance": 1.0, "noise_variance": 0.1}])
+@pytest.mark.parametrize(
+    "estimator", ["bayes", "forgetting", "iv", {"name": "bayes", "prior_variance": 1.0, "noise_variance": 0.1}]
+)
 def test_a_configured_estimator_gives_epsilon_and_reward_of_its_own_fit(estimator):
     """info["epsilon"] is the error of the estimator's fit on the delivered data (its batch fit
     computed here independently), the log_error return telescopes, and the vector environment
@@ -640,7 +642,13 @@ def test_a_configured_estimator_gives_epsilon_and_reward_of_its_own_fit(estimato
 
 @pytest.mark.parametrize(
     "estimator,text",
-    [("ridge", "ridge"), ({"name": "forgetting", "forgetting_factor": 1.5}, "1.5"), ({"name": "forgetting", "factor": 0.9}, "factor"), ({"name": "bayes", "prior_variance": -1.0}, "variance"), (3, "3")],
+    [
+        ("ridge", "ridge"),
+        ({"name": "forgetting", "forgetting_factor": 1.5}, "1.5"),
+        ({"name": "forgetting", "factor": 0.9}, "factor"),
+        ({"name": "bayes", "prior_variance": -1.0}, "variance"),
+        (3, "3"),
+    ],
 )
 def test_a_bad_estimator_is_refused_at_construction(estimator, text):
     with pytest.raises(ParameterError, match=text):
@@ -677,8 +685,20 @@ def test_huge_integer_settings_are_refused_naming_the_value(key, value, text):
 def test_an_infinite_actuator_bound_is_refused():
     """action_scale = 1e308 with sigma_u2 = 4 makes u_max = 2e308 = inf in float64."""
     with pytest.raises(ParameterError, match=r"u_max.*action_scale = 1e\+308 and sigma_u2 = 4"):
-        resolve_params({**SMALL, "preset": None, "A": [[0.5]], "B": [[1.0]], "sigma_w2": 1.0, "sigma_u2": 4.0,
-                        "upsilon": 1e9, "tau_c": "1y", "gamma_c": 1e-3, "action_scale": 1e308})
+        resolve_params(
+            {
+                **SMALL,
+                "preset": None,
+                "A": [[0.5]],
+                "B": [[1.0]],
+                "sigma_w2": 1.0,
+                "sigma_u2": 4.0,
+                "upsilon": 1e9,
+                "tau_c": "1y",
+                "gamma_c": 1e-3,
+                "action_scale": 1e308,
+            }
+        )
 
 
 def test_a_quantisation_table_beyond_its_bound_is_refused_before_it_is_built():

@@ -193,7 +193,9 @@ def test_pari_missing_is_one_line_naming_the_extra(monkeypatch):
     assert "\n" not in str(err.value)
 
 
-@pytest.mark.skipif(not __import__("encctl_gym.cryptanalysis.pari", fromlist=["x"]).pari_available(), reason="needs the cryptanalysis extra")
+@pytest.mark.skipif(
+    not __import__("encctl_gym.cryptanalysis.pari", fromlist=["x"]).pari_available(), reason="needs the cryptanalysis extra"
+)
 def test_pari_breaker_in_the_loop_matches():
     a, _, _ = rollout(make(max_samples=9))
     b, _, _ = rollout(make(max_samples=9, breaker="pari"))

@@ -9,8 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from encctl_gym.attacks.forgery import injection_value
-from encctl_gym.crypto.quantized import QuantizedLinearController
 from encctl_gym.crypto.encoding import Encoder
+from encctl_gym.crypto.quantized import QuantizedLinearController
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import EncodingOverflowError, ParameterError
 from encctl_gym.loop import BACKENDS, ElGamalLoop, IdealLoop, LoopBackend, loop_group, make_loop

@@ -59,8 +59,21 @@ LENGTH_KEYS = frozenset({"tau_c", "max_samples", "security_parameter", "key_leng
 _OWN_KEYS = ("tau_c", "security_parameter", "key_length")
 #: What must agree between the environment a run was trained in and a setting it plays in: the
 #: system, its key and budget, and how the error is measured.
-_SAME_SYSTEM = ("sigma_w2", "sigma_x2", "sigma_u2", "upsilon", "tau_c", "gamma_c", "security_parameter", "key_length",
-                "deciphering_model", "scheme", "adversary", "estimator", "warmup_steps")
+_SAME_SYSTEM = (
+    "sigma_w2",
+    "sigma_x2",
+    "sigma_u2",
+    "upsilon",
+    "tau_c",
+    "gamma_c",
+    "security_parameter",
+    "key_length",
+    "deciphering_model",
+    "scheme",
+    "adversary",
+    "estimator",
+    "warmup_steps",
+)
 
 
 def system_config(run: RunInfo, system: str | None = None, config: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -142,8 +155,9 @@ def left_out(runs: Sequence[RunInfo], settings: Sequence[Setting]) -> list[tuple
     return out
 
 
-def learned_players(setting: Setting, runs: Sequence[RunInfo], which: str = "best", *,
-                    deterministic: bool = False) -> list[tuple[Attacker, Setting]]:
+def learned_players(
+    setting: Setting, runs: Sequence[RunInfo], which: str = "best", *, deterministic: bool = False
+) -> list[tuple[Attacker, Setting]]:
     """The learned attackers of the runs that play in ``setting``, each with the setting it plays
     in: ``setting`` in the environment the run was trained in (:func:`run_setting`).
 
@@ -157,8 +171,10 @@ def learned_players(setting: Setting, runs: Sequence[RunInfo], which: str = "bes
     try:
         from agents.sb3 import load_attacker
     except ModuleNotFoundError as exc:
-        raise EncctlError(f"learned attackers need stable-baselines3 (module {exc.name!r} is missing); "
-                          "install the extra: pip install 'encctl-gym[rl]'") from exc
+        raise EncctlError(
+            f"learned attackers need stable-baselines3 (module {exc.name!r} is missing); "
+            "install the extra: pip install 'encctl-gym[rl]'"
+        ) from exc
     names = [r.algo + ("-blind" if r.observation == "blind" else "") for r, _ in chosen]
     count = Counter(names)
     out: list[tuple[Attacker, Setting]] = []
@@ -167,4 +183,3 @@ def learned_players(setting: Setting, runs: Sequence[RunInfo], which: str = "bes
         w = which if which == "final" or (run.path / "best_model.zip").exists() else "final"
         out.append((load_attacker(run.path, which=w, params=play.params, name=label, deterministic=deterministic), play))
     return out
-

@@ -35,7 +35,18 @@ from .report import summary_markdown
 from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, make_setting, parse_delays, system_entry
 from .tables import write_csvs
 
-__all__ = ["QUICK_SYSTEMS", "QUICK_CAP", "QUICK_EPISODES", "MAX_COUNT", "add_arguments", "run", "main", "write_outputs", "positive", "names"]
+__all__ = [
+    "QUICK_SYSTEMS",
+    "QUICK_CAP",
+    "QUICK_EPISODES",
+    "MAX_COUNT",
+    "add_arguments",
+    "run",
+    "main",
+    "write_outputs",
+    "positive",
+    "names",
+]
 
 QUICK_SYSTEMS = ("paper-example",)
 QUICK_CAP = 60
@@ -69,24 +80,52 @@ def names(text: str, what: str) -> tuple[str, ...]:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``encctl-gym compare``."""
     parser.add_argument("--out", default="results/compare", help="output directory (default results/compare)")
-    parser.add_argument("--quick", action="store_true",
-                        help=f"small smoke test ({QUICK_SYSTEMS[0]}, N <= {QUICK_CAP}, {QUICK_EPISODES} episodes, {QUICK_POINTS} lengths)")
+    parser.add_argument(
+        "--quick",
+        action="store_true",
+        help=f"small smoke test ({QUICK_SYSTEMS[0]}, N <= {QUICK_CAP}, {QUICK_EPISODES} episodes, {QUICK_POINTS} lengths)",
+    )
     parser.add_argument("--seed", type=int, default=0, help="environment seeds seed, seed + 1, ... (default 0)")
-    parser.add_argument("--episodes", type=int, default=None, help=f"episodes per attacker, setting and attack length (default {FULL_EPISODES})")
-    parser.add_argument("--systems", default=None, help=f"comma-separated presets or plant files (as train --system reads; default {','.join(DEFAULT_SYSTEMS)})")
+    parser.add_argument(
+        "--episodes", type=int, default=None, help=f"episodes per attacker, setting and attack length (default {FULL_EPISODES})"
+    )
+    parser.add_argument(
+        "--systems",
+        default=None,
+        help=f"comma-separated presets or plant files (as train --system reads; default {','.join(DEFAULT_SYSTEMS)})",
+    )
     parser.add_argument("--delays", default=None, help="comma-separated decipher delays: integers >= 0 or end (default 0,end)")
-    parser.add_argument("--attackers", default=None,
-                        help=f"comma-separated registered attackers (default all: {','.join(ATTACKERS)}); learned ones come from --runs")
+    parser.add_argument(
+        "--attackers",
+        default=None,
+        help=f"comma-separated registered attackers (default all: {','.join(ATTACKERS)}); learned ones come from --runs",
+    )
     parser.add_argument("--max-samples", type=int, default=None, help=f"evaluation cap on N (default {DEFAULT_CAP})")
-    parser.add_argument("--points", type=int, default=None,
-                        help=f"attack lengths N on the log grid of every curve, in every setting, at most --max-samples "
-                        f"(default {FULL_POINTS}; quick {QUICK_POINTS})")
-    parser.add_argument("--runs", action="append", default=[], help="training run directory or a parent of runs (repeatable; "
-                        "default results/train if it exists)")
-    parser.add_argument("--which", choices=("best", "final"), default="best",
-                        help="learned model: the best of the training's evaluation callback (default) or the final one")
-    parser.add_argument("--elgamal-episodes", type=int, default=1,
-                        help="episodes of each attacker through real ElGamal ciphertexts (64-bit key, N = 40; default 1, 0: none)")
+    parser.add_argument(
+        "--points",
+        type=int,
+        default=None,
+        help=f"attack lengths N on the log grid of every curve, in every setting, at most --max-samples "
+        f"(default {FULL_POINTS}; quick {QUICK_POINTS})",
+    )
+    parser.add_argument(
+        "--runs",
+        action="append",
+        default=[],
+        help="training run directory or a parent of runs (repeatable; default results/train if it exists)",
+    )
+    parser.add_argument(
+        "--which",
+        choices=("best", "final"),
+        default="best",
+        help="learned model: the best of the training's evaluation callback (default) or the final one",
+    )
+    parser.add_argument(
+        "--elgamal-episodes",
+        type=int,
+        default=1,
+        help="episodes of each attacker through real ElGamal ciphertexts (64-bit key, N = 40; default 1, 0: none)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
@@ -123,12 +162,32 @@ def run(args: argparse.Namespace) -> int:
     skipped += [(r.path, why) for r, why in left_out(runs, settings)]
     for path, why in skipped:
         print(f"encctl-gym compare: leaving out the run {path}: {why}", file=sys.stderr)
-    result = compute(settings=settings, episodes=episodes, seed=args.seed, points=points, runs=runs,
-                     which=args.which, elgamal_episodes=args.elgamal_episodes, elgamal_N=min(40, cap),
-                     progress=not args.no_progress, attackers=attackers)
-    cmd = ["encctl-gym compare", f"--seed {args.seed}", f"--episodes {episodes}", f"--systems {','.join(systems)}",
-           f"--delays {','.join(str(d) for d in delays)}", f"--max-samples {cap}", f"--points {points}",
-           f"--which {args.which}"] + [f"--runs {r}" for r in roots] + (["--quick"] if quick else [])
+    result = compute(
+        settings=settings,
+        episodes=episodes,
+        seed=args.seed,
+        points=points,
+        runs=runs,
+        which=args.which,
+        elgamal_episodes=args.elgamal_episodes,
+        elgamal_N=min(40, cap),
+        progress=not args.no_progress,
+        attackers=attackers,
+    )
+    cmd = (
+        [
+            "encctl-gym compare",
+            f"--seed {args.seed}",
+            f"--episodes {episodes}",
+            f"--systems {','.join(systems)}",
+            f"--delays {','.join(str(d) for d in delays)}",
+            f"--max-samples {cap}",
+            f"--points {points}",
+            f"--which {args.which}",
+        ]
+        + [f"--runs {r}" for r in roots]
+        + (["--quick"] if quick else [])
+    )
     if args.attackers:
         cmd.append(f"--attackers {','.join(attackers)}")
     md, paths = write_outputs(result, Path(args.out), command=" ".join(cmd))

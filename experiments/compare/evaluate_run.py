@@ -43,7 +43,11 @@ __all__ = ["BASELINES", "EPISODES", "run_settings", "system_config", "add_argume
 BASELINES = ("gaussian", "colored", "optimal")
 #: Default episodes per attacker and attack length.
 EPISODES = 100
-def run_settings(run: RunInfo, systems: tuple[str, ...] | None, delays: tuple[Any, ...] | None, length: int | None) -> list[Setting]:
+
+
+def run_settings(
+    run: RunInfo, systems: tuple[str, ...] | None, delays: tuple[Any, ...] | None, length: int | None
+) -> list[Setting]:
     """The settings of an evaluation (module docstring); ``length`` None: each system's full budget."""
     if delays is None:
         own = run.env.get("decipher_delay", 0)
@@ -56,8 +60,10 @@ def run_settings(run: RunInfo, systems: tuple[str, ...] | None, delays: tuple[An
         config = system_config(run, label, plant)
         for d in delays:
             if d == "end" and run.observation != "blind":
-                raise ConfigError(f"the {run.observation!r} policy of {run.path} reads delivered states; it cannot play with "
-                                  "decipher_delay 'end' (only a blind policy can)")
+                raise ConfigError(
+                    f"the {run.observation!r} policy of {run.path} reads delivered states; it cannot play with "
+                    "decipher_delay 'end' (only a blind policy can)"
+                )
             out.append(make_setting(label, d, None, config=config, length=length))
     return out
 
@@ -65,22 +71,49 @@ def run_settings(run: RunInfo, systems: tuple[str, ...] | None, delays: tuple[An
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``encctl-gym evaluate``."""
     parser.add_argument("run_dir", metavar="RUN_DIR", help="a training run directory (written by encctl-gym train)")
-    parser.add_argument("--episodes", type=int, default=None, help=f"episodes per attacker and attack length (default {EPISODES})")
-    parser.add_argument("--systems", default=None,
-                        help="comma-separated presets or plant files (as train --system reads) to play on (default: the run's own system)")
-    parser.add_argument("--delays", default=None,
-                        help="comma-separated decipher delays: integers >= 0 or end (default: the run's; a blind policy also end)")
-    parser.add_argument("--deterministic", action="store_true",
-                        help="play the policy's mean action (not recommended: the policy's noise is its excitation)")
-    parser.add_argument("--allow-pickle", action="store_true",
-                        help="unpickle an older run's vecnormalize.pkl (a pickle can run any code: only for runs you trust)")
-    parser.add_argument("--which", choices=("best", "final"), default="best", help="the best model of the training's evaluations (default) or the final one")
-    parser.add_argument("--samples", type=int, default=None,
-                        help="attack length N to evaluate at, set through the deciphering budget (default: the training attack length)")
-    parser.add_argument("--full-budget", action="store_true", help="evaluate at the full tau_c budget of each system at its lambda")
+    parser.add_argument(
+        "--episodes", type=int, default=None, help=f"episodes per attacker and attack length (default {EPISODES})"
+    )
+    parser.add_argument(
+        "--systems",
+        default=None,
+        help="comma-separated presets or plant files (as train --system reads) to play on (default: the run's own system)",
+    )
+    parser.add_argument(
+        "--delays",
+        default=None,
+        help="comma-separated decipher delays: integers >= 0 or end (default: the run's; a blind policy also end)",
+    )
+    parser.add_argument(
+        "--deterministic",
+        action="store_true",
+        help="play the policy's mean action (not recommended: the policy's noise is its excitation)",
+    )
+    parser.add_argument(
+        "--allow-pickle",
+        action="store_true",
+        help="unpickle an older run's vecnormalize.pkl (a pickle can run any code: only for runs you trust)",
+    )
+    parser.add_argument(
+        "--which",
+        choices=("best", "final"),
+        default="best",
+        help="the best model of the training's evaluations (default) or the final one",
+    )
+    parser.add_argument(
+        "--samples",
+        type=int,
+        default=None,
+        help="attack length N to evaluate at, set through the deciphering budget (default: the training attack length)",
+    )
+    parser.add_argument(
+        "--full-budget", action="store_true", help="evaluate at the full tau_c budget of each system at its lambda"
+    )
     parser.add_argument("--points", type=int, default=6, help="attack lengths N on the log grid of every curve (default 6)")
     parser.add_argument("--seed", type=int, default=20_000, help="environment seeds seed, seed + 1, ... (default 20000)")
-    parser.add_argument("--elgamal-episodes", type=int, default=0, help="episodes of each attacker through real ElGamal ciphertexts (default 0)")
+    parser.add_argument(
+        "--elgamal-episodes", type=int, default=0, help="episodes of each attacker through real ElGamal ciphertexts (default 0)"
+    )
     parser.add_argument("--out", default=None, help="output directory (default RUN_DIR/evaluation)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
@@ -95,8 +128,11 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("give --samples or --full-budget, not both")
     length = None if args.full_budget else (positive("samples", args.samples, 2) or resolve_params(info.env).horizon)
     if args.deterministic:
-        print("encctl-gym evaluate: warning: --deterministic plays the policy's mean action; its noise is its excitation, "
-              "and without it a state-feedback policy leaves [x; u] nearly rank deficient (expect a larger error)", file=sys.stderr)
+        print(
+            "encctl-gym evaluate: warning: --deterministic plays the policy's mean action; its noise is its excitation, "
+            "and without it a state-feedback policy leaves [x; u] nearly rank deficient (expect a larger error)",
+            file=sys.stderr,
+        )
     systems = names(args.systems, "systems") if args.systems is not None else None  # an empty list is an error
     delays = parse_delays(args.delays) if args.delays is not None else None
     settings = run_settings(info, systems, delays, length)
@@ -106,25 +142,51 @@ def run(args: argparse.Namespace) -> int:
 
     def learned(setting: Setting) -> list[Attacker]:
         label = info.algo + ("-blind" if info.observation == "blind" else "")
-        return [load_attacker(info.path, which=which, params=setting.params, name=label, deterministic=args.deterministic,
-                              allow_pickle=args.allow_pickle)]
+        return [
+            load_attacker(
+                info.path,
+                which=which,
+                params=setting.params,
+                name=label,
+                deterministic=args.deterministic,
+                allow_pickle=args.allow_pickle,
+            )
+        ]
 
-    result = compute(settings=settings, episodes=episodes, seed=args.seed, points=args.points, attackers=BASELINES,
-                     elgamal_episodes=args.elgamal_episodes, elgamal_N=min(40, min(s.params.horizon for s in settings)),
-                     progress=not args.no_progress, players=learned)
-    cmd = [f"encctl-gym evaluate {info.path}", f"--episodes {episodes}", f"--seed {args.seed}", f"--points {args.points}",
-           f"--which {args.which}", "--full-budget" if length is None else f"--samples {length}"]
+    result = compute(
+        settings=settings,
+        episodes=episodes,
+        seed=args.seed,
+        points=args.points,
+        attackers=BASELINES,
+        elgamal_episodes=args.elgamal_episodes,
+        elgamal_N=min(40, min(s.params.horizon for s in settings)),
+        progress=not args.no_progress,
+        players=learned,
+    )
+    cmd = [
+        f"encctl-gym evaluate {info.path}",
+        f"--episodes {episodes}",
+        f"--seed {args.seed}",
+        f"--points {args.points}",
+        f"--which {args.which}",
+        "--full-budget" if length is None else f"--samples {length}",
+    ]
     if systems:
         cmd.append(f"--systems {','.join(systems)}")
     if delays:
         cmd.append(f"--delays {','.join(str(d) for d in delays)}")
     if args.deterministic:
         cmd.append("--deterministic")
-    _, paths = write_outputs(result, out, command=" ".join(cmd), title=f"{info.path.name} against the baselines (`encctl-gym evaluate`)")
+    _, paths = write_outputs(
+        result, out, command=" ".join(cmd), title=f"{info.path.name} against the baselines (`encctl-gym evaluate`)"
+    )
     print(comparison_table(result))
     print()
     print(design_efficiencies(result))
-    print(f"\n{episodes} episodes per attacker and attack length on environment seeds {args.seed}, {args.seed + 1}, ...; "
-          f"{'deterministic' if args.deterministic else 'stochastic'} policy ({args.which} model).")
+    print(
+        f"\n{episodes} episodes per attacker and attack length on environment seeds {args.seed}, {args.seed + 1}, ...; "
+        f"{'deterministic' if args.deterministic else 'stochastic'} policy ({args.which} model)."
+    )
     print("wrote " + ", ".join(str(p) for p in paths))
     return 0
