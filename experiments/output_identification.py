@@ -213,6 +213,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("results/output_identification"))
     args = parser.parse_args(argv)
     runs, points, n_max = (4, 4, 2000) if args.quick else (args.runs, args.points, None)
+    if runs < 2 or points < 3:  # an interval needs two runs, a fitted rate three sizes
+        print(f"output_identification: --runs must be >= 2 and --points >= 3, got {runs} and {points}", file=sys.stderr)
+        return 2
     try:
         rows = run(runs, points, n_max, args.seed)
         paths = write(rows, args.out)
