@@ -70,6 +70,9 @@ def test_refusals():
         fit_empirical_complexity(N, -good)
     with pytest.raises(ParameterError, match="level"):
         fit_empirical_complexity(N, good, level=1.5)
+    slow = fit_empirical_complexity(N, np.ones((5, 3)) * N**-0.001, bootstrap=100)
+    with pytest.raises(ParameterError, match="reaches gamma_c = 1e-06 only at N = e\\^"):
+        empirical_design(slow, THREAT, gamma_c=1e-6)
     flat = fit_empirical_complexity(N, good * np.array([1.0, 1.0, 1.0]), bootstrap=100)
     with pytest.raises(ParameterError, match="not positive|non-positive"):
         empirical_design(flat, THREAT, gamma_c=1e-3)

@@ -176,8 +176,12 @@ def _n_star(a: float, c: float, gamma_c: float) -> int:
     """The smallest integer ``N`` with ``c / N^a < gamma_c`` (``a > 0``)."""
     if not a > 0:
         raise ParameterError(f"the fitted exponent a = {a:.3g} is not positive: the error does not decrease with N")
-    root = (c / gamma_c) ** (1.0 / a)
-    return max(int(math.floor(root)) + 1, 1)
+    log_root = (math.log(c) - math.log(gamma_c)) / a
+    if log_root > 700:  # beyond float range, and far beyond any sample size a design can use
+        raise ParameterError(
+            f"the fitted rate c / N^a (a = {a:.3g}, c = {c:.3g}) reaches gamma_c = {gamma_c:g} only at N = e^{log_root:.0f}"
+        )
+    return max(int(math.floor(math.exp(log_root))) + 1, 1)
 
 
 def empirical_design(
