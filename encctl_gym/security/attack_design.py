@@ -55,6 +55,7 @@ import numpy as np
 from .._validation import check_bool, check_int, check_positive, check_schur_stable, check_system, format_value
 from ..errors import ParameterError, ResourceLimitError, SolverError
 from ..plant import Plant, as_plant
+from .bayes_complexity import stationary_regressor_covariance
 from .complexity import check_sample_size
 from .design import SecurityDesign, design_for_sample_size
 from .gramians import controllability_gramian, noise_gramian
@@ -208,8 +209,8 @@ def gaussian_attack_design(A: Any, B: Any, *, sigma_u2: float, sigma_w2: float) 
     """
     A, B, su, sw = _check_inputs(A, B, sigma_u2, sigma_w2)
     n, m = B.shape
-    Sxx = su * controllability_gramian(A, B) + sw * noise_gramian(A)
-    Sigma = np.block([[Sxx, np.zeros((n, m))], [np.zeros((m, n)), su * np.eye(m)]])
+    Sigma = stationary_regressor_covariance(A, B, sigma_u2=su, sigma_w2=sw)
+    Sxx = Sigma[:n, :n]
     trace_inv = float(np.trace(np.linalg.inv(Sxx)) + m / su)
     return AttackDesign(Sigma, np.zeros((m, n)), su * np.eye(m), trace_inv, su, sw, "gaussian")
 

@@ -60,10 +60,6 @@ __all__ = [
 ]
 
 
-def _check_plant(A: Any, B: Any) -> tuple[np.ndarray, np.ndarray]:
-    return check_system(A, B)
-
-
 def input_noise_covariance(B: Any, sigma_w2: float, sigma_d2: float) -> np.ndarray:
     """``Sigma = sigma_d2 B B^T + sigma_w2 I``: the noise the attacker faces when the plant side adds
     ``d[t] ~ N(0, sigma_d2 I)`` to the applied input (module docstring)."""
@@ -74,7 +70,7 @@ def input_noise_covariance(B: Any, sigma_w2: float, sigma_d2: float) -> np.ndarr
 
 
 def _noise_terms(A: Any, B: Any, sigma_w2: float, sigma_d2: float) -> tuple[float, float, float, int, int]:
-    A, B = _check_plant(A, B)
+    A, B = check_system(A, B)
     n, m = B.shape
     tr_u = float(np.trace(controllability_gramian(A, B)))
     tr_w = float(np.trace(noise_gramian(A)))
@@ -174,7 +170,7 @@ def closed_loop_state_covariance(A: Any, B: Any, Phi: Any, *, sigma_w2: float, s
     UnstableSystemError
         If ``A + B Phi`` is not Schur stable.
     """
-    A, B = _check_plant(A, B)
+    A, B = check_system(A, B)
     Phi = as_finite_array("Phi", Phi, ndim=2)
     if Phi.shape != (B.shape[1], B.shape[0]):
         raise ShapeError(f"Phi must have shape {(B.shape[1], B.shape[0])}, got {Phi.shape}")
@@ -192,7 +188,7 @@ def noise_defense_price(
     applied input ``v = Phi x + d``, i.e. ``tr(Q P) + tr(R Phi P Phi^T) + sigma_d2 tr R``, with and
     without the noise, and their increases (``Q = I``, ``R = I`` unless given).
     """
-    A, B = _check_plant(A, B)
+    A, B = check_system(A, B)
     n, m = B.shape
     Q = np.eye(n) if Q is None else as_finite_array("Q", Q, ndim=2)
     R = np.eye(m) if R is None else as_finite_array("R", R, ndim=2)
