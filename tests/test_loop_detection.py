@@ -53,8 +53,8 @@ def test_an_injection_is_detected():
 
 def test_audits_never_alarm_without_an_injection_and_catch_one_at_their_rate():
     rng = np.random.default_rng(2)
-    audit = Audit(PHI, rate=0.1, tolerance=1e-3, rng=np.random.default_rng(3))
     K, T = 100, 500
+    audit = Audit(PHI, rate=0.1, rngs=[np.random.default_rng([3, k]) for k in range(K)], tolerance=1e-3)
     caught_honest = 0
     caught_attack = 0
     for _ in range(T):
@@ -70,7 +70,7 @@ def test_audits_never_alarm_without_an_injection_and_catch_one_at_their_rate():
 
 def test_refusals():
     with pytest.raises(ParameterError, match="audit_rate must lie in \\[0, 1\\], got 1.5"):
-        Audit(PHI, rate=1.5, tolerance=0.0, rng=np.random.default_rng())
+        Audit(PHI, rate=1.5, rngs=[np.random.default_rng()])
     with pytest.raises(ParameterError, match="positive definite"):
         ChiSquaredDetector(A_CL, np.zeros((2, 2)), window=3, false_alarm_rate=0.01)
     with pytest.raises(ShapeError, match="same size"):

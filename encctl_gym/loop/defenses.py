@@ -31,7 +31,7 @@ from ..crypto.residue_table import residue_table
 from ..errors import ParameterError
 from .backend import loop_group, lqr_gain, table_limit
 from .defender import DEFENDERS, DefenderAction, PlantView
-from .detection import ChiSquaredDetector
+from .detection import Audit, ChiSquaredDetector, check_audit_rate
 
 __all__ = ["AuditDefender", "DetectorDefender", "NoiseDefender", "audit_tolerance"]
 
@@ -109,26 +109,23 @@ class AuditDefender(_PlantSidePolicy):
     name = "audit"
 
     def __init__(self, rate: float = 5e-4) -> None:
-        rate = check_nonnegative("rate", rate)
-        if rate > 1:
-            raise ParameterError(f"rate must lie in [0, 1], got {rate}")
-        self.rate = rate
-        self.audits = 0
+        self.rate = check_audit_rate(rate, "rate")
 
     def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
         super().reset(K, n, m, rngs)
-        self.audits = 0
+        self._audit = Audit(self.Phi, self.rate, rngs)
+
+    @property
+    def audits(self) -> int:
+        """Audits run in the current episode (over all copies)."""
+        return self._audit.audits
 
     def act(self, view: PlantView) -> DefenderAction | None:
         x_prev, self._x_prev = self._x_prev, np.array(view.state, dtype=float)
         if x_prev is None or self.rate == 0.0:
             return None
-        audited = np.array([rng.random() < self.rate for rng in self.rngs[: self.K]])
-        if not audited.any():
-            return None
-        self.audits += int(audited.sum())
-        diff = np.abs(view.last_input - x_prev @ self.Phi.T)
-        caught = audited & np.any(diff > audit_tolerance(self.Phi, x_prev, self.delta, self.max_shift), axis=1)
+        tolerance = audit_tolerance(self.Phi, x_prev, self.delta, self.max_shift)
+        caught = self._audit.check(x_prev, view.last_input, tolerance)
         return DefenderAction(end=True) if caught.any() else None
 
     def __repr__(self) -> str:

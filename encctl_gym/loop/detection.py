@@ -17,6 +17,7 @@ in lockstep (the vector environment's copies), each with its own random stream:
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -25,7 +26,15 @@ from .._validation import as_finite_array, check_int, check_nonnegative
 from ..errors import ParameterError, ShapeError
 from ..security.defenses import chi2_threshold
 
-__all__ = ["Audit", "ChiSquaredDetector"]
+__all__ = ["Audit", "ChiSquaredDetector", "check_audit_rate"]
+
+
+def check_audit_rate(rate: Any, name: str = "audit_rate") -> float:
+    """``rate`` as an audit probability in [0, 1]; the package's error names it otherwise."""
+    rate = check_nonnegative(name, rate)
+    if rate > 1:
+        raise ParameterError(f"{name} must lie in [0, 1], got {rate}")
+    return rate
 
 
 class Audit:
@@ -36,38 +45,41 @@ class Audit:
     Phi : array_like, shape (m, n)
         The controller gain the plant side encrypted.
     rate : float
-        Audit probability per step, in [0, 1].
+        Audit probability per step and loop, in [0, 1].
+    rngs : sequence of numpy.random.Generator
+        The plant side's own streams, one per loop: loop ``k`` is audited when
+        ``rngs[k].random() < rate``.
     tolerance : float
-        The largest difference (max-norm) the encoding can explain: the decoded ``Phi x`` differs
-        from the real one by at most this much (the encoder's error bound).
-    rng : numpy.random.Generator
-        The plant side's own stream for the audit draws.
+        The largest difference the encoding can explain (the encoder's error bound), unless
+        :meth:`check` is given one per loop and input.
     """
 
-    def __init__(self, Phi: Any, rate: float, tolerance: float, rng: np.random.Generator) -> None:
+    def __init__(self, Phi: Any, rate: float, rngs: Sequence[np.random.Generator], tolerance: float = 0.0) -> None:
         self.Phi = as_finite_array("Phi", Phi, ndim=2)
-        rate = check_nonnegative("audit_rate", rate)
-        if rate > 1:
-            raise ParameterError(f"audit_rate must lie in [0, 1], got {rate}")
-        self.rate = rate
+        self.rate = check_audit_rate(rate)
         self.tolerance = check_nonnegative("tolerance", tolerance)
-        self._rng = rng
+        self._rngs = rngs
         self.audits = 0
 
-    def check(self, x: Any, u_decrypted: Any) -> np.ndarray:
-        """One step of ``K`` loops: which are audited and caught, shape (K,) of bool."""
+    def check(self, x: Any, u_decrypted: Any, tolerance: Any = None) -> np.ndarray:
+        """One step of ``K`` loops: which are audited and caught, shape (K,) of bool. A loop is
+        caught when an entry of ``u - Phi x`` exceeds the tolerance (``tolerance``: a float or an
+        array broadcasting to (K, m); default the constructor's)."""
         x = np.atleast_2d(np.asarray(x, dtype=float))
         u = np.atleast_2d(np.asarray(u_decrypted, dtype=float))
         if x.shape[1] != self.Phi.shape[1] or u.shape != (x.shape[0], self.Phi.shape[0]):
             raise ShapeError(
                 f"x and u must have shapes (K, {self.Phi.shape[1]}) and (K, {self.Phi.shape[0]}), got {x.shape} and {u.shape}"
             )
-        audited = self._rng.random(x.shape[0]) < self.rate
+        K = x.shape[0]
+        if len(self._rngs) < K:
+            raise ShapeError(f"the audit has {len(self._rngs)} random streams for {K} loops")
+        audited = np.array([rng.random() < self.rate for rng in self._rngs[:K]], dtype=bool)
         self.audits += int(audited.sum())
         if not audited.any():
             return audited
-        diff = np.max(np.abs(u - x @ self.Phi.T), axis=1)
-        return audited & (diff > self.tolerance)
+        tol = self.tolerance if tolerance is None else tolerance
+        return audited & np.any(np.abs(u - x @ self.Phi.T) > tol, axis=1)
 
 
 class ChiSquaredDetector:
