@@ -16,7 +16,7 @@ Figure 1 (c) (``fig1-c``):
   collected before the attack ends, the median final error over ``gamma_c``, and the wall time
   per step against the undefended loop (a ratio measured in the same run).
 
-    python -m experiments.defenses [--measure] [--episodes 20] [--out results/defenses]
+    python -m encctl_gym.experiments.defenses [--measure] [--episodes 20] [--out results/defenses]
 
 Prints the tables and writes them as ``defenses_analytic.md`` (and ``defenses_measured.md``).
 """
@@ -116,9 +116,9 @@ MEASURED_DEFENDERS: tuple[tuple[str, Any], ...] = (
 def measure(system: str, episodes: int, seed: int) -> list[dict[str, Any]]:
     """Every defender against every attacker of the module docstring, ``episodes`` each."""
     import gymnasium as gym
+    from encctl_gym.agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker
 
     import encctl_gym  # noqa: F401  (registers the environment)
-    from agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker
 
     p = get_preset(system)
     rows: list[dict[str, Any]] = []
@@ -186,7 +186,7 @@ def format_measured(rows: list[dict[str, Any]]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m experiments.defenses", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m encctl_gym.experiments.defenses", description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("results/defenses"))
     parser.add_argument(
         "--measure", action="store_true", help="also measure every defender against every attacker in the environment"
@@ -207,14 +207,16 @@ def main(argv: list[str] | None = None) -> int:
     print(text)
     args.out.mkdir(parents=True, exist_ok=True)
     path = args.out / "defenses_analytic.md"
-    path.write_text("# The defender's levers in closed form\n\nCommand: `python -m experiments.defenses`\n\n" + text + "\n")
+    path.write_text(
+        "# The defender's levers in closed form\n\nCommand: `python -m encctl_gym.experiments.defenses`\n\n" + text + "\n"
+    )
     print(f"  wrote {path}")
     if measured:
         table = format_measured(measured)
         print(table)
         path = args.out / "defenses_measured.md"
         path.write_text(
-            f"# The defences measured in the environment\n\nCommand: `python -m experiments.defenses --measure --episodes {args.episodes}`"
+            f"# The defences measured in the environment\n\nCommand: `python -m encctl_gym.experiments.defenses --measure --episodes {args.episodes}`"
             f" (seed {args.seed}; decipher_delay = 0, ideal backend, each system's own tau_c)\n\n" + table + "\n"
         )
         print(f"  wrote {path}")
