@@ -10,7 +10,7 @@ from gymnasium import spaces
 
 from .._validation import format_value
 from ..errors import ParameterError
-from ..loop import LoopBackend, make_defender, make_loop
+from ..loop import LoopBackend, defender_for, make_loop
 from .config import AttackParams, default_config, resolve_params
 from .episode import EpisodeCore, EpisodeSchedule, attack_design_for, check_episode_memory
 
@@ -197,7 +197,7 @@ class EncryptedLTIAttackEnv(gym.Env):
         self.render_mode = render_mode
         p = self.params
         check_episode_memory(p, 1, schedule)  # before anything is sized by the parameters
-        defender = make_defender(p.defender)
+        defender = defender_for(p)
         self._loop = make_loop(p, defender)  # refuses a loop it cannot build (the quantisation table) before the spaces are sized
         self.action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
         self.observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
