@@ -42,8 +42,8 @@ from ..security.deciphering import (
 )
 from ..security.design import design_from_traces
 from ..security.exact import decimal_fraction
-from ..security.rotation import check_rotation_period, rotated_affordable_samples, rotated_deciphering_time
 from ..security.gramians import controllability_gramian, noise_gramian
+from ..security.rotation import check_rotation_period, rotated_affordable_samples, rotated_deciphering_time
 from ..units import parse_duration
 from .layout import ObservationLayout
 from .rewards import REWARDS as _REWARD_CLASSES

@@ -33,8 +33,8 @@ from .defender import DEFENDERS, DefenderAction, DefenderPolicy, FixedDefender, 
 from .defenses import AuditDefender, DetectorDefender, NoiseDefender  # registers "noise", "audit", "chi2"
 from .elgamal import ElGamalLoop
 from .ideal import IdealLoop
-from .rotation import RotatingDefender, defender_for  # registers "rotate"
 from .quantize import Quantization
+from .rotation import RotatingDefender, defender_for  # registers "rotate"
 
 __all__ = [
     "LoopBackend",
