@@ -22,7 +22,8 @@ from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ParameterError
 from encctl_gym.loop import DefenderAction, RotatingDefender
 from encctl_gym.loop.elgamal import party_random_sources
-from encctl_gym.loop.rotation import GroupDecipherers, GroupPool
+from encctl_gym.loop.provisioning import GroupDecipherers
+from encctl_gym.loop.rotation import GroupPool
 from encctl_gym.security.cost_models import KeyBreakCost
 from encctl_gym.security.defenses import rotated_deciphering_operations
 from encctl_gym.security.exact import decimal_fraction

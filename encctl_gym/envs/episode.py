@@ -52,7 +52,8 @@ from ..ident.compiled import OnlineKernels, ProvidesKernels
 from ..ident.registry import make_estimator
 from ..loop import LoopBackend
 from ..loop.defender import DefenderPolicy, DefenderStreams, PlantView, check_defender_action, make_defender
-from ..loop.rotation import RotationRecord, check_new_group, defender_for, rotation_info
+from ..loop.provisioning import RotationRecord
+from ..loop.rotation import check_new_group, defender_for, rotation_info
 from ..resources import check_memory
 from . import _kernels as kern
 from .config import AttackParams

@@ -115,8 +115,8 @@ class ElGamalLoop:
     def rotate_group(self, group: Any) -> Any:
         """Move to a fresh ``group`` (group rotation): KeyGen in it, the server re-provisioned, the
         adversary's breaker on the new group; returns the
-        :class:`~encctl_gym.loop.rotation.ProvisioningCost` (:func:`~encctl_gym.loop.rotation.rotate_elgamal_loop`)."""
-        from .rotation import rotate_elgamal_loop
+        :class:`~encctl_gym.loop.provisioning.ProvisioningCost` (:func:`~encctl_gym.loop.provisioning.rotate_elgamal_loop`)."""
+        from .provisioning import rotate_elgamal_loop
 
         return rotate_elgamal_loop(self, group)
 

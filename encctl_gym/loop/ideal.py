@@ -98,11 +98,11 @@ class IdealLoop:
 
     def rotate_group(self, group: Any) -> Any:
         """Move to a fresh ``group`` (group rotation): its quantisation (:meth:`use_group`); returns
-        the :class:`~encctl_gym.loop.rotation.ProvisioningCost` the ElGamal loop has, counted
-        (``n m`` encryptions of ``Ecd(Phi)``, :func:`~encctl_gym.loop.rotation.provisioning_bytes`)."""
+        the :class:`~encctl_gym.loop.provisioning.ProvisioningCost` the ElGamal loop has, counted
+        (``n m`` encryptions of ``Ecd(Phi)``, :func:`~encctl_gym.loop.provisioning.provisioning_bytes`)."""
         import time
 
-        from .rotation import ProvisioningCost, provisioning_bytes
+        from .provisioning import ProvisioningCost, provisioning_bytes
 
         t0 = time.perf_counter()
         self.use_group(group)
