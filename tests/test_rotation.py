@@ -250,3 +250,22 @@ def test_a_bad_new_group_is_refused_naming_it(group, text):
     env.reset(seed=0)
     with pytest.raises(ParameterError, match=text):
         env.step(np.zeros(env.action_space.shape, dtype=np.float32))
+
+
+@pytest.mark.parametrize("K", [1, 10, 100, 13159])
+def test_the_rotated_key_length_is_the_smallest_whose_groups_cost_more_than_the_budget(K):
+    from encctl_gym.security.cost_models import PaperModel, PrecomputationModel
+    from encctl_gym.security.rotation import rotated_minimum_key_length
+
+    budget = Fraction(442 * 10**15) * Fraction(315_360_000)  # the design example: Upsilon tau_c
+    model, N = PrecomputationModel(), 13159
+    k = rotated_minimum_key_length(model, N, K, budget)
+
+    def work(bits):  # by hand: ceil(N / K) precomputations and N per-key descents
+        c = model.break_cost(bits)
+        return -(-N // K) * c.precomputation + N * c.next
+
+    assert work(k) > budget >= work(k - 1)
+    if K >= N:
+        assert k == model.minimum_key_length(N, budget)  # one group: the fixed-group design
+    assert rotated_minimum_key_length(PaperModel(), N, K, budget) == PaperModel().minimum_key_length(N, budget)

@@ -18,12 +18,15 @@ rotation charges it per group:
 
 :func:`rotated_deciphering_time` is ``tau(N)`` (seconds), :func:`rotated_affordable_samples` the
 largest ``N`` with ``tau(N) <= tau_c``, exactly (rational arithmetic, as
-:func:`~encctl_gym.security.deciphering.max_affordable_samples`).
+:func:`~encctl_gym.security.deciphering.max_affordable_samples`), and
+:func:`rotated_minimum_key_length` the smallest key length whose ``N*`` samples cost more than
+``Upsilon tau_c`` under rotation (eq:opt_key charged per group).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from fractions import Fraction
 from typing import Any
 
@@ -31,12 +34,18 @@ import numpy as np
 
 from .._validation import as_finite_array, check_int, format_value
 from ..errors import ParameterError
-from .cost_models import KeyBreakCost
+from .cost_models import CostModel, KeyBreakCost, PaperModel
 from .deciphering import independent_keys, sample_deciphering_time
 from .defenses import rotated_deciphering_operations, rotation_precomputations
 from .exact import decimal_fraction
 
-__all__ = ["check_rotation_period", "rotated_operations", "rotated_deciphering_time", "rotated_affordable_samples"]
+__all__ = [
+    "check_rotation_period",
+    "rotated_operations",
+    "rotated_deciphering_time",
+    "rotated_affordable_samples",
+    "rotated_minimum_key_length",
+]
 
 
 def check_rotation_period(every: Any, name: str = "rotate_group_every") -> int:
@@ -110,3 +119,48 @@ def rotated_affordable_samples(
     rest = budget - q * block
     r = 0 if rest < first else 1 + math.floor((rest - first) / nxt)
     return q * K + r
+
+
+class _GroupCharged(CostModel):
+    """``base`` with the work of ``groups`` groups carried by the first key, so that the shared
+    key-length search of :class:`CostModel` sees, exactly (rational), ``operations(keys) =
+    groups (first - next) + keys next`` (independent keys) or ``operations(1) = groups first``
+    (one break per group, ``whole_groups``)."""
+
+    def __init__(self, base: CostModel, groups: int, whole_groups: bool) -> None:
+        self.base, self.groups, self.whole_groups = base, groups, whole_groups
+        self.name, self.key_length_range = base.name, base.key_length_range
+
+    def break_cost(self, key_length: int) -> KeyBreakCost:
+        c = self.base.break_cost(key_length)
+        first = self.groups * c.first if self.whole_groups else c.first + (self.groups - 1) * (c.first - c.next)
+        return replace(c, first=first)
+
+    def describe(self) -> dict[str, Any]:
+        return {**self.base.describe(), "groups": self.groups}
+
+
+def rotated_minimum_key_length(
+    model: CostModel, N_star: Any, every: Any, budget: Fraction, *, scheme: str = "modified", adversary: str = "eavesdropper"
+) -> int:
+    """The smallest key length ``k`` whose ``N*`` samples, in groups of ``K = every``, cost more than
+    ``budget`` (``Upsilon tau_c``) operations under ``model`` (eq:opt_key with the work of the
+    module docstring).
+
+    The paper's model charges every key alike, so rotation leaves its design with independent
+    keys (the integer ``lambda*`` of Theorem thm:opt_sec, then eq:opt_key) unchanged; every other
+    model is searched with its first key carrying the ``ceil(N* / K) - 1`` further
+    precomputations (exact, in fractions). With one break per group (static keys; the token
+    scheme against a malicious server) the ``ceil(N* / K)`` groups cost one first key each.
+
+    Raises
+    ------
+    ModelRangeError
+        If the answer lies outside the model's key-length range.
+    """
+    N_star = check_int("N_star", N_star, minimum=1)
+    groups = rotation_precomputations(N_star, check_rotation_period(every))
+    whole = not independent_keys(scheme, adversary)
+    if isinstance(model, PaperModel):  # every key 2^lambda: the paper's two steps for the keys to break
+        return model.minimum_key_length(groups if whole else N_star, budget)
+    return _GroupCharged(model, groups, whole).minimum_key_length(1 if whole else N_star, budget)
