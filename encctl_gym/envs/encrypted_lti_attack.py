@@ -166,6 +166,8 @@ class EncryptedLTIAttackEnv(gym.Env):
     | ``samples_collected``, ``samples_delivered`` | N paid for, N delivered                 |
     | ``deciphering_time``| seconds of attacker computation spent (Definition def:sdt)       |
     | ``input_energy``, ``average_power`` | energy spent, and per input channel and step     |
+    | ``detected``        | the defender stopped the attack (:mod:`encctl_gym.loop.defenses`) |
+    | ``groups``, ``group_rotations``, ... | with group rotation only (``rotate_group_every``): the groups used, the encryptions and bytes re-provisioned, the group generation and wait seconds, and with a breaker its precomputations (:func:`encctl_gym.loop.rotation.rotation_info`) |
 
     **Privileged**: ``epsilon``, ``gamma`` and ``gamma_opt`` are functions of the true plant
     ``(A, B)`` (``epsilon`` from the start: at reset it is ``||[A B]||_F^2 / (n (n + m))``,
