@@ -269,3 +269,35 @@ def test_the_rotated_key_length_is_the_smallest_whose_groups_cost_more_than_the_
     if K >= N:
         assert k == model.minimum_key_length(N, budget)  # one group: the fixed-group design
     assert rotated_minimum_key_length(PaperModel(), N, K, budget) == PaperModel().minimum_key_length(N, budget)
+
+
+def test_an_audit_composed_with_rotation_follows_the_encoding_of_each_new_group():
+    """The honest controller, audited at every step across rotations, never alarms: the audit's
+    error bound takes every new group's largest shift."""
+    from encctl_gym.crypto.residue_table import residue_table
+    from encctl_gym.loop import make_loop
+    from encctl_gym.loop.backend import table_limit
+    from encctl_gym.loop.defender import PlantView
+    from encctl_gym.loop.defenses import AuditDefender
+
+    p = resolve_params({**BASE, "max_samples": 40})
+    d = RotatingDefender(every=3, inner=AuditDefender(rate=1.0))
+    loop = make_loop(p, d)
+    K, T = 20, 30
+    rng = np.random.default_rng(3)
+    x, U = np.zeros((K, p.n)), np.zeros((T, K, p.m))
+    step = {"k": 0}
+    view = PlantView(x, U, lambda: step["k"])
+    d.reset(K, p.n, p.m, [np.random.default_rng(i) for i in range(K)])
+    moves = 0
+    for k in range(T):
+        step["k"] = k
+        x[...] = rng.uniform(-5, 5, size=(K, p.n))
+        action = d.act(view)
+        assert action is None or not action.end
+        if action is not None and action.new_group is not None:
+            loop.rotate_group(action.new_group)
+            moves += 1
+            assert d.inner.max_shift == residue_table(loop.group, table_limit(p, loop.Phi)).max_shift
+        U[k] = loop.control(x)
+    assert moves == T // 3 and d.inner.audits == K * (T - 1)

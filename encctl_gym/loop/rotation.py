@@ -185,7 +185,8 @@ class RotatingDefender:
         so samples ``x_{jK} .. x_{(j+1)K - 1}`` lie in group ``j``.
     inner : defender spec, optional
         Another policy composed with the rotation (its noise and alarm pass through; it picks
-        the first group): a name of ``DEFENDERS``, a mapping or a policy object. Default ``"fixed"``.
+        the first group, and its ``on_new_group(group)``, if it has one, is called at every move):
+        a name of ``DEFENDERS``, a mapping or a policy object. Default ``"fixed"``.
     ahead : int, default 2
         Groups the pool generates ahead.
     """
@@ -239,6 +240,9 @@ class RotatingDefender:
         t.model_seconds += self.pool.model_seconds
         t.waited += waited
         self._next += 1
+        hook = getattr(self.inner, "on_new_group", None)
+        if hook is not None:  # e.g. the audit's error bound follows the new group's encoding
+            hook(group)
         if action is None:
             return DefenderAction(new_group=group)
         return DefenderAction(input_noise=action.input_noise, end=action.end, new_group=group)
