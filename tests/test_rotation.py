@@ -301,3 +301,19 @@ def test_an_audit_composed_with_rotation_follows_the_encoding_of_each_new_group(
             assert d.inner.max_shift == residue_table(loop.group, table_limit(p, loop.Phi)).max_shift
         U[k] = loop.control(x)
     assert moves == T // 3 and d.inner.audits == K * (T - 1)
+
+
+def test_the_measured_clock_charges_every_group_s_precomputation():
+    env = make(crypto="elgamal", breaker="index-calculus", deciphering_clock="measured", rotate_group_every=5, max_samples=10)
+    _, info = rollout(env)
+    dec = env.unwrapped.episode.loop.decipherer
+    pre = [c.seconds for m, c in dec.costs if m == "precomputation"]
+    assert len(pre) == info["breaker_precomputations"] == 2
+    assert info["deciphering_time"] == pytest.approx(dec.seconds) and dec.seconds >= sum(pre)
+
+
+def test_the_generic_model_is_unchanged_by_rotation():
+    kw = dict(preset="paper-example", key_length=64, deciphering_model="generic", max_samples=50)
+    plain, rotated = resolve_params(**kw), resolve_params(**kw, rotate_group_every=7)
+    Ns = np.arange(51)
+    assert np.array_equal(plain.deciphering_time(Ns), rotated.deciphering_time(Ns))
