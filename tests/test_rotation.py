@@ -317,3 +317,16 @@ def test_the_generic_model_is_unchanged_by_rotation():
     plain, rotated = resolve_params(**kw), resolve_params(**kw, rotate_group_every=7)
     Ns = np.arange(51)
     assert np.array_equal(plain.deciphering_time(Ns), rotated.deciphering_time(Ns))
+
+
+@pytest.mark.slow
+def test_the_rotation_table_counts_one_precomputation_per_group():
+    from experiments.defenses import format_rotation, rotation_rows
+
+    rows = rotation_rows(samples=12, seed=1)
+    ks = [r["k_star_precomputation"] for r in rows["design"]]
+    assert ks == sorted(ks) and len(set(r["k_star_paper"] for r in rows["design"])) == 1  # paper model: unchanged
+    for r in rows["measured"]:
+        assert r["precomputations"] == r["groups"] == r["groups_expected"] == -(-12 // r["K"])
+        assert r["encryptions"] == (r["groups"] - 1) * 16
+    assert format_rotation(rows).count("\n") == 2 + 4 + 1 + 2 + 4 - 1
