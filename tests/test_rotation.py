@@ -330,3 +330,17 @@ def test_the_rotation_table_counts_one_precomputation_per_group():
         assert r["precomputations"] == r["groups"] == r["groups_expected"] == -(-12 // r["K"])
         assert r["encryptions"] == (r["groups"] - 1) * 16
     assert format_rotation(rows).count("\n") == 2 + 4 + 1 + 2 + 4 - 1
+
+
+def test_a_copied_rotating_episode_runs_on_as_the_original():
+    env = make(crypto="ideal", rotate_group_every=3)
+    env.reset(seed=4)
+    a = np.full(env.action_space.shape, 0.3, dtype=np.float32)
+    for _ in range(4):
+        env.step(a)
+    twin = copy.deepcopy(env)
+    for _ in range(5):
+        o1, r1, *_, i1 = env.step(a)
+        o2, r2, *_, i2 = twin.step(a)
+        assert o1.tobytes() == o2.tobytes() and i1["groups"] == i2["groups"]  # the loop and its groups
+    assert twin.unwrapped.episode.loop.group == env.unwrapped.episode.loop.group
