@@ -53,7 +53,7 @@ from ..ident.registry import make_estimator
 from ..loop import LoopBackend
 from ..loop.defender import DefenderPolicy, DefenderStreams, PlantView, check_defender_action, make_defender
 from ..loop.provisioning import RotationRecord
-from ..loop.rotation import check_new_group, defender_for, rotation_info
+from ..loop.rotation import check_new_group, defender_for, move_loop, rotation_info
 from ..resources import check_memory
 from . import _kernels as kern
 from .config import AttackParams
@@ -403,7 +403,7 @@ class EpisodeCore:
         self._noise_ahead = False
         self._chunks = 0
         if getattr(self.loop, "group", None) is not self._first_group:  # back to the first group (rotation)
-            self._move_loop(self._first_group)
+            move_loop(self.loop, self.stepper, self._first_group)
         self.rotation = RotationRecord()
         self.loop.start_episode()
         for _ in range(self.p.warmup_steps):  # normal operation under the encrypted controller (eq:ec)
@@ -596,18 +596,8 @@ class EpisodeCore:
                 self.stopped = ended = True
             if decision.new_group is not None:  # group rotation: the period runs in the new group
                 group = check_new_group(decision.new_group, getattr(self.loop, "group", None))
-                self.rotation.add(self._move_loop(group))
+                self.rotation.add(move_loop(self.loop, self.stepper, group))
         return self.stepper.step(act, w, ended)
-
-    def _move_loop(self, group: Any) -> Any:
-        """The loop moves to ``group`` (its ``rotate_group``); a compiled step takes the new quantisation."""
-        rotate = getattr(self.loop, "rotate_group", None)
-        if rotate is None:
-            raise ParameterError(f"the {self.p.crypto} backend cannot move to another group (it has no rotate_group)")
-        cost = rotate(group)
-        if hasattr(self.stepper, "quant") and self.loop.quantization is not None:
-            self.stepper.quant = tuple(self.loop.quantization)
-        return cost
 
     def _attack_step(self) -> int:
         """The attack step about to run (0 at the first): its input goes to ``U[collected - 1]``."""

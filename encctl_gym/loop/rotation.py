@@ -46,7 +46,7 @@ from ..security.rotation import check_rotation_period
 from .defender import DEFENDERS, DefenderAction, DefenderPolicy, PlantView, make_defender
 from .provisioning import GroupDecipherers, RotationRecord
 
-__all__ = ["GroupPool", "GenerationTally", "RotatingDefender", "defender_for", "check_new_group", "rotation_info"]
+__all__ = ["GroupPool", "GenerationTally", "RotatingDefender", "defender_for", "check_new_group", "move_loop", "rotation_info"]
 
 
 def _generate(bits: int, seed: int, max_seconds: float) -> tuple[GroupParams, float]:
@@ -290,6 +290,25 @@ def check_new_group(group: Any, current: Any) -> GroupParams:
             f"DefenderAction.new_group must have the loop's size, {current.bits} bits, got a group of {group.bits} bits"
         )
     return group.verify()
+
+
+def move_loop(loop: Any, stepper: Any, group: Any) -> Any:
+    """The episode's move of ``loop`` to ``group`` (its ``rotate_group``; returns the
+    :class:`~encctl_gym.loop.provisioning.ProvisioningCost`); a compiled ``stepper`` takes the new
+    quantisation.
+
+    Raises
+    ------
+    ParameterError
+        For a backend without ``rotate_group``.
+    """
+    rotate = getattr(loop, "rotate_group", None)
+    if rotate is None:
+        raise ParameterError(f"the {type(loop).__name__} backend cannot move to another group (it has no rotate_group)")
+    cost = rotate(group)
+    if hasattr(stepper, "quant") and loop.quantization is not None:
+        stepper.quant = tuple(loop.quantization)
+    return cost
 
 
 def rotation_info(record: RotationRecord, defender: Any, loop: Any, breaker: bool) -> dict[str, Any]:
