@@ -43,6 +43,7 @@ from ..security.deciphering import (
 from ..security.design import design_from_traces
 from ..security.exact import decimal_fraction
 from ..security.gramians import controllability_gramian, noise_gramian
+from ..security.rotation import check_rotation_period, rotated_affordable_samples, rotated_deciphering_time
 from ..units import parse_duration
 from .layout import ObservationLayout
 from .rewards import REWARDS as _REWARD_CLASSES
@@ -127,6 +128,11 @@ def default_config() -> dict[str, Any]:
     ``defender``                  the plant side's policy (:mod:`encctl_gym.loop.defender`): a
                                   name of ``DEFENDERS`` (``"fixed"``: the paper's fixed defender)
                                   or an object implementing ``DefenderPolicy``
+    ``rotate_group_every``        ``None`` (one group) or ``K >= 1``: every K attack steps the
+                                  plant side moves to a fresh safe-prime group of the same size
+                                  and re-provisions the server (:mod:`encctl_gym.loop.rotation`);
+                                  the attacker pays each group's precomputation
+                                  (:mod:`encctl_gym.security.rotation`)
     ============================  ==============================================================
     """
     return {
@@ -162,6 +168,7 @@ def default_config() -> dict[str, Any]:
         "gamma_opt": True,
         "crypto_seed": None,
         "defender": "fixed",
+        "rotate_group_every": None,
     }
 
 
@@ -210,6 +217,7 @@ class AttackParams:
     sources: dict[str, str] = field(default_factory=dict)  # where A, B, the variances and design values came from
     defender: Any = "fixed"  # the defender policy specification (a name or a policy object), checked
     horizon_capped: bool = False  # no max_samples and a budget beyond MAX_DEFAULT_HORIZON: N is that cap
+    rotate_group_every: int | None = None  # K: a fresh group every K attack steps (None: one group)
 
     def warn_if_capped(self) -> None:
         """Warn (once per environment, when it is made) that the attack length is the default cap
@@ -232,7 +240,13 @@ class AttackParams:
         return int(self.B.shape[1])
 
     def deciphering_time(self, N: Any) -> Any:
-        """tau(N) of the configured model (Definition def:sdt, :func:`sample_deciphering_time`), seconds."""
+        """tau(N) of the configured model (Definition def:sdt, :func:`sample_deciphering_time`), seconds;
+        with ``rotate_group_every`` the model charged per group
+        (:func:`~encctl_gym.security.rotation.rotated_deciphering_time`)."""
+        if self.rotate_group_every is not None:
+            return rotated_deciphering_time(
+                N, self.cost, self.upsilon, self.rotate_group_every, scheme=self.scheme, adversary=self.adversary
+            )
         return sample_deciphering_time(N, self.cost, self.upsilon, scheme=self.scheme, adversary=self.adversary)
 
     @property
@@ -445,7 +459,12 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         key_length = paper.key_length_for_security_parameter(lam)  # eq:opt_key
         cost = paper.cost_of_security_parameter(lam) if model_name == "paper" else model.break_cost(key_length)
 
-    budget = max_affordable_samples(tau_c, cost, upsilon, scheme=scheme, adversary=adversary)
+    rotate_every = cfg["rotate_group_every"]
+    if rotate_every is not None:  # every group's keys are charged (security.rotation)
+        rotate_every = check_rotation_period(rotate_every)
+        budget: int | float = rotated_affordable_samples(tau_c, cost, upsilon, rotate_every, scheme=scheme, adversary=adversary)
+    else:
+        budget = max_affordable_samples(tau_c, cost, upsilon, scheme=scheme, adversary=adversary)
     max_samples = cfg["max_samples"]
     if max_samples is not None:
         max_samples = check_int("max_samples", max_samples, minimum=1)
@@ -546,4 +565,5 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         sources=sources,
         defender=defender,
         horizon_capped=max_samples is None and horizon < budget,
+        rotate_group_every=rotate_every,
     )

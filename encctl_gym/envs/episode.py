@@ -52,6 +52,8 @@ from ..ident.compiled import OnlineKernels, ProvidesKernels
 from ..ident.registry import make_estimator
 from ..loop import LoopBackend
 from ..loop.defender import DefenderPolicy, DefenderStreams, PlantView, check_defender_action, make_defender
+from ..loop.provisioning import RotationRecord
+from ..loop.rotation import check_new_group, defender_for, move_loop, rotation_info
 from ..resources import check_memory
 from . import _kernels as kern
 from .config import AttackParams
@@ -274,9 +276,12 @@ class EpisodeCore:
         fused = q is not None and self.reward.fused and self.kernels is not None and self.kernels.fused
         self.stepper: StepStrategy = choose_step(self, q, fused, parallel)
         # the other party: the plant side's decisions, each step, on what the plant knows
-        self.defender = make_defender(p.defender) if defender is None else make_defender(defender)
+        self.defender = defender_for(p) if defender is None else make_defender(defender)
         self.plant_view = PlantView(s.x, s.U, self._attack_step)
         self.stopped = False  # the defender ended the attack
+        #: the group rotations of the episode (loop.rotation): every episode starts on the loop's first group
+        self.rotation = RotationRecord()
+        self._first_group = getattr(loop, "group", None)
         C = sch.chunk
         self._noise_draws = np.zeros((K, C, n))  # each copy's chunk, as its generator draws it
         self._noise = np.zeros((C, K, n))  # period-major, like X: one period's noise is contiguous
@@ -397,6 +402,9 @@ class EpisodeCore:
         self._noise_pos = self.schedule.chunk
         self._noise_ahead = False
         self._chunks = 0
+        if getattr(self.loop, "group", None) is not self._first_group:  # back to the first group (rotation)
+            move_loop(self.loop, self.stepper, self._first_group)
+        self.rotation = RotationRecord()
         self.loop.start_episode()
         for _ in range(self.p.warmup_steps):  # normal operation under the encrypted controller (eq:ec)
             kern.plant_step(self._dims, self.state.x, self.loop.control(self.state.x), self._draw_noise(), self._A, self._B)
@@ -586,6 +594,9 @@ class EpisodeCore:
                 w = w + noise @ self.consts.B.T
             if stop:
                 self.stopped = ended = True
+            if decision.new_group is not None:  # group rotation: the period runs in the new group
+                group = check_new_group(decision.new_group, getattr(self.loop, "group", None))
+                self.rotation.add(move_loop(self.loop, self.stepper, group))
         return self.stepper.step(act, w, ended)
 
     def _attack_step(self) -> int:
@@ -640,7 +651,13 @@ class EpisodeCore:
 
     def info_arrays(self) -> dict[str, np.ndarray]:
         """Info of every copy as new arrays of shape (K,) (:func:`~encctl_gym.envs.layout.info_dict`)."""
-        return info_dict(self.eps.copy(), self.state.energy.copy(), self._shared_info(), self.has_gamma_opt, self.K, self.stopped)
+        info = info_dict(self.eps.copy(), self.state.energy.copy(), self._shared_info(), self.has_gamma_opt, self.K, self.stopped)
+        for key, value in self._rotation_info().items():
+            info[key] = np.full(self.K, value)
+        return info
+
+    def _rotation_info(self) -> dict[str, Any]:
+        return rotation_info(self.rotation, self.defender, self.loop, self.p.breaker is not None)
 
     def info(self) -> dict[str, Any]:
         """Info of copy 0 as Python scalars (single environment).
@@ -648,6 +665,8 @@ class EpisodeCore:
         ``epsilon`` is the error (Definition def:error) of the attacker's current estimate: the
         least squares estimate once ``n + m`` columns are delivered, ``[A B] = 0`` before.
         """
-        return info_dict(
+        info = info_dict(
             float(self.eps[0]), float(self.state.energy[0]), self._shared_info(), self.has_gamma_opt, detected=self.stopped
         )
+        info.update(self._rotation_info())
+        return info

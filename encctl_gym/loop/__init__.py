@@ -10,7 +10,8 @@ Backends implement :class:`~encctl_gym.loop.backend.LoopBackend` and are picked 
   ciphertexts, one copy.
 
 The defender policies with real levers (input noise, audits, a chi-squared detector) are in
-:mod:`encctl_gym.loop.defenses`.
+:mod:`encctl_gym.loop.defenses`; group rotation (a fresh group every K steps) in
+:mod:`encctl_gym.loop.rotation`.
 
 Both use the group the defender picks (:mod:`encctl_gym.loop.defender`; by default that of
 :func:`~encctl_gym.loop.backend.loop_group` for the key length), so their trajectories agree
@@ -33,6 +34,7 @@ from .defenses import AuditDefender, DetectorDefender, NoiseDefender  # register
 from .elgamal import ElGamalLoop
 from .ideal import IdealLoop
 from .quantize import Quantization
+from .rotation import RotatingDefender, defender_for  # registers "rotate"
 
 __all__ = [
     "LoopBackend",
@@ -53,6 +55,8 @@ __all__ = [
     "DetectorDefender",
     "PlantView",
     "make_defender",
+    "RotatingDefender",
+    "defender_for",
 ]
 
 #: Backends by the name the environment's ``crypto`` key gives.

@@ -11,8 +11,9 @@ sees and what noise it adds to its own actuator input. A :class:`DefenderPolicy`
 * :meth:`DefenderPolicy.act`, at every attack step before the period runs, with a
   :class:`PlantView` of what the plant side knows (its state, the inputs it decoded). It returns
   ``None`` (nothing to do) or a :class:`DefenderAction`: noise added to the input the plant
-  applies this period, and whether the plant side stops the attack (the episode then ends,
-  ``terminated``, with every paid sample delivered).
+  applies this period, whether the plant side stops the attack (the episode then ends,
+  ``terminated``, with every paid sample delivered), and a fresh group to move the loop to
+  (group rotation, :mod:`encctl_gym.loop.rotation`).
 
 Policies are picked by the environment's ``defender`` key: a name of :data:`DEFENDERS` or an
 object that implements the protocol. The default, :class:`FixedDefender` (``"fixed"``), is the
@@ -60,10 +61,15 @@ class DefenderAction:
     end : bool
         The plant side stops the attack now: the episode ends this step (``terminated``) for
         every copy (the copies of a batch run in lockstep).
+    new_group : GroupParams, optional
+        Move the loop to this safe-prime group (of the loop's size) before the period: KeyGen in
+        it and the server re-provisioned (group rotation, :mod:`encctl_gym.loop.rotation`; the
+        backend's ``rotate_group``).
     """
 
     input_noise: Any = None
     end: bool = False
+    new_group: Any = None
 
 
 class PlantView:

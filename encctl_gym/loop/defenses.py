@@ -63,8 +63,14 @@ class _PlantSidePolicy:
         self.delta = float(params.delta)
         self.sigma_w2 = float(params.sigma_w2)
         group = loop_group(params.key_length)
-        self.max_shift = residue_table(group, table_limit(params, self.Phi)).max_shift  # cached: the loop's own table
+        self._limit = table_limit(params, self.Phi)
+        self.max_shift = residue_table(group, self._limit).max_shift  # cached: the loop's own table
         return group
+
+    def on_new_group(self, group: Any) -> None:
+        """The loop moved to ``group`` (group rotation, :mod:`encctl_gym.loop.rotation`): the
+        encoding's error bound takes that group's largest shift."""
+        self.max_shift = residue_table(group, self._limit).max_shift
 
     def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
         self.K, self.rngs = K, rngs

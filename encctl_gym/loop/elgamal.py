@@ -102,11 +102,23 @@ class ElGamalLoop:
 
     def start_episode(self) -> None:
         """Fresh keys (KeyGen) and Phi encrypted under ``pk_0``; the server of the scheme is set up."""
+        self.provision()
+        self.decipherer.start_episode()
+
+    def provision(self) -> None:
+        """KeyGen in the loop's group and the server of the scheme set up with ``Enc(pk_0, Ecd(Phi))``."""
         from ..crypto.quantized import QuantizedLinearController
 
         quant = QuantizedLinearController(self.Phi, self.encoder, self.params.x_bound)
         self.plant, self.server = self._scheme.parties(quant, self.random_sources["plant"], self.random_sources["server"])
-        self.decipherer.start_episode()
+
+    def rotate_group(self, group: Any) -> Any:
+        """Move to a fresh ``group`` (group rotation): KeyGen in it, the server re-provisioned, the
+        adversary's breaker on the new group; returns the
+        :class:`~encctl_gym.loop.provisioning.ProvisioningCost` (:func:`~encctl_gym.loop.provisioning.rotate_elgamal_loop`)."""
+        from .provisioning import rotate_elgamal_loop
+
+        return rotate_elgamal_loop(self, group)
 
     @staticmethod
     def _single(v: np.ndarray) -> np.ndarray:
