@@ -242,8 +242,7 @@ class EpisodeCore:
         # regressor Gram matrix G of the delivered data and cross term C = sum z x_next^T, kept
         # as [G | C] with the copies innermost (see _kernels); G and C are views of it, (K, d, .)
         self._GC = np.zeros((self.d * (self.d + n), K))
-        gc = self._GC.reshape(self.d, self.d + n, K).transpose(2, 0, 1)
-        self.G, self.C = gc[:, :, : self.d], gc[:, :, self.d :]
+        self.G, self.C = self._gram_views()
         self._gram_scratch = np.zeros((self.d + n, K))  # add_gram's, apart from the step's (the helper runs it)
         self._gram_upto = 1  # G and C hold the columns j < _gram_upto (the fused step lets them lag)
         self._dims = kern.dims(n, m, p.input_history * m)  # the sizes, as the kernels take them
@@ -320,10 +319,23 @@ class EpisodeCore:
         self._wait_noise()
         self._wait_gram()
 
+    def _gram_views(self) -> tuple[np.ndarray, np.ndarray]:
+        """G and C as views of ``[G | C]`` (``_GC``), shape (K, d, d) and (K, d, n)."""
+        gc = self._GC.reshape(self.d, self.d + self.n, self.K).transpose(2, 0, 1)
+        return gc[:, :, : self.d], gc[:, :, self.d :]
+
     def __getstate__(self) -> dict[str, Any]:
-        """Pickling and deep copies see the helper's work finished (a future cannot be copied)."""
+        """Pickling and deep copies see the helper's work finished (a future cannot be copied).
+        The views G and C are left out: a copy would make them arrays of their own, which the
+        kernels (writing ``_GC``) no longer update; :meth:`__setstate__` makes them again."""
         self.wait()
-        return self.__dict__.copy()
+        state = self.__dict__.copy()
+        del state["G"], state["C"]
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self.G, self.C = self._gram_views()
 
     # ----------------------------------------------------------------- randomness
     def _fill_noise(self, dst: np.ndarray, chunk: int) -> None:
