@@ -344,3 +344,12 @@ def test_a_copied_rotating_episode_runs_on_as_the_original():
         o2, r2, *_, i2 = twin.step(a)
         assert o1.tobytes() == o2.tobytes() and i1["groups"] == i2["groups"]  # the loop and its groups
     assert twin.unwrapped.episode.loop.group == env.unwrapped.episode.loop.group
+
+
+def test_closing_the_env_stops_the_group_pools_worker():
+    env = make(crypto="ideal", rotate_group_every=3)
+    rollout(env)
+    pool = env.unwrapped.episode.defender.pool
+    assert pool._executor is not None  # the worker ran ahead during the episode
+    env.close()
+    assert pool._executor is None

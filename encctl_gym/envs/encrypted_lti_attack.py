@@ -238,3 +238,8 @@ class EncryptedLTIAttackEnv(gym.Env):
         from .render import render_error_curve
 
         return render_error_curve(self._core, self.params, self.design)
+
+    def close(self) -> None:
+        """Release the episode's resources (a rotating defender's group pool, see :meth:`EpisodeCore.close`)."""
+        self._core.close()
+        super().close()

@@ -319,6 +319,14 @@ class EpisodeCore:
         self._wait_noise()
         self._wait_gram()
 
+    def close(self) -> None:
+        """The helper's work finished, and the defender's own resources released (its optional
+        ``close``, e.g. the rotating defender's group pool)."""
+        self.wait()
+        close = getattr(self.defender, "close", None)
+        if close is not None:
+            close()
+
     def _gram_views(self) -> tuple[np.ndarray, np.ndarray]:
         """G and C as views of ``[G | C]`` (``_GC``), shape (K, d, d) and (K, d, n)."""
         gc = self._GC.reshape(self.d, self.d + self.n, self.K).transpose(2, 0, 1)

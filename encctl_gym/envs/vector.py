@@ -154,6 +154,6 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         return self._core.observation(), reward, flags[0], flags[1], self._core.info_arrays()
 
     def close_extras(self, **kwargs: Any) -> None:
-        self._core.wait()
+        self._core.close()
         if self.helper is not None:
             self.helper.close()

@@ -247,6 +247,14 @@ class RotatingDefender:
             return DefenderAction(new_group=group)
         return DefenderAction(input_noise=action.input_noise, end=action.end, new_group=group)
 
+    def close(self) -> None:
+        """Stop the pool's worker (the environment's ``close``); the inner policy's too, if it has one."""
+        if self.pool is not None:
+            self.pool.close()
+        inner_close = getattr(self.inner, "close", None)
+        if inner_close is not None:
+            inner_close()
+
     def __repr__(self) -> str:
         return f"RotatingDefender(every={self.every!r}, inner={self.inner!r})"
 
