@@ -13,7 +13,9 @@ sees and what noise it adds to its own actuator input. A :class:`DefenderPolicy`
   ``None`` (nothing to do) or a :class:`DefenderAction`: noise added to the input the plant
   applies this period, whether the plant side stops the attack (the episode then ends,
   ``terminated``, with every paid sample delivered), and a fresh group to move the loop to
-  (group rotation, :mod:`encctl_gym.loop.rotation`).
+  (group rotation, :mod:`encctl_gym.loop.rotation`);
+* ``close()``, optional: called by the environment's ``close`` to release what the policy holds
+  (the rotating defender's group pool stops its worker).
 
 Policies are picked by the environment's ``defender`` key: a name of :data:`DEFENDERS` or an
 object that implements the protocol. The default, :class:`FixedDefender` (``"fixed"``), is the
