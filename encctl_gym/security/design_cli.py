@@ -45,8 +45,10 @@ from ..errors import ConfigError, ParameterError
 from ..plant_file import load_plant_file, load_system
 from ..presets import DESIGN_FIELDS, design_defaults, get_preset, preset_names
 from ..units import SECONDS_PER_UNIT, parse_duration
+from . import defense_cli
 from .attack_design import SDP_MAX_DIMENSION
 from .cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION, check_gnfs_correction
+from .defense_design import design_defenses
 from .records import load_records
 from .report import COMPLEXITIES, LABELS, design_report
 from .threat import ThreatModel
@@ -121,6 +123,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="records file (layout of security/data/deciphering_records.json) for the precomputation model's per-key ratio",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
+    defense_cli.add_arguments(parser)
 
 
 # --------------------------------------------------------------------------- option parsing
@@ -329,12 +332,27 @@ def run(args: argparse.Namespace) -> int:
         key_length=key_length,
         calibration=records,
     )
+    defense = defense_cli.defense_options(args)
+    if defense is not None:
+        res["defenses"] = design_defenses(
+            (A, B),
+            threat,
+            cost_models=models or tuple(DECIPHERING_MODELS),
+            gnfs_correction=correction,
+            calibration=records,
+            **defense,
+        )
     if args.json:
+        if "defenses" in res:
+            res["defenses"] = res["defenses"].to_dict()
         res["title"] = title
         res["sources"] = sources
         print(json.dumps(_sanitize(res), indent=2, allow_nan=False))
     else:
-        print(_format_table(res, title, sources_line))
+        text = _format_table(res, title, sources_line)
+        if "defenses" in res:
+            text += "\n" + "\n".join(defense_cli.format_defenses(res["defenses"]))
+        print(text)
     return 0
 
 
