@@ -2,8 +2,9 @@
 
 ``--rotate-every K|auto``, ``--audit-rate p|auto`` with ``--detection-delta``, ``--defense-noise S``
 and ``--min-key-length``: parsed here, designed by :func:`~.defense_design.design_defenses`, printed
-by :func:`format_defenses`. The design command (:mod:`.design_cli`) calls :func:`add_arguments`,
-:func:`defense_options` and :func:`format_defenses`; nothing is designed here.
+by :func:`format_defenses`. The design command (:mod:`encctl_gym.design_command`) registers
+:func:`add_arguments`; :mod:`.design_cli` calls :func:`defense_options` and :func:`format_defenses`;
+nothing is designed here.
 """
 
 from __future__ import annotations
@@ -57,7 +58,7 @@ def _number_or_auto(name: str, text: str | None) -> float | str | None:
 def defense_options(args: argparse.Namespace) -> dict[str, Any] | None:
     """The keyword arguments of :func:`~.defense_design.design_defenses` from the command line,
     or ``None`` when no defender option was given (values are checked by the design)."""
-    if all(getattr(args, dest) is None for dest in OPTIONS):
+    if all(getattr(args, dest, None) is None for dest in OPTIONS):
         return None
     rotate = _number_or_auto("rotate_every", args.rotate_every)
     out: dict[str, Any] = {

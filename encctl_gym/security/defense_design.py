@@ -31,7 +31,7 @@ reference machine (:class:`DefenderCosts`), is
   exponentiations (KeyGen, the ``n m`` encryptions ``Enc(pk_0', Ecd(Phi))`` and their fixed
   decryption parts), divided by ``K``;
 * the audits: ``p`` local control computations per step, each the measured time of the plant
-  side's own check (:func:`measure_local_control_seconds`);
+  side's own check (:func:`encctl_gym.loop.defense_costs.measure_local_control_seconds`);
 
 and, in the units of the quadratic cost, the control cost of the noise
 (:func:`~.defenses.noise_defense_price`; the noise is an input of the design, not searched, so
@@ -49,16 +49,12 @@ fixed group is the minimum over all ``K``.
 from __future__ import annotations
 
 import math
-import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from fractions import Fraction
 from typing import Any
 
-import numpy as np
-
 from .._validation import as_finite_array, check_int, check_nonnegative, check_positive, format_value
-from ..crypto.group import estimate_generation_seconds, modular_exponentiation_seconds
 from ..errors import ModelRangeError, ParameterError
 from ..plant import as_plant
 from .cost_models import GNFS_MIN_KEY_LENGTH, CostModel, paper_security_parameter
@@ -84,7 +80,6 @@ __all__ = [
     "check_detection_delta",
     "design_defenses",
     "largest_rotation_period",
-    "measure_local_control_seconds",
     "plant_exponentiations_per_step",
     "reprovision_exponentiations",
     "rotated_key_length",
@@ -107,57 +102,48 @@ def reprovision_exponentiations(n: int, m: int) -> int:
     return 1 + 3 * check_int("n", n, minimum=1) * check_int("m", m, minimum=1)
 
 
-def measure_local_control_seconds(n: int, m: int, repeats: int = 2000) -> float:
-    """The measured time of one audit: the plant side computes ``Phi x`` itself and compares it
-    with the decrypted input (:class:`encctl_gym.loop.detection.Audit` at rate 1, one loop).
-    The median over ``repeats`` calls, in seconds."""
-    from ..loop.detection import Audit  # the loop layer imports this package
-
-    n = check_int("n", n, minimum=1)
-    m = check_int("m", m, minimum=1)
-    repeats = check_int("repeats", repeats, minimum=1, maximum=10**7)
-    rng = np.random.default_rng(0)
-    Phi, x = rng.standard_normal((m, n)), rng.standard_normal((1, n))
-    audit = Audit(Phi, 1.0, [np.random.default_rng(1)], tolerance=1e-9)
-    u = x @ Phi.T
-    times = np.empty(repeats)
-    for i in range(repeats):
-        t0 = time.perf_counter()
-        audit.check(x, u)
-        times[i] = time.perf_counter() - t0
-    return float(np.median(times))
-
-
 @dataclass(frozen=True)
 class DefenderCosts:
-    """The defender's cost terms per step, in seconds on the reference machine (module docstring).
+    """The defender's cost terms per step, in seconds (module docstring).
+
+    The time models come from the layers that own them (this package is mathematics only):
+    :func:`encctl_gym.loop.defense_costs.reference_defender_costs` builds the reference machine's.
 
     Attributes
     ----------
     n, m : int
         State and input dimensions.
+    exponentiation_seconds : callable
+        ``k -> `` the time of one modular exponentiation at ``k`` bits.
+    group_generation_seconds : callable
+        ``k -> `` the expected time of a ``k``-bit safe-prime search.
     local_control_seconds : float
-        One audit (:func:`measure_local_control_seconds`).
+        One audit: ``Phi x`` computed on the plant side and compared.
     """
 
     n: int
     m: int
+    exponentiation_seconds: Callable[[int], float]
+    group_generation_seconds: Callable[[int], float]
     local_control_seconds: float
 
     def __post_init__(self) -> None:
         check_int("n", self.n, minimum=1)
         check_int("m", self.m, minimum=1)
         check_nonnegative("local_control_seconds", self.local_control_seconds)
+        for name in ("exponentiation_seconds", "group_generation_seconds"):
+            if not callable(getattr(self, name)):
+                raise ParameterError(f"{name} must be a function of the key length, got {format_value(getattr(self, name))}")
 
     def encrypted_step_seconds(self, key_length: int) -> float:
         """``(3 n + 1) t_pow(k)``: the plant side's encrypted step at ``k`` bits."""
-        return plant_exponentiations_per_step(self.n) * modular_exponentiation_seconds(key_length)
+        return plant_exponentiations_per_step(self.n) * float(self.exponentiation_seconds(key_length))
 
     def rotation_seconds(self, key_length: int) -> float:
         """A move to a fresh ``k``-bit group: the expected safe-prime search plus ``1 + 3 n m``
         exponentiations (not yet divided by ``K``)."""
-        t_pow = modular_exponentiation_seconds(key_length)
-        return estimate_generation_seconds(key_length) + reprovision_exponentiations(self.n, self.m) * t_pow
+        t_pow = float(self.exponentiation_seconds(key_length))
+        return float(self.group_generation_seconds(key_length)) + reprovision_exponentiations(self.n, self.m) * t_pow
 
     def audit_seconds(self, audit_rate: float) -> float:
         """``p`` local control computations per step."""
@@ -359,6 +345,8 @@ def design_defenses(
     plant: Any,
     threat: ThreatModel,
     *,
+    costs: DefenderCosts,
+    controller: Any,
     cost_models: Sequence[str] = ("paper", "precomputation", "generic"),
     rotate_every: int | str | None = None,
     audit_rate: float | str | None = None,
@@ -367,8 +355,6 @@ def design_defenses(
     gnfs_correction: Any = 0.0,
     calibration: RecordSet | None = None,
     min_key_length: int = DEFAULT_MIN_KEY_LENGTH,
-    local_control_seconds: float | None = None,
-    controller: Any = None,
 ) -> DefenseDesign:
     """The cheapest secure mix of the defender's levers per cost model (module docstring).
 
@@ -378,6 +364,10 @@ def design_defenses(
         The plant of eq:system.
     threat : ThreatModel
         With ``sigma_u2``, ``sigma_w2``, ``gamma_c``, ``tau_c``, ``upsilon`` (and the adversary).
+    costs : DefenderCosts
+        The cost terms (:func:`encctl_gym.loop.defense_costs.reference_defender_costs`).
+    controller : array_like, shape (m, n)
+        ``Phi``, for the noise's control cost (the loop's is ``-lqr_gain(A, B)``, ``Q = R = I``).
     cost_models : sequence of str
         Deciphering-cost models (:data:`~.cost_models.DECIPHERING_MODELS`).
     rotate_every : int, "auto" or None
@@ -394,11 +384,6 @@ def design_defenses(
         Records of the precomputation model.
     min_key_length : int, default :data:`DEFAULT_MIN_KEY_LENGTH`
         The key length of an audit-secure mix.
-    local_control_seconds : float, optional
-        One audit's time (default: :func:`measure_local_control_seconds`).
-    controller : array_like, shape (m, n), optional
-        ``Phi`` for the noise's control cost (default: the loop's LQR gain, ``Q = R = I``).
-
     Returns
     -------
     DefenseDesign
@@ -424,14 +409,10 @@ def design_defenses(
     N_star = noise_defense_design(p, t, sigma_d2=sd).N_star
     keys = keys_to_break(N_star, "modified", t.adversary)
     budget = defense_budget(t.tau_c, t.upsilon)
-    if controller is None:
-        from ..loop.backend import lqr_gain  # the loop layer imports this package
-
-        controller = -lqr_gain(p.A, p.B)
+    if not isinstance(costs, DefenderCosts) or (costs.n, costs.m) != (p.n, p.m):
+        raise ParameterError(f"costs must be DefenderCosts for n = {p.n}, m = {p.m}, got {format_value(costs)}")
     Phi = as_finite_array("controller", controller, ndim=2)
     price = noise_defense_price(p.A, p.B, Phi, sigma_w2=float(t.sigma_w2), sigma_d2=sd)
-    local = measure_local_control_seconds(p.n, p.m) if local_control_seconds is None else local_control_seconds
-    costs = DefenderCosts(p.n, p.m, check_nonnegative("local_control_seconds", local))
     p_star = minimum_audit_rate(N_star, delta)
     while undetected_probability(N_star, p_star) > delta:  # the closed form's last rounding step
         p_star = math.nextafter(p_star, 1.0)

@@ -36,6 +36,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -48,7 +49,7 @@ from ..units import SECONDS_PER_UNIT, parse_duration
 from . import defense_cli
 from .attack_design import SDP_MAX_DIMENSION
 from .cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION, check_gnfs_correction
-from .defense_design import design_defenses
+from .defense_design import DefenseDesign
 from .records import load_records
 from .report import COMPLEXITIES, LABELS, design_report
 from .threat import ThreatModel
@@ -123,7 +124,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="records file (layout of security/data/deciphering_records.json) for the precomputation model's per-key ratio",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
-    defense_cli.add_arguments(parser)
 
 
 # --------------------------------------------------------------------------- option parsing
@@ -269,8 +269,10 @@ def _format_table(res: dict[str, Any], title: str, sources: str | None = None) -
 
 
 # --------------------------------------------------------------------------- the command
-def run(args: argparse.Namespace) -> int:
-    """Run ``encctl-gym design``: print the tables (or JSON); return 0."""
+def run(args: argparse.Namespace, defenses: Callable[..., DefenseDesign] | None = None) -> int:
+    """Run ``encctl-gym design``: print the tables (or JSON); return 0. ``defenses`` designs the
+    defender's levers when one of their options is given (:mod:`encctl_gym.design_command`
+    passes :func:`encctl_gym.loop.defense_costs.design_loop_defenses`)."""
     if args.preset and args.system_file:
         raise ConfigError("give either SYSTEM_FILE or --preset, not both")
     base: dict[str, Any] = dict(DEFAULTS)
@@ -334,7 +336,9 @@ def run(args: argparse.Namespace) -> int:
     )
     defense = defense_cli.defense_options(args)
     if defense is not None:
-        res["defenses"] = design_defenses(
+        if defenses is None:
+            raise ConfigError("the defender's options need the loop's cost terms: run them through encctl-gym design")
+        res["defenses"] = defenses(
             (A, B),
             threat,
             cost_models=models or tuple(DECIPHERING_MODELS),
