@@ -122,3 +122,14 @@ def test_the_measured_defence_table_on_a_small_plant():
     assert all(r["detection_rate"] == 1.0 for r in rows if r["defender"].startswith("chi2"))  # every step injects
     assert all(r["samples_median"] <= r["horizon"] for r in rows)
     assert format_measured(rows).count("\n") == len(rows) + 1
+
+
+def test_the_detection_delay_sweep_and_its_figure_on_a_small_plant(tmp_path):
+    from experiments.defenses import DETECTORS, detection_delays, format_delays, plot_delays
+
+    rows = detection_delays("small", episodes=1, seed=0, ratios=(1e-3, 100.0), max_samples=300)
+    assert len(rows) == len(DETECTORS) * 2 * 3
+    loud = [r for r in rows if r["power_ratio"] == 100.0]
+    assert all(r["detection_rate"] == 1.0 and r["delay"][1] <= 300 for r in loud)
+    assert format_delays(rows).count("\n") == len(rows) + 1
+    assert plot_delays(rows, tmp_path / "delays.png").stat().st_size > 0
