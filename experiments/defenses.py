@@ -265,7 +265,6 @@ def detection_delays(
     import gymnasium as gym
 
     import encctl_gym  # noqa: F401  (registers the environment)
-
     from encctl_gym.envs.config import resolve_params
 
     p = get_preset(system)
