@@ -28,6 +28,7 @@ Prints the tables and writes them as ``defenses_analytic.md`` (and ``defenses_me
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from pathlib import Path
@@ -182,7 +183,7 @@ def wilson_interval(successes: int, trials: int, z: float = 1.96) -> tuple[float
 
 def _quartiles(values: list[float]) -> tuple[float, float, float]:
     if not values:
-        return (float("nan"),) * 3  # type: ignore[return-value]
+        return (math.nan, math.nan, math.nan)
     q = np.quantile(values, [0.25, 0.5, 0.75])
     return float(q[0]), float(q[1]), float(q[2])
 
