@@ -124,6 +124,7 @@ def test_the_measured_defence_table_on_a_small_plant():
     assert format_measured(rows).count("\n") == len(rows) + 1
 
 
+@pytest.mark.slow
 def test_the_detection_delay_sweep_and_its_figure_on_a_small_plant(tmp_path):
     from experiments.defenses import DETECTORS, detection_delays, format_delays, plot_delays
 
