@@ -22,7 +22,7 @@ from .errors import EncctlError
 # name -> (module, one-line help)
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "design": (
-        "encctl_gym.security.design_cli",
+        "encctl_gym.design_command",
         "optimal security parameter and key length for a plant (Theorem thm:opt_sec, eq:opt_key)",
     ),
     "reproduce": ("encctl_gym.experiments.reproduce", "reproduce the paper's figures and design example (writes PNG and CSV)"),

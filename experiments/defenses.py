@@ -16,13 +16,17 @@ Figure 1 (c) (``fig1-c``):
   breaker, which redoes its precomputation on every new group (counted and timed), with the
   plant side's cost (encryptions and bytes re-provisioned, group generation, waiting for the pool).
 * **Measured in the environment** (``--measure``): each defender policy of
-  :mod:`encctl_gym.loop.defenses` (none; audits at three rates; the chi-squared detector; input
-  noise at two levels) against the Gaussian, AR(1) and optimal-design attackers through the
-  environment (ideal backend, the system's own budget ``tau_c``): the detection rate, the samples
-  collected before the attack ends, the median final error over ``gamma_c``, and the wall time
-  per step against the undefended loop (a ratio measured in the same run).
+  :mod:`encctl_gym.loop.defenses` (none; audits at three rates; the chi-squared and CUSUM
+  detectors; input noise at two levels) against the Gaussian, AR(1) and optimal-design attackers
+  through the environment (ideal backend, the system's own budget ``tau_c``): the detection rate
+  (Wilson 95 % interval), the detection delay and the samples collected before the attack ends,
+  the final error over ``gamma_c`` (medians and quartiles), the defender's own wall time per step
+  (its ``act``, timed), and the whole step's time against the undefended loop's.
+* **Detection delay against input energy** (``--delays``): the chi-squared and CUSUM detectors
+  against every attacker at attack powers ``sigma_u2 / sigma_w2`` in :data:`ENERGY_RATIOS`
+  (``defenses_detection.md`` and the figure ``defenses_detection.png``).
 
-    python -m encctl_gym.experiments.defenses [--measure] [--episodes 20] [--rotation] [--out results/defenses]
+    python -m encctl_gym.experiments.defenses [--measure] [--delays] [--rotation] [--episodes 20] [--out results/defenses] [--figures figures]
 
 Prints the tables and writes them as ``defenses_analytic.md`` (and ``defenses_measured.md``,
 ``defenses_rotation.md``).
@@ -31,6 +35,7 @@ Prints the tables and writes them as ``defenses_analytic.md`` (and ``defenses_me
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from pathlib import Path
@@ -115,15 +120,107 @@ MEASURED_DEFENDERS: tuple[tuple[str, Any], ...] = (
     ("audit p = 5e-4", {"name": "audit", "rate": 5e-4}),
     ("audit p = 1e-3", {"name": "audit", "rate": 1e-3}),
     ("chi2, W = 10, 1e-4 per step", {"name": "chi2", "window": 10, "false_alarm_rate": 1e-4}),
+    ("cusum, c = 2, 1e-4 per step", {"name": "cusum", "false_alarm_rate": 1e-4, "variance_ratio": 2.0}),
     ("noise sigma_d2 = sigma_w2", "noise-w"),
     ("noise sigma_d2 = 10 sigma_w2", "noise-10w"),
 )
+
+#: The detectors of the detection-delay sweep (label, ``defender`` value).
+DETECTORS: tuple[tuple[str, dict[str, Any]], ...] = (
+    ("chi2", {"name": "chi2", "window": 10, "false_alarm_rate": 1e-4}),
+    ("cusum", {"name": "cusum", "false_alarm_rate": 1e-4, "variance_ratio": 2.0}),
+)
+
+
+def _defender_spec(spec: Any, p: Any) -> Any:
+    if spec == "noise-w":
+        return {"name": "noise", "sigma_d2": p.sigma_w2}
+    if spec == "noise-10w":
+        return {"name": "noise", "sigma_d2": 10 * p.sigma_w2}
+    return spec
+
+
+def _attackers(env: Any) -> dict[str, Any]:
+    from encctl_gym.agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker
+
+    params = env.unwrapped.params
+    return {
+        "gaussian": GaussianAttacker(params),
+        "ar1": ColoredGaussianAttacker(params),
+        "optimal": OptimalDesignAttacker.from_env(env.unwrapped),
+    }
+
+
+class _TimedPolicy:
+    """The defender of an environment with its ``act`` timed (the defender's own cost per step)."""
+
+    def __init__(self, core: Any) -> None:
+        self.policy, self.seconds, self.calls = core.defender, 0.0, 0
+        core.defender = self
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.policy, name)
+
+    def act(self, view: Any) -> Any:
+        t0 = time.perf_counter()
+        try:
+            return self.policy.act(view)
+        finally:
+            self.seconds += time.perf_counter() - t0
+            self.calls += 1
+
+
+def _episodes(env: Any, att: Any, episodes: int, seed: int) -> tuple[list[dict[str, Any]], float, float]:
+    """``episodes`` attacks; per episode ``detected``, ``samples``, ``epsilon``, ``energy``; the
+    wall time per step and the defender's own time per step (its ``act``), both after one untimed
+    step, so compiled kernels are loaded before the clock runs."""
+    obs, _ = env.reset(seed=seed)
+    att.reset(seed=0)
+    env.step(att.act(obs[None])[0])
+    timer = _TimedPolicy(env.unwrapped.episode)
+    out, steps, t0 = [], 0, time.perf_counter()
+    for e in range(episodes):
+        obs, info = env.reset(seed=seed + e)
+        att.reset(seed=np.random.SeedSequence([seed, e]))
+        while True:
+            obs, _, term, trunc, info = env.step(att.act(obs[None])[0])
+            steps += 1
+            if term or trunc:
+                break
+        out.append(
+            {
+                "detected": bool(info["detected"]),
+                "samples": int(info["samples_collected"]),
+                "epsilon": float(info["epsilon"]),
+                "power": float(info["average_power"]),
+            }
+        )
+    wall = (time.perf_counter() - t0) / steps
+    env.unwrapped.episode.defender = timer.policy
+    return out, wall, timer.seconds / steps
+
+
+def wilson_interval(successes: int, trials: int, z: float = 1.96) -> tuple[float, float]:
+    """The Wilson score interval of a binomial proportion (95 % by default)."""
+    if trials == 0:
+        return (0.0, 1.0)
+    ph = successes / trials
+    den = 1 + z * z / trials
+    mid = (ph + z * z / (2 * trials)) / den
+    half = z * np.sqrt(ph * (1 - ph) / trials + z * z / (4 * trials * trials)) / den
+    return (float(max(0.0, mid - half)), float(min(1.0, mid + half)))
+
+
+def _quartiles(values: list[float]) -> tuple[float, float, float]:
+    if not values:
+        return (math.nan, math.nan, math.nan)
+    q = np.quantile(values, [0.25, 0.5, 0.75])
+    return float(q[0]), float(q[1]), float(q[2])
 
 
 def measure(system: str, episodes: int, seed: int) -> list[dict[str, Any]]:
     """Every defender against every attacker of the module docstring, ``episodes`` each."""
     import gymnasium as gym
-    from encctl_gym.agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker
 
     import encctl_gym  # noqa: F401  (registers the environment)
 
@@ -131,63 +228,124 @@ def measure(system: str, episodes: int, seed: int) -> list[dict[str, Any]]:
     rows: list[dict[str, Any]] = []
     base_time: dict[str, float] = {}
     for label, spec in MEASURED_DEFENDERS:
-        if spec == "noise-w":
-            spec = {"name": "noise", "sigma_d2": p.sigma_w2}
-        elif spec == "noise-10w":
-            spec = {"name": "noise", "sigma_d2": 10 * p.sigma_w2}
-        env = gym.make("encctl_gym/EncryptedLTIAttack-v0", config={"preset": system, "decipher_delay": 0, "defender": spec})
+        config = {"preset": system, "decipher_delay": 0, "defender": _defender_spec(spec, p)}
+        env = gym.make("encctl_gym/EncryptedLTIAttack-v0", config=config)
         params = env.unwrapped.params  # type: ignore[attr-defined]
-        attackers = {
-            "gaussian": GaussianAttacker(params),
-            "ar1": ColoredGaussianAttacker(params),
-            "optimal": OptimalDesignAttacker.from_env(env.unwrapped),
-        }
-        for name, att in attackers.items():
-            detected, samples, finals = [], [], []
-            obs, _ = env.reset(seed=seed)  # one untimed step: compiled kernels are loaded before the clock runs
-            att.reset(seed=0)
-            env.step(att.act(obs[None])[0])
-            steps, t0 = 0, time.perf_counter()
-            for e in range(episodes):
-                obs, info = env.reset(seed=seed + e)
-                att.reset(seed=np.random.SeedSequence([seed, e]))
-                while True:
-                    obs, _, term, trunc, info = env.step(att.act(obs[None])[0])
-                    steps += 1
-                    if term or trunc:
-                        break
-                detected.append(bool(info["detected"]))
-                samples.append(int(info["samples_collected"]))
-                finals.append(float(info["epsilon"]))
-            per_step = (time.perf_counter() - t0) / steps
+        for name, att in _attackers(env).items():
+            eps, per_step, defender_step = _episodes(env, att, episodes, seed)
             if label == "none":
                 base_time[name] = per_step
+            hits = sum(e["detected"] for e in eps)
+            delays = [float(e["samples"]) for e in eps if e["detected"]]
             rows.append(
                 {
                     "system": system,
                     "defender": label,
                     "attacker": name,
                     "episodes": episodes,
-                    "detection_rate": float(np.mean(detected)),
-                    "samples_median": float(np.median(samples)),
-                    "error_over_gamma_c": float(np.median(finals)) / p.gamma_c,
+                    "detection_rate": hits / episodes,
+                    "detection_interval": wilson_interval(hits, episodes),
+                    "samples": _quartiles([float(e["samples"]) for e in eps]),
+                    "samples_median": float(np.median([e["samples"] for e in eps])),
+                    "delay": _quartiles(delays),
+                    "error_over_gamma_c": _quartiles([e["epsilon"] / p.gamma_c for e in eps]),
                     "horizon": params.horizon,
+                    "seconds_per_step": per_step,
+                    "defender_seconds_per_step": defender_step,
                     "time_ratio": per_step / base_time[name],
                 }
             )
     return rows
 
 
+def _iqr(q: tuple[float, float, float], fmt: str = ".3g") -> str:
+    if not np.isfinite(q[1]):
+        return "-"
+    return f"{q[1]:{fmt}} [{q[0]:{fmt}}, {q[2]:{fmt}}]"
+
+
 def format_measured(rows: list[dict[str, Any]]) -> str:
     """The measured table as markdown."""
     out = [
-        "| system | defender | attacker | detected | samples collected (median) | final error / gamma_c (median) | time per step / undefended |",
+        "| system | defender | attacker | detected [95 % CI] | detection delay, median [IQR] | samples collected, median [IQR] "
+        "| final E[eps] / gamma_c, median [IQR] | defender's own time per step (us) | time per step / undefended |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lo, hi = r["detection_interval"]
+        out.append(
+            f"| {r['system']} | {r['defender']} | {r['attacker']} | {r['detection_rate']:.0%} [{lo:.0%}, {hi:.0%}] | "
+            f"{_iqr(r['delay'], '.0f')} | {_iqr(r['samples'], '.0f')} of {r['horizon']} | {_iqr(r['error_over_gamma_c'])} | "
+            f"{1e6 * r['defender_seconds_per_step']:.1f} | {r['time_ratio']:.2f} |"
+        )
+    return "\n".join(out)
+
+
+#: Attack powers of the detection-delay sweep, in units of the system's sigma_w2.
+ENERGY_RATIOS: tuple[float, ...] = (1e-3, 1e-2, 0.1, 1.0, 10.0, 100.0)
+
+
+def detection_delays(
+    system: str, episodes: int, seed: int, *, ratios: tuple[float, ...] = ENERGY_RATIOS, max_samples: int = 2000
+) -> list[dict[str, Any]]:
+    """Detection delay of the chi-squared and CUSUM detectors against the attacker's input power:
+    every attacker at ``sigma_u2 = ratio sigma_w2`` for each ratio, attacks of at most
+    ``max_samples`` steps (an attack not detected by then counts as undetected, its delay censored;
+    the key length is the preset's design at its own power, so the horizon does not move with the
+    power)."""
+    import gymnasium as gym
+
+    import encctl_gym  # noqa: F401  (registers the environment)
+    from encctl_gym.envs.config import resolve_params
+
+    p = get_preset(system)
+    key_length = resolve_params({"preset": system}).key_length  # the design's key at the preset's power, held fixed
+    rows: list[dict[str, Any]] = []
+    for det_label, spec in DETECTORS:
+        for ratio in ratios:
+            su2 = ratio * p.sigma_w2
+            config = {
+                "preset": system,
+                "decipher_delay": 0,
+                "defender": spec,
+                "sigma_u2": su2,
+                "key_length": key_length,
+                "max_samples": max_samples,
+            }
+            env = gym.make("encctl_gym/EncryptedLTIAttack-v0", config=config)
+            for name, att in _attackers(env).items():
+                eps, _, _ = _episodes(env, att, episodes, seed)
+                hits = sum(e["detected"] for e in eps)
+                rows.append(
+                    {
+                        "system": system,
+                        "detector": det_label,
+                        "attacker": name,
+                        "sigma_u2": su2,
+                        "power_ratio": ratio,
+                        "average_power": float(np.mean([e["power"] for e in eps])),
+                        "episodes": episodes,
+                        "detection_rate": hits / episodes,
+                        "detection_interval": wilson_interval(hits, episodes),
+                        "delay": _quartiles([float(e["samples"]) for e in eps if e["detected"]]),
+                        "max_samples": max_samples,
+                    }
+                )
+    return rows
+
+
+def format_delays(rows: list[dict[str, Any]]) -> str:
+    """The detection-delay table as markdown."""
+    out = [
+        "| system | detector | attacker | sigma_u2 / sigma_w2 | measured power per channel | detected [95 % CI] "
+        "| detection delay (steps), median [IQR] |",
         "|---|---|---|---|---|---|---|",
     ]
     for r in rows:
+        lo, hi = r["detection_interval"]
         out.append(
-            f"| {r['system']} | {r['defender']} | {r['attacker']} | {r['detection_rate']:.0%} | "
-            f"{r['samples_median']:.0f} of {r['horizon']} | {r['error_over_gamma_c']:.3g} | {r['time_ratio']:.2f} |"
+            f"| {r['system']} | {r['detector']} | {r['attacker']} | {r['power_ratio']:g} | {r['average_power']:.3g} | "
+            f"{r['detection_rate']:.0%} [{lo:.0%}, {hi:.0%}] | {_iqr(r['delay'], '.0f')} |"
         )
     return "\n".join(out)
 
@@ -327,12 +485,56 @@ def format_rotation(rows: dict[str, list[dict[str, Any]]]) -> str:
     return "\n".join(out)
 
 
+def plot_delays(rows: list[dict[str, Any]], path: Path) -> Path:
+    """Median detection delay (IQR bars) against the attack power, one panel per system; a
+    detector that misses some attacks is drawn with open markers."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from encctl_gym.plotting import legend_below, save_figure
+
+    systems = list(dict.fromkeys(r["system"] for r in rows))
+    fig, axes = plt.subplots(1, len(systems), figsize=(6.2 * len(systems), 4.4), squeeze=False)
+    styles = {"chi2": "-", "cusum": "--"}
+    markers = {"gaussian": "o", "ar1": "s", "optimal": "^"}
+    for ax, system in zip(axes[0], systems):
+        for det in styles:
+            for att in markers:
+                sel = [r for r in rows if r["system"] == system and r["detector"] == det and r["attacker"] == att]
+                sel = [r for r in sel if np.isfinite(r["delay"][1])]
+                if not sel:
+                    continue
+                x = np.array([r["power_ratio"] for r in sel])
+                med = np.array([r["delay"][1] for r in sel])
+                err = np.array([[r["delay"][1] - r["delay"][0] for r in sel], [r["delay"][2] - r["delay"][1] for r in sel]])
+                line = ax.errorbar(x, med, yerr=err, ls=styles[det], marker=markers[att], ms=5, capsize=2, label=f"{det}, {att}")
+                missed = [i for i, r in enumerate(sel) if r["detection_rate"] < 1]
+                if missed:
+                    ax.plot(x[missed], med[missed], ls="none", marker=markers[att], ms=10, mfc="none", color=line[0].get_color())
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("attack power sigma_u2 / sigma_w2")
+        ax.set_ylabel("detection delay (steps)")
+        ax.set_title(system)
+        ax.grid(True, which="major", alpha=0.3)
+    bottom = legend_below(fig, axes[0], ncol=3)
+    fig.suptitle("Detection delay vs attack power (open markers: not every attack detected)", fontsize=9)
+    fig.tight_layout(rect=(0, bottom, 1, 1))
+    return save_figure(fig, path)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m encctl_gym.experiments.defenses", description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("results/defenses"))
     parser.add_argument(
         "--measure", action="store_true", help="also measure every defender against every attacker in the environment"
     )
+    parser.add_argument(
+        "--delays", action="store_true", help="also measure the detectors' delay against the attack power (table and figure)"
+    )
+    parser.add_argument("--figures", type=Path, default=Path("figures"), help="directory of the detection-delay figure")
     parser.add_argument("--episodes", type=int, default=20, help="episodes per defender and attacker (default 20)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument(
@@ -351,6 +553,7 @@ def main(argv: list[str] | None = None) -> int:
         text = format_tables(noise, audit_rows(noise))
         measured = [r for system in SYSTEMS for r in measure(system, args.episodes, args.seed)] if args.measure else []
         rotation = rotation_rows(args.rotation_samples, args.seed) if args.rotation else None
+        delays = [r for system in SYSTEMS for r in detection_delays(system, args.episodes, args.seed)] if args.delays else []
     except EncctlError as exc:
         print(f"defenses: {exc}", file=sys.stderr)
         return 2
@@ -381,6 +584,17 @@ def main(argv: list[str] | None = None) -> int:
             "attacker, one episode per K)\n\n" + table + "\n"
         )
         print(f"  wrote {path}")
+    if delays:
+        table = format_delays(delays)
+        print(table)
+        path = args.out / "defenses_detection.md"
+        path.write_text(
+            f"# Detection delay against the attack power\n\nCommand: `python -m encctl_gym.experiments.defenses --delays --episodes {args.episodes}`"
+            f" (seed {args.seed}; decipher_delay = 0, ideal backend, attacks of at most 2000 steps)\n\n" + table + "\n"
+        )
+        print(f"  wrote {path}")
+        args.figures.mkdir(parents=True, exist_ok=True)
+        print(f"  wrote {plot_delays(delays, args.figures / 'defenses_detection.png')}")
     return 0
 
 

@@ -30,7 +30,7 @@ from ..crypto.group import SHIPPED_BITS
 from ..errors import ParameterError
 from .backend import LoopBackend, loop_group, lqr_gain, table_limit
 from .defender import DEFENDERS, DefenderAction, DefenderPolicy, FixedDefender, PlantView, make_defender
-from .defenses import AuditDefender, DetectorDefender, NoiseDefender  # registers "noise", "audit", "chi2"
+from .defenses import AuditDefender, CusumDefender, DetectorDefender, NoiseDefender  # registers "noise", "audit", "chi2", "cusum"
 from .elgamal import ElGamalLoop
 from .ideal import IdealLoop
 from .quantize import Quantization
@@ -52,6 +52,7 @@ __all__ = [
     "FixedDefender",
     "NoiseDefender",
     "AuditDefender",
+    "CusumDefender",
     "DetectorDefender",
     "PlantView",
     "make_defender",

@@ -45,8 +45,14 @@ attack_design
     cvxpy; imported on use).
 report
     ``design_report``: everything the design command reports for a plant, as a dict.
+defense_design
+    The cheapest secure mix of key length, group rotation, audits and noise per cost model,
+    with the defender's cost per step (its time models are passed in by the loop layer).
+defense_cli
+    The defender's options of ``encctl-gym design`` and their section of the output.
 design_cli
-    The ``encctl-gym design`` subcommand (prints :func:`.report.design_report`).
+    The ``encctl-gym design`` subcommand (prints :func:`.report.design_report`; with the
+    defender's levers through :mod:`encctl_gym.design_command`).
 """
 
 from __future__ import annotations
