@@ -20,6 +20,7 @@ from ..errors import BudgetError, ConfigError, ParameterError
 from ..ident.registry import make_estimator
 from ..loop import BACKENDS as _LOOP_BACKENDS
 from ..loop.defender import make_defender
+from ..loop.scheme import SCHEMES, make_scheme
 from ..presets import get_preset
 from ..security.complexity import sic_from_traces
 from ..security.cost_models import (
@@ -32,14 +33,7 @@ from ..security.cost_models import (
     check_security_parameter,
     deciphering_model,
 )
-from ..security.deciphering import (
-    ADVERSARIES,
-    SCHEMES,
-    independent_keys,
-    max_affordable_samples,
-    per_sample_cost,
-    sample_deciphering_time,
-)
+from ..security.deciphering import ADVERSARIES, independent_keys, max_affordable_samples, per_sample_cost, sample_deciphering_time
 from ..security.design import design_from_traces
 from ..security.exact import decimal_fraction
 from ..security.gramians import controllability_gramian, noise_gramian
@@ -233,7 +227,7 @@ class AttackParams:
 
     def deciphering_time(self, N: Any) -> Any:
         """tau(N) of the configured model (Definition def:sdt, :func:`sample_deciphering_time`), seconds."""
-        return sample_deciphering_time(N, self.cost, self.upsilon, scheme=self.scheme, adversary=self.adversary)
+        return sample_deciphering_time(N, self.cost, self.upsilon, scheme=make_scheme(self.scheme), adversary=self.adversary)
 
     @property
     def energy_budget(self) -> float:
@@ -396,7 +390,8 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     upsilon = check_positive("upsilon", raw["upsilon"])
     tau_c = parse_duration(raw["tau_c"], "tau_c")
     gamma_c = check_positive("gamma_c", raw["gamma_c"])
-    scheme = _choice("scheme", cfg["scheme"], SCHEMES)
+    scheme = _choice("scheme", cfg["scheme"], tuple(SCHEMES))
+    encryption = make_scheme(scheme)  # the scheme seam: what the adversary must break
     adversary = _choice("adversary", cfg["adversary"], ADVERSARIES)
     reward = _choice("reward", cfg["reward"], REWARDS)
     estimator = cfg["estimator"]
@@ -445,7 +440,7 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         key_length = paper.key_length_for_security_parameter(lam)  # eq:opt_key
         cost = paper.cost_of_security_parameter(lam) if model_name == "paper" else model.break_cost(key_length)
 
-    budget = max_affordable_samples(tau_c, cost, upsilon, scheme=scheme, adversary=adversary)
+    budget = max_affordable_samples(tau_c, cost, upsilon, scheme=encryption, adversary=adversary)
     max_samples = cfg["max_samples"]
     if max_samples is not None:
         max_samples = check_int("max_samples", max_samples, minimum=1)
@@ -524,7 +519,7 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         next_sample_cost=float(cost.next / decimal_fraction("upsilon", upsilon)),
         budget_samples=budget,
         horizon=horizon,
-        independent_keys=independent_keys(scheme, adversary),
+        independent_keys=independent_keys(encryption, adversary),
         budget_limited=budget_limited,
         decipher_delay=delay_v,
         warmup_steps=warmup,

@@ -9,6 +9,10 @@ Backends implement :class:`~encctl_gym.loop.backend.LoopBackend` and are picked 
 * ``"elgamal"`` (:class:`~encctl_gym.loop.elgamal.ElGamalLoop`): real dynamic-key ElGamal
   ciphertexts, one copy.
 
+The encryption scheme the ElGamal backend runs is an
+:class:`~encctl_gym.loop.scheme.EncryptionScheme` of :data:`SCHEMES` (the three ElGamal variants
+of :mod:`encctl_gym.loop.elgamal_scheme`, or a new one: a class and a row).
+
 The defender policies with real levers (input noise, audits, a chi-squared detector) are in
 :mod:`encctl_gym.loop.defenses`.
 
@@ -31,8 +35,10 @@ from .backend import LoopBackend, loop_group, lqr_gain, table_limit
 from .defender import DEFENDERS, DefenderAction, DefenderPolicy, FixedDefender, PlantView, make_defender
 from .defenses import AuditDefender, DetectorDefender, NoiseDefender  # registers "noise", "audit", "chi2"
 from .elgamal import ElGamalLoop
+from .elgamal_scheme import ElGamalScheme  # registers "modified", "token", "static"
 from .ideal import IdealLoop
 from .quantize import Quantization
+from .scheme import SCHEMES, EncryptionScheme, make_scheme
 
 __all__ = [
     "LoopBackend",
@@ -41,6 +47,10 @@ __all__ = [
     "IdealLoop",
     "ElGamalLoop",
     "Quantization",
+    "EncryptionScheme",
+    "ElGamalScheme",
+    "SCHEMES",
+    "make_scheme",
     "loop_group",
     "lqr_gain",
     "table_limit",
