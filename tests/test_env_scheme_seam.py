@@ -13,7 +13,10 @@ from encctl_gym.attacks.forgery import injection_integers
 from encctl_gym.crypto.encoding import Encoder, lift
 from encctl_gym.envs.encrypted_lti_attack import EncryptedLTIAttackEnv
 from encctl_gym.errors import ParameterError
-from encctl_gym.loop import SCHEMES, ElGamalScheme, EncryptionScheme, make_scheme
+from encctl_gym.envs.config import resolve_params
+from encctl_gym.loop import SCHEMES, ElGamalScheme, EncryptionScheme, LoopSpec, make_scheme
+from encctl_gym.plant import Plant
+from encctl_gym.security.threat import ThreatModel
 from encctl_gym.security.deciphering import independent_keys
 
 SMALL = {"preset": "small", "gamma_opt": False, "key_length": 64, "max_samples": 25, "warmup_steps": 3}
@@ -171,3 +174,15 @@ def test_an_unknown_scheme_names_the_registered_ones():
         make_scheme("rsa")
     with pytest.raises(ParameterError, match="EncryptionScheme"):
         make_scheme(object())
+
+
+def test_the_parameters_compose_a_plant_a_threat_model_and_a_loop():
+    p = resolve_params({**SMALL, "scheme": "token", "adversary": "server", "deciphering_model": "precomputation"})
+    assert isinstance(p.plant, Plant) and np.array_equal(p.plant.A, p.A) and (p.plant.n, p.plant.m) == (p.n, p.m)
+    assert isinstance(p.threat, ThreatModel)
+    assert (p.threat.tau_c, p.threat.upsilon, p.threat.gamma_c, p.threat.adversary) == (p.tau_c, p.upsilon, p.gamma_c, "server")
+    assert p.threat.model.name == "precomputation"
+    assert isinstance(p.loop, LoopSpec)
+    assert (p.loop.scheme, p.loop.key_length, p.loop.delta, p.loop.crypto) == ("token", 64, p.delta, "ideal")
+    assert p.loop.encryption().independent_keys(p.adversary) is p.independent_keys is False
+    assert p.loop.group().bits == 64

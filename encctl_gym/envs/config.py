@@ -11,6 +11,7 @@ import math
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -21,12 +22,15 @@ from ..ident.registry import make_estimator
 from ..loop import BACKENDS as _LOOP_BACKENDS
 from ..loop.defender import make_defender
 from ..loop.scheme import SCHEMES, make_scheme
+from ..loop.spec import LoopSpec
+from ..plant import Plant
 from ..presets import get_preset
 from ..security.complexity import sic_from_traces
 from ..security.cost_models import (
     DECIPHERING_MODELS,
     GENERIC_MIN_KEY_LENGTH,
     GUILLEVIC_CORRECTION,
+    CostModel,
     KeyBreakCost,
     PaperModel,
     check_gnfs_correction,
@@ -37,6 +41,7 @@ from ..security.deciphering import ADVERSARIES, independent_keys, max_affordable
 from ..security.design import design_from_traces
 from ..security.exact import decimal_fraction
 from ..security.gramians import controllability_gramian, noise_gramian
+from ..security.threat import ThreatModel
 from ..units import parse_duration
 from .layout import ObservationLayout
 from .rewards import REWARDS as _REWARD_CLASSES
@@ -161,7 +166,15 @@ def default_config() -> dict[str, Any]:
 
 @dataclass(frozen=True)
 class AttackParams:
-    """Resolved, validated parameters of one environment (shared by the vector environment)."""
+    """Resolved, validated parameters of one environment (shared by the vector environment).
+
+    The fields are flat; the value objects they compose are :attr:`plant` (the
+    :class:`~encctl_gym.plant.Plant` ``(A, B)``), :attr:`threat` (the
+    :class:`~encctl_gym.security.threat.ThreatModel`: variances, gamma_c, tau_c, Upsilon, the
+    adversary and the cost model) and :attr:`loop` (the :class:`~encctl_gym.loop.spec.LoopSpec`:
+    backend, scheme, key length, Delta, breaker, defender), each built once from the checked
+    fields.
+    """
 
     A: np.ndarray
     B: np.ndarray
@@ -204,6 +217,42 @@ class AttackParams:
     sources: dict[str, str] = field(default_factory=dict)  # where A, B, the variances and design values came from
     defender: Any = "fixed"  # the defender policy specification (a name or a policy object), checked
     horizon_capped: bool = False  # no max_samples and a budget beyond MAX_DEFAULT_HORIZON: N is that cap
+    cost_model: CostModel | None = None  # the built deciphering model (its GNFS correction); None: the named one's defaults
+
+    @cached_property
+    def plant(self) -> Plant:
+        """The plant ``(A, B)`` of eq:system as a value object."""
+        return Plant(self.A, self.B)
+
+    @cached_property
+    def threat(self) -> ThreatModel:
+        """The adversary and the defender's tolerances (Definition def:security)."""
+        return ThreatModel(
+            tau_c=self.tau_c,
+            upsilon=self.upsilon,
+            sigma_u2=self.sigma_u2,
+            sigma_w2=self.sigma_w2,
+            sigma_x2=self.sigma_x2,
+            gamma_c=self.gamma_c,
+            adversary=self.adversary,
+            cost_model=self.cost_model if self.cost_model is not None else self.deciphering_model,
+        )
+
+    @cached_property
+    def loop(self) -> LoopSpec:
+        """The closed loop: backend, scheme, key length, Delta, breaker, defender."""
+        return LoopSpec(
+            crypto=self.crypto,
+            scheme=self.scheme,
+            key_length=self.key_length,
+            delta=self.delta,
+            x_bound=self.x_bound,
+            u_max=self.u_max,
+            breaker=self.breaker,
+            breaker_time_limit=self.breaker_time_limit,
+            crypto_seed=self.crypto_seed,
+            defender=self.defender,
+        )
 
     def warn_if_capped(self) -> None:
         """Warn (once per environment, when it is made) that the attack length is the default cap
@@ -227,7 +276,7 @@ class AttackParams:
 
     def deciphering_time(self, N: Any) -> Any:
         """tau(N) of the configured model (Definition def:sdt, :func:`sample_deciphering_time`), seconds."""
-        return sample_deciphering_time(N, self.cost, self.upsilon, scheme=make_scheme(self.scheme), adversary=self.adversary)
+        return sample_deciphering_time(N, self.cost, self.upsilon, scheme=self.loop.encryption(), adversary=self.adversary)
 
     @property
     def energy_budget(self) -> float:
@@ -541,4 +590,5 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         sources=sources,
         defender=defender,
         horizon_capped=max_samples is None and horizon < budget,
+        cost_model=model,
     )

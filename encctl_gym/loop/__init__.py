@@ -27,7 +27,7 @@ the rounding pattern only.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 from ..crypto.group import SHIPPED_BITS
 from ..errors import ParameterError
@@ -39,6 +39,10 @@ from .elgamal_scheme import ElGamalScheme  # registers "modified", "token", "sta
 from .ideal import IdealLoop
 from .quantize import Quantization
 from .scheme import SCHEMES, EncryptionScheme, make_scheme
+from .spec import LoopSpec
+
+if TYPE_CHECKING:
+    from ..envs.config import AttackParams
 
 __all__ = [
     "LoopBackend",
@@ -51,6 +55,7 @@ __all__ = [
     "ElGamalScheme",
     "SCHEMES",
     "make_scheme",
+    "LoopSpec",
     "loop_group",
     "lqr_gain",
     "table_limit",
@@ -69,7 +74,7 @@ __all__ = [
 BACKENDS: dict[str, type] = {"ideal": IdealLoop, "elgamal": ElGamalLoop}
 
 
-def make_loop(params: Any, defender: DefenderPolicy | None = None) -> LoopBackend:
+def make_loop(params: AttackParams, defender: DefenderPolicy | None = None) -> LoopBackend:
     """The backend selected by ``params.crypto``, on the group the defender picks
     (``defender``, else the policy of ``params.defender``; by default :func:`loop_group` of the
     key length).
