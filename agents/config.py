@@ -46,14 +46,13 @@ aliases (nested aliases can expand a small file into gigabytes) and nested at mo
 from __future__ import annotations
 
 import copy
-import numbers
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from encctl_gym._validation import format_value
+from encctl_gym._validation import check_int, format_value
 from encctl_gym.envs.config import completion_preset, resolve_params
 from encctl_gym.envs.config import default_config as env_default_config
 from encctl_gym.errors import ConfigError, EncctlError, ParameterError
@@ -302,13 +301,7 @@ def _int(minimum: int, optional: bool = False, maximum: int | None = None) -> Ch
     def check(name: str, v: Any) -> Any:
         if v is None and optional:
             return v
-        if isinstance(v, bool) or not isinstance(v, numbers.Integral):
-            raise ConfigError(f"{name} must be an integer{' or null' if optional else ''}, got {format_value(v)}")
-        if int(v) < minimum:
-            raise ConfigError(f"{name} must be >= {minimum}, got {format_value(v)}")
-        if maximum is not None and int(v) > maximum:
-            raise ConfigError(f"{name} must be <= {maximum}, got {format_value(v)}")
-        return int(v)
+        return check_int(name, v, minimum, maximum, error=ConfigError)  # the package's one integer rule
 
     return check
 
