@@ -170,7 +170,7 @@ MAX_EXACT_FLOAT_INT = 2**53
 
 
 def check_int(
-    name: str, value: Any, minimum: int | None = None, maximum: int | None = None, *, error: type[ParameterError] = ParameterError
+    name: str, value: Any, minimum: int | None = None, maximum: int | None = None, *, error: type[EncctlError] = ParameterError
 ) -> int:
     """``value`` as an int, the package's one integer check.
 
