@@ -168,8 +168,9 @@ class EpisodeCore:
         self._gram_upto = 1  # G and C hold the columns j < _gram_upto (the fused step lets them lag)
         self._dims = kern.dims(n, m, p.input_history * m)  # the sizes, as the kernels take them
         self.reward = REWARDS[p.reward](p, K)
-        # the attacker's estimator: one that provides kernels (least squares) runs compiled on the
-        # episode's arrays; any other is updated column by column (encctl_gym.ident)
+        # the attacker's estimator: one that provides kernels (least squares, fused; Bayes,
+        # forgetting, IV: moment kernels) runs compiled on the episode's arrays; any other is
+        # updated column by column (encctl_gym.ident)
         est = make_estimator(p.estimator)
         self.kernels: OnlineKernels | None = (
             est.online_kernels(K, self._A, self._B, s.Q, sch.refresh, sch.cond_limit)

@@ -227,6 +227,9 @@ class BayesianLeastSquares(MomentEstimator):
         """The compiled online form (:class:`~encctl_gym.ident.compiled.MomentKernels`): the
         moments by a compiled stage, the estimate by :meth:`solve` (the empirical-Bayes search is
         compiled, :func:`encctl_gym.ident._moment_kernels.evidence_solve`)."""
-        n, m = A.shape[0], B.shape[1]
-        self.check_dimensions(n, m)
-        return MomentKernels(self, K, A, B, refresh, lambda M, columns: self.solve(M, columns, n, m))
+        self.check_dimensions(A.shape[0], B.shape[1])
+        return MomentKernels(self, K, A, B, refresh)
+
+    def online_solve(self, M: np.ndarray, columns: int, n: int, m: int) -> np.ndarray:
+        """The estimates of the online form: :meth:`solve`."""
+        return self.solve(M, columns, n, m)

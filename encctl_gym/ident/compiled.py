@@ -204,16 +204,16 @@ class MomentKernels:
     Parameters
     ----------
     estimator : MomentEstimator
-        Gives the feature count, the decay, the minimum sample size and the label.
+        Gives the feature count, the decay, the minimum sample size, the label and
+        ``online_solve(M, columns, n, m) -> theta (K, n, n + m)`` (NaN for a copy without an
+        estimate): its solve on the moments ``M (K, p, p)``, compiled where it has one (a method,
+        so that an episode pickles).
     K : int
         Copies.
     A, B : numpy.ndarray
         The true plant (the error of Definition def:error is against it).
     refresh : int
         Kept for the protocol (nothing drifts: the moments are exact sums).
-    solve : callable
-        ``(M, columns) -> theta (K, n, n + m)``, NaN for a copy without an estimate: the
-        estimator's solve on the moments ``M (K, p, p)``, compiled where the estimator has one.
     lags : int, default 0
         Instrumental variables' ``L`` (the rows carry ``L + 1`` lagged inputs); 0 for ``[z; y]`` rows.
     """
@@ -221,7 +221,7 @@ class MomentKernels:
     fused = False
     all_ready = False  # no steady state of its own: every delivery goes through settle
 
-    def __init__(self, estimator: Any, K: int, A: np.ndarray, B: np.ndarray, refresh: int, solve: Any, *, lags: int = 0) -> None:
+    def __init__(self, estimator: Any, K: int, A: np.ndarray, B: np.ndarray, refresh: int, *, lags: int = 0) -> None:
         self.n, self.m = A.shape[0], B.shape[1]
         self.d = self.n + self.m
         self.K = K
@@ -232,12 +232,15 @@ class MomentKernels:
         self.decay = float(estimator.decay)
         self.lags = int(lags)
         self.need = int(estimator.min_sample_size(self.n, self.m))
-        self.solve = solve
         self.refresh = refresh
         self.since_refresh = 0
         self._sc = np.zeros((self.d + self.n, K))
         #: the last estimates ``[A_hat B_hat]`` (K, n, n + m), NaN before the first
         self.theta = np.full((K, self.n, self.d), np.nan)
+
+    def solve(self, M: np.ndarray, columns: int) -> np.ndarray:
+        """The estimator's estimates from the moments ``M`` of ``columns`` columns, ``(K, n, n + m)``."""
+        return self.estimator.online_solve(M, columns, self.n, self.m)
 
     def reset(self) -> None:
         self.M[:] = 0.0

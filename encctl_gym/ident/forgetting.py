@@ -72,18 +72,17 @@ class ForgettingLeastSquares(MomentEstimator):
     def online_kernels(
         self, K: int, A: np.ndarray, B: np.ndarray, Q: np.ndarray, refresh: int, cond_limit: float
     ) -> MomentKernels:
-        """The compiled online form (:class:`~encctl_gym.ident.compiled.MomentKernels`): the
-        weighted moments by a compiled stage, the Jacobi-scaled Cholesky solve compiled
-        (:func:`encctl_gym.ident._moment_kernels.gram_solve`), the copies it refuses by
+        """The compiled online form (:class:`~encctl_gym.ident.compiled.MomentKernels`) with
+        :meth:`online_solve`."""
+        return MomentKernels(self, K, A, B, refresh)
+
+    def online_solve(self, M: np.ndarray, columns: int, n: int, m: int) -> np.ndarray:
+        """:meth:`solve` compiled: the Jacobi-scaled Cholesky solve of every copy
+        (:func:`encctl_gym.ident._moment_kernels.gram_solve`), and for the copies it refuses
         :func:`~encctl_gym.ident.ordinary.gram_solve`'s minimum-norm solve."""
-        n, m = A.shape[0], B.shape[1]
-
-        def solve(M: np.ndarray, columns: int) -> np.ndarray:
-            theta = np.empty((M.shape[0], n, n + m))
-            ok = np.empty(M.shape[0], dtype=bool)
-            mk.gram_solve(M, n, m, theta, ok)
-            if not ok.all():
-                theta[~ok] = gram_solve(M[~ok], n, m)
-            return theta
-
-        return MomentKernels(self, K, A, B, refresh, solve)
+        theta = np.empty((M.shape[0], n, n + m))
+        ok = np.empty(M.shape[0], dtype=bool)
+        mk.gram_solve(M, n, m, theta, ok)
+        if not ok.all():
+            theta[~ok] = gram_solve(M[~ok], n, m)
+        return theta

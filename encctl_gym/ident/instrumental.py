@@ -153,16 +153,13 @@ class InstrumentalVariables(MomentEstimator):
         self, K: int, A: np.ndarray, B: np.ndarray, Q: np.ndarray, refresh: int, cond_limit: float
     ) -> MomentKernels:
         """The compiled online form (:class:`~encctl_gym.ident.compiled.MomentKernels`): the rows
-        ``[zeta_j; z_j; x_{j+1}]`` (from column ``L`` on) by a compiled stage, and two-stage least
-        squares compiled (:func:`encctl_gym.ident._moment_kernels.iv_solve`; NaN where singular,
-        as :meth:`solve`)."""
+        ``[zeta_j; z_j; x_{j+1}]`` (from column ``L`` on) by a compiled stage, with :meth:`online_solve`."""
         n, m = A.shape[0], B.shape[1]
         self.check_dimensions(n, m)
-        q = self.instruments(n, m)
+        return MomentKernels(self, K, A, B, refresh, lags=self.lags_for(n, m))
 
-        def solve(M: np.ndarray, columns: int) -> np.ndarray:
-            theta = np.empty((M.shape[0], n, n + m))
-            mk.iv_solve(M, n, m, q, theta)
-            return theta
-
-        return MomentKernels(self, K, A, B, refresh, solve, lags=self.lags_for(n, m))
+    def online_solve(self, M: np.ndarray, columns: int, n: int, m: int) -> np.ndarray:
+        """:meth:`solve` compiled (:func:`encctl_gym.ident._moment_kernels.iv_solve`; NaN where singular)."""
+        theta = np.empty((M.shape[0], n, n + m))
+        mk.iv_solve(M, n, m, self.instruments(n, m), theta)
+        return theta
