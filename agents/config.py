@@ -52,7 +52,7 @@ from typing import Any
 
 import yaml
 
-from encctl_gym._validation import check_int, format_value
+from encctl_gym._validation import check_int, format_value, read_bounded
 from encctl_gym.envs.config import completion_preset, resolve_params
 from encctl_gym.envs.config import default_config as env_default_config
 from encctl_gym.errors import ConfigError, EncctlError, ParameterError
@@ -130,10 +130,9 @@ def read_yaml(path: str | Path) -> dict[str, Any]:
     p = Path(path)
     if not p.is_file():
         raise ConfigError(f"config file {str(p)!r} does not exist")
-    if p.stat().st_size > MAX_CONFIG_BYTES:
-        raise ConfigError(f"config file {str(p)!r} is larger than {MAX_CONFIG_BYTES} bytes")
+    raw = read_bounded("config file", p, MAX_CONFIG_BYTES, "MAX_CONFIG_BYTES", error=ConfigError)
     try:
-        text = p.read_text()
+        text = raw.decode("utf-8")
         _check_yaml_tokens(text, f"config file {str(p)!r}")
         data = yaml.safe_load(text)
     except ConfigError:

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import ConfigError, EncctlError, ParameterError, ShapeError, UnstableSystemError
+from .errors import ConfigError, EncctlError, ParameterError, ResourceLimitError, ShapeError, UnstableSystemError
 
 __all__ = [
     "one_line",
@@ -40,6 +40,7 @@ __all__ = [
     "spectral_radius",
     "check_schur_stable",
     "check_regular_file",
+    "read_bounded",
     "FLOAT_MAX",
 ]
 
@@ -344,3 +345,46 @@ def check_regular_file(what: str, path: Any) -> str:
         raise ConfigError(f"{what} {name!r} is a directory, not a file")
     kind = next((label for test, label in _FILE_KINDS if test(mode)), "a special file")
     raise ConfigError(f"{what} {name!r} is not a regular file: it is {kind}")
+
+
+def read_bounded(what: str, path: Any, limit: int, limit_name: str, *, error: type[EncctlError] = ResourceLimitError) -> bytes:
+    """The bytes of the file ``path``, the package's one bounded file read: a file of more than
+    ``limit`` bytes is refused before it is read, and at most ``limit + 1`` bytes are ever read
+    (a file that grows meanwhile cannot make it read more).
+
+    Parameters
+    ----------
+    what : str
+        What the file is, for messages (``"system file"``, ``"config file"``, ...).
+    path : str or os.PathLike
+        The file (callers check first that it is a regular file where a FIFO could block).
+    limit : int
+        Most bytes accepted.
+    limit_name : str
+        The constant that holds ``limit``, named in the message.
+    error : type of EncctlError, default ResourceLimitError
+        Raised for a file over the limit.
+
+    Raises
+    ------
+    ConfigError
+        If the file cannot be opened or read.
+    ResourceLimitError
+        (or ``error``) for a file of more than ``limit`` bytes; the message gives both sizes.
+    """
+    name = os.fspath(path)
+
+    def too_large(size: int) -> EncctlError:
+        return error(f"{what} {name!r} has {size} bytes, more than {limit_name} = {limit}")
+
+    try:
+        with open(name, "rb") as f:
+            size = os.fstat(f.fileno()).st_size
+            if size > limit:
+                raise too_large(size)
+            raw = f.read(limit + 1)
+    except OSError as exc:
+        raise ConfigError(f"cannot read {what} {name!r}: {exc.strerror or exc}") from None
+    if len(raw) > limit:
+        raise too_large(len(raw))
+    return raw

@@ -342,7 +342,7 @@ def test_group_files_that_cannot_be_read_are_config_errors(tmp_path):
     with big.open("wb") as f:  # sparse: larger than the bound on paper only
         f.seek(MAX_GROUP_FILE_BYTES)
         f.write(b" ")
-    with pytest.raises(ConfigError, match=rf"larger than MAX_GROUP_FILE_BYTES = {MAX_GROUP_FILE_BYTES}"):
+    with pytest.raises(ConfigError, match=rf"more than MAX_GROUP_FILE_BYTES = {MAX_GROUP_FILE_BYTES}"):
         GroupParams.load(big)
     # a file of exactly the bound is read (and then refused for its content only)
     with big.open("r+b") as f:

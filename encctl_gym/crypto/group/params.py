@@ -23,7 +23,7 @@ from functools import cached_property
 from pathlib import Path
 from typing import Any
 
-from ..._validation import check_bool, check_int, format_value
+from ..._validation import check_bool, check_int, format_value, read_bounded
 from ...errors import ConfigError, GroupError, ParameterError
 from .. import arith
 from ..arith import format_int as fmt
@@ -298,16 +298,7 @@ class GroupParams:
         if verify is not True:
             verify = check_bool("verify", verify)
         shown = format_value(str(source))
-        try:
-            with source.open("rb") as f:
-                raw = f.read(MAX_GROUP_FILE_BYTES + 1)
-        except OSError as exc:
-            raise ConfigError(f"cannot read the group file {shown}: {exc.strerror or exc}") from None
-        if len(raw) > MAX_GROUP_FILE_BYTES:
-            raise ConfigError(
-                f"the group file {shown} is larger than MAX_GROUP_FILE_BYTES = {MAX_GROUP_FILE_BYTES} bytes "
-                "(a group file is a few kilobytes)"
-            )
+        raw = read_bounded("the group file", source, MAX_GROUP_FILE_BYTES, "MAX_GROUP_FILE_BYTES", error=ConfigError)
         try:
             text = raw.decode("utf-8")
         except UnicodeDecodeError as exc:
