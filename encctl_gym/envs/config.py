@@ -67,7 +67,8 @@ def default_config() -> dict[str, Any]:
     ``sigma_w2``                  process noise variance (preset's if ``None``)
     ``sigma_x2``                  variance of x_0 (preset's if ``None``; the paper uses 1)
     ``sigma_u2``                  attacker's average input power per channel (energy budget)
-    ``scheme``                    ``"modified"`` (the paper's), ``"token"``, ``"static"``
+    ``scheme``                    ``"modified"`` (the paper's), ``"token"``, ``"static"``, or any
+                                  row of :data:`encctl_gym.loop.scheme.SCHEMES`
     ``adversary``                 ``"eavesdropper"`` or ``"server"``
     ``security_parameter``        lambda in bits; ``None``: from ``key_length``, else lambda* of
                                   Theorem thm:opt_sec for the preset's design parameters
