@@ -11,13 +11,13 @@ import pytest
 
 from encctl_gym.attacks.forgery import injection_integers
 from encctl_gym.crypto.encoding import Encoder, lift
+from encctl_gym.envs.config import resolve_params
 from encctl_gym.envs.encrypted_lti_attack import EncryptedLTIAttackEnv
 from encctl_gym.errors import ParameterError
-from encctl_gym.envs.config import resolve_params
 from encctl_gym.loop import SCHEMES, ElGamalScheme, EncryptionScheme, LoopSpec, make_scheme
 from encctl_gym.plant import Plant
-from encctl_gym.security.threat import ThreatModel
 from encctl_gym.security.deciphering import independent_keys
+from encctl_gym.security.threat import ThreatModel
 
 SMALL = {"preset": "small", "gamma_opt": False, "key_length": 64, "max_samples": 25, "warmup_steps": 3}
 
