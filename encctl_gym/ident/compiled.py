@@ -226,6 +226,7 @@ class MomentKernels:
         self.d = self.n + self.m
         self.K = K
         self.estimator = estimator
+        estimator.check_online_memory(K, self.n, self.m)  # before the moments are allocated
         self.theta_true = np.hstack([A, B])
         self.c = float(self.n * self.d)  # Definition def:error
         self.M = np.zeros((K, estimator.features(self.n, self.m), estimator.features(self.n, self.m)))
