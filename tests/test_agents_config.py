@@ -226,7 +226,7 @@ def test_billion_laughs_is_refused_before_expansion(tmp_path):
         read_yaml(f)
     big = tmp_path / "big.yaml"
     big.write_text("x: " + "1" * (1 << 20) + "\n")
-    with pytest.raises(ConfigError, match="larger than"):
+    with pytest.raises(ConfigError, match="more than MAX_CONFIG_BYTES"):
         read_yaml(big)
 
 
@@ -474,7 +474,7 @@ def test_run_json_parse_failures_are_config_errors(tmp_path, monkeypatch):
         read_run(d)
     _run_dir(tmp_path, {"algo": "ppo", "observation": "full", "env": {}, "pad": "x" * 200})
     monkeypatch.setattr(runs, "MAX_RUN_FILE_BYTES", 100)
-    with pytest.raises(ConfigError, match=r"run.json has \d+ bytes; a run.json has at most 100"):
+    with pytest.raises(ConfigError, match=r"run.json' has \d+ bytes, more than MAX_RUN_FILE_BYTES = 100"):
         read_run(d)
 
 

@@ -443,7 +443,7 @@ def test_helper_thread_gives_the_same_numbers_through_refreshes_and_early_resets
     """The helper thread (noise drawn ahead, Gram catch-up) changes where work runs, not the
     numbers: a vector env with it matches single envs without it, step for step, through noise
     chunks, Gram hand-overs, exact refreshes, the episode end and resets in mid-episode."""
-    from encctl_gym.envs.episode import EpisodeSchedule
+    from encctl_gym.envs.schedule import EpisodeSchedule
 
     schedule = EpisodeSchedule(chunk=16, gram_batch=4, refresh=40)  # many chunk, hand-over and refresh boundaries
     K, cfg = 4, {**SMALL, "scheme": "static", "max_samples": 150}

@@ -12,7 +12,8 @@ from .._validation import format_value
 from ..errors import ParameterError
 from ..loop import LoopBackend, defender_for, make_loop
 from .config import AttackParams, default_config, resolve_params
-from .episode import EpisodeCore, EpisodeSchedule, attack_design_for, check_episode_memory
+from .episode import EpisodeCore, attack_design_for
+from .schedule import EpisodeSchedule, check_episode_memory
 
 __all__ = ["EncryptedLTIAttackEnv", "reset_options", "check_seed"]
 

@@ -23,8 +23,9 @@ from ..errors import ParameterError
 from ..loop import defender_for, make_loop
 from .config import AttackParams, resolve_params
 from .encrypted_lti_attack import check_seed, reset_options
-from .episode import EpisodeCore, EpisodeSchedule, attack_design_for, check_episode_memory
+from .episode import EpisodeCore, attack_design_for
 from .helper import HelperThread
+from .schedule import EpisodeSchedule, check_episode_memory
 
 __all__ = ["EncryptedLTIAttackVectorEnv"]
 

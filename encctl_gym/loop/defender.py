@@ -32,13 +32,16 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol, overload, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, overload, runtime_checkable
 
 import numpy as np
 
 from .._validation import as_finite_array, format_value
 from ..errors import ParameterError
 from .backend import loop_group
+
+if TYPE_CHECKING:
+    from ..envs.config import AttackParams
 
 __all__ = [
     "DefenderAction",
@@ -154,7 +157,7 @@ class DefenderPolicy(Protocol):
 
     name: str
 
-    def group(self, params: Any) -> Any:
+    def group(self, params: AttackParams) -> Any:
         """The group the loop runs on (its key length), for the environment's resolved ``params``."""
         ...
 
@@ -174,7 +177,7 @@ class FixedDefender:
 
     name = "fixed"
 
-    def group(self, params: Any) -> Any:
+    def group(self, params: AttackParams) -> Any:
         """:func:`~encctl_gym.loop.backend.loop_group` of ``params.key_length``."""
         return loop_group(params.key_length)
 

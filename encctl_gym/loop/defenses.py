@@ -24,7 +24,7 @@ of all (the environment's ``info["detected"]``).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -34,6 +34,9 @@ from ..errors import ParameterError
 from .backend import loop_group, lqr_gain, table_limit
 from .defender import DEFENDERS, DefenderAction, PlantView
 from .detection import Audit, ChiSquaredDetector, CusumDetector, check_audit_rate
+
+if TYPE_CHECKING:
+    from ..envs.config import AttackParams
 
 __all__ = ["AuditDefender", "CusumDefender", "DetectorDefender", "NoiseDefender", "audit_tolerance"]
 
@@ -58,7 +61,7 @@ class _PlantSidePolicy:
 
     name = "plant-side"
 
-    def group(self, params: Any) -> Any:
+    def group(self, params: AttackParams) -> Any:
         self.A = np.asarray(params.A, dtype=float)
         self.B = np.asarray(params.B, dtype=float)
         self.Phi = -lqr_gain(self.A, self.B)

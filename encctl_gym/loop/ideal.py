@@ -11,7 +11,7 @@ copies; the environment's compiled step runs its per-period arithmetic itself fr
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -19,6 +19,9 @@ from .._validation import format_value
 from ..errors import EncodingOverflowError, ResourceLimitError
 from .backend import lqr_gain, table_limit
 from .quantize import OK, Quantization, collect_states, forge_inputs
+
+if TYPE_CHECKING:
+    from ..envs.config import AttackParams
 
 __all__ = ["IdealLoop", "MAX_TABLE_LIMIT"]
 
@@ -46,7 +49,8 @@ class IdealLoop:
     #: nothing is broken: the time charged is the cost model's
     deciphering_seconds = 0.0
 
-    def __init__(self, params: Any, group: Any) -> None:
+    def __init__(self, params: AttackParams, group: Any) -> None:
+
         self.delta = float(params.delta)
         self.x_bound = float(params.x_bound)
         self.n, self.m = params.n, params.m

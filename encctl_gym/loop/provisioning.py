@@ -124,17 +124,24 @@ def rotate_elgamal_loop(loop: Any, group: GroupParams) -> ProvisioningCost:
     adversary's decipherer for the group, KeyGen and ``Enc(pk_0', Ecd(Phi))`` to a new server
     (``loop.provision()``); returns what was sent, counted on the server's ciphertexts."""
     from ..attacks.decipherer import make_decipherer
-    from ..crypto.encoding import Encoder
 
     t0 = time.perf_counter()
     if not isinstance(loop.decipherer, GroupDecipherers):
         loop.decipherer = GroupDecipherers(
             loop.decipherer,
             loop.group,
-            lambda g: make_decipherer(loop.params, g, lambda: loop.plant.secret_key, loop.random_sources["breaker"]),
+            lambda g: make_decipherer(
+                loop.params.breaker,
+                g,
+                lambda: loop.encryption.oracle_secret(loop.plant),
+                scheme=loop.encryption,
+                adversary=loop.params.adversary,
+                time_limit=loop.params.breaker_time_limit,
+                rng=loop.random_sources["breaker"],
+            ),
         )
     loop.group = group
-    loop.encoder = Encoder(group, float(loop.params.delta))
+    loop.encoder = loop.encryption.encoder(group, float(loop.params.delta))
     loop.decipherer.move_to(group)
     loop.provision()
     encryptions = sum(len(row) for row in loop.server.ct_phi)

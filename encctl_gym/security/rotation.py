@@ -35,7 +35,7 @@ import numpy as np
 from .._validation import as_finite_array, check_int, format_value
 from ..errors import ParameterError
 from .cost_models import CostModel, KeyBreakCost, PaperModel
-from .deciphering import independent_keys, sample_deciphering_time
+from .deciphering import KeyExposure, independent_keys, sample_deciphering_time
 from .defenses import rotated_deciphering_operations, rotation_precomputations
 from .exact import decimal_fraction
 
@@ -54,7 +54,7 @@ def check_rotation_period(every: Any, name: str = "rotate_group_every") -> int:
 
 
 def rotated_operations(
-    N: Any, cost: KeyBreakCost, every: Any, *, scheme: str = "modified", adversary: str = "eavesdropper"
+    N: Any, cost: KeyBreakCost, every: Any, *, scheme: str | KeyExposure = "modified", adversary: str = "eavesdropper"
 ) -> float:
     """The attacker's work for ``N`` samples when the group rotates every ``every`` steps (module
     docstring), in operations: :func:`~encctl_gym.security.defenses.rotated_deciphering_operations`
@@ -70,7 +70,7 @@ def rotated_operations(
 
 
 def rotated_deciphering_time(
-    N: Any, cost: KeyBreakCost, upsilon: Any, every: Any, *, scheme: str = "modified", adversary: str = "eavesdropper"
+    N: Any, cost: KeyBreakCost, upsilon: Any, every: Any, *, scheme: str | KeyExposure = "modified", adversary: str = "eavesdropper"
 ) -> float | np.ndarray:
     """``tau(N)`` in seconds under rotation every ``every`` steps (module docstring).
 
@@ -99,7 +99,7 @@ def rotated_deciphering_time(
 
 
 def rotated_affordable_samples(
-    tau_c: Any, cost: KeyBreakCost, upsilon: Any, every: Any, *, scheme: str = "modified", adversary: str = "eavesdropper"
+    tau_c: Any, cost: KeyBreakCost, upsilon: Any, every: Any, *, scheme: str | KeyExposure = "modified", adversary: str = "eavesdropper"
 ) -> int:
     """The largest ``N`` with ``tau(N) <= tau_c`` under rotation every ``K = every`` steps, exactly.
 
@@ -141,7 +141,7 @@ class _GroupCharged(CostModel):
 
 
 def rotated_minimum_key_length(
-    model: CostModel, N_star: Any, every: Any, budget: Fraction, *, scheme: str = "modified", adversary: str = "eavesdropper"
+    model: CostModel, N_star: Any, every: Any, budget: Fraction, *, scheme: str | KeyExposure = "modified", adversary: str = "eavesdropper"
 ) -> int:
     """The smallest key length ``k`` whose ``N*`` samples, in groups of ``K = every``, cost more than
     ``budget`` (``Upsilon tau_c``) operations under ``model`` (eq:opt_key with the work of the
