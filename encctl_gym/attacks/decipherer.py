@@ -99,6 +99,9 @@ class KeyBreaking:
         :class:`~encctl_gym.errors.BreakerTimeoutError`.
     rng
         The breaker's random source (its walks, its randomised descents).
+    precomputation : str, optional
+        A precomputation file the breaker loads (``breaker_precomputation``; the index calculus),
+        checked against ``group`` here.
 
     Raises
     ------
@@ -118,10 +121,11 @@ class KeyBreaking:
         adversary: str,
         time_limit: float = DEFAULT_BREAKER_TIME_LIMIT,
         rng: Any = None,
+        precomputation: Any = None,
     ) -> None:
         from ..cryptanalysis import TokenChain, get_breaker
 
-        b = get_breaker(breaker, rng=rng)
+        b = get_breaker(breaker, rng=rng, **({} if precomputation is None else {"precomputation": precomputation}))
         if scheme == "token" and adversary == "server" and not isinstance(b, TokenChain):
             b = TokenChain(b, rng=rng)
         b.check_time(
@@ -201,4 +205,5 @@ def make_decipherer(params: Any, group: Any, read_key: Callable[[], Any], rng: A
         adversary=params.adversary,
         time_limit=getattr(params, "breaker_time_limit", DEFAULT_BREAKER_TIME_LIMIT),
         rng=rng,
+        precomputation=getattr(params, "breaker_precomputation", None),
     )

@@ -167,7 +167,7 @@ class SavedPrecomputation:
             fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent if str(target.parent) else ".")
             try:
                 with os.fdopen(fd, "wb") as f:
-                    np.savez_compressed(f, **arrays)
+                    np.savez_compressed(f, **arrays)  # type: ignore[arg-type]
                 os.replace(tmp, target)
             except BaseException:
                 Path(tmp).unlink(missing_ok=True)
