@@ -28,7 +28,7 @@ The phases
 1. **Factor base** (:class:`~.smoothness.FactorBase`): the primes ``l <= B``, with B chosen by
    the cost model :func:`choose_bound` (Dickman's rho for the smoothness probability, the
    measured cost of a sieved cell and of the linear algebra).
-2. **Relation collection** (:func:`collect_relations`): for ``y = g^e`` every pair
+2. **Relation collection** (:func:`~.relations.collect_relations`): for ``y = g^e`` every pair
    ``a = b y (mod p)`` of y's lattice (:mod:`.lattice_sieve`: a reduced basis of about
    ``sqrt(p)``, a region of small combinations sieved row by row) with a and b B-smooth gives
    ``lambda(y) = lambda(|a|) - lambda(|b|)`` (by (i) and (ii)), the relation
@@ -43,6 +43,13 @@ Phases 1-3 depend only on (p, q, g): they are the precomputation. Phase 4 needs 
 relation's worth of sieving per key (usually one lattice), a small fraction of the
 precomputation, so after the first key a dynamic-key sequence (Example ex:dyn_elgamal) costs
 little per key.
+
+The precomputation is plain data: :meth:`FactorBaseLogs.save` writes it to a file that
+``IndexCalculus(precomputation=path)`` loads, checked against its group
+(:mod:`.precomputation_file`); phases 2 and 3 report their progress to a callback
+(:mod:`.progress`), and a ``KeyboardInterrupt`` there ends the call with
+:class:`~.precomputation_file.PrecomputationInterrupted`, which carries the relations collected
+so far and the position of the residue walk, to save and resume from.
 """
 
 from __future__ import annotations
