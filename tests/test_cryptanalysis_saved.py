@@ -166,6 +166,24 @@ def test_an_interrupted_collection_is_saved_and_resumed(group, tmp_path) -> None
     assert pow(group.g, pre.break_key(_key(group, s)).s, group.p) == _key(group, s)
 
 
+def test_an_interruption_in_the_linear_algebra_keeps_every_relation(group, tmp_path, monkeypatch) -> None:
+    def stop_in_linear_algebra(phase: str, done: float, total: float | None) -> None:
+        if phase.startswith("linear algebra"):
+            raise KeyboardInterrupt
+
+    with pytest.raises(PrecomputationInterrupted) as stop:
+        get_breaker("index-calculus", rng=9).precompute(group, progress=stop_in_linear_algebra)
+    assert stop.value.phase == "linear algebra"
+    state = stop.value.state
+    k = len(ic.FactorBase(state.bound))
+    assert len(state.relations) >= k  # the collection was complete
+    path = state.save(tmp_path / "la.npz")
+    _no_sieving(monkeypatch)  # the resumed run goes straight to the linear algebra
+    pre = IndexCalculus(precomputation=path, rng=9).precompute(group)
+    s = 4242 % group.q
+    assert pow(group.g, pre.break_key(_key(group, s)).s, group.p) == _key(group, s)
+
+
 def test_a_relation_altered_in_the_file_is_refused(group, tmp_path) -> None:
     with pytest.raises(PrecomputationInterrupted) as stop:
         get_breaker("index-calculus", rng=4).precompute(group, progress=_stop_after(40))

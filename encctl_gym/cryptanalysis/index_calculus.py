@@ -220,7 +220,6 @@ class _PhaseClock:
         self.wall: dict[str, float] = {"factor_base": 0.0, "relations": 0.0, "linear_algebra": 0.0, **(wall or {})}
         self.cpu: dict[str, float] = {"factor_base": 0.0, "relations": 0.0, "linear_algebra": 0.0, **(cpu or {})}
         self._name = ""
-        self._inside = False
 
     def __call__(self, name: str) -> _PhaseClock:
         self._name = name
@@ -228,15 +227,13 @@ class _PhaseClock:
 
     @property
     def current(self) -> str:
-        """The phase running now (``""`` between phases), with a space for the underscore."""
-        return self._name.replace("_", " ") if self._inside else ""
+        """The phase entered last (running, or ended by an exception), with a space for the underscore."""
+        return self._name.replace("_", " ")
 
     def __enter__(self) -> None:
-        self._inside = True
         self._t0, self._c0 = time.perf_counter(), time.process_time()
 
     def __exit__(self, *exc: object) -> None:
-        self._inside = False
         self.wall[self._name] += time.perf_counter() - self._t0
         self.cpu[self._name] += time.process_time() - self._c0
 
@@ -556,8 +553,9 @@ class IndexCalculus(Breaker):
         logs: list[int | None] = [None] * k
         small = sum(1 for ell in fb.primes if ell <= max(2, math.isqrt(min(fb.bound, group.p))))
         for _ in range(self.MAX_ROUNDS):
-            with clock("relations"):
-                collect_relations(group, fb, relations, need, walk, deadline, counts)
+            if len(relations) < need:  # a resumed collection may have them all
+                with clock("relations"):
+                    collect_relations(group, fb, relations, need, walk, deadline, counts)
             # The elimination runs inside FLINT and cannot be interrupted: refuse it up front
             # when the cost model says it would overrun the time limit.
             expected = cost_model(group.bits, fb.bound)["linear_algebra"]
