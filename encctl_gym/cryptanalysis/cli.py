@@ -186,7 +186,7 @@ def _interrupted(stop: PrecomputationInterrupted, save: str | None) -> int:
     return 130
 
 
-def _phase_lines(pre: Any, loaded: str | None, saved: str | None) -> list[str]:
+def _phase_lines(pre: Any, loaded: Any, saved: str | None) -> list[str]:
     # The time of each phase of the index calculus's precomputation, and where it came from or went.
     lines = []
     if isinstance(pre, FactorBaseLogs) and pre.phase_seconds:
@@ -197,7 +197,10 @@ def _phase_lines(pre: Any, loaded: str | None, saved: str | None) -> list[str]:
         lines.append(f"phases (wall, CPU): {phases}; the descent is each key's time below")
         lines.append(f"factor base: {len(pre.logs)} primes up to {pre.bound}, {pre.solved} logarithms solved")
     if loaded is not None:
-        lines.append(f"precomputation loaded from {loaded} (checked against this group); its time is the file's")
+        lines.append(
+            f"precomputation loaded from {loaded.path} in {format_seconds(loaded.read_seconds)} (read and checked: "
+            "every logarithm, and the group); the time shown above is the file's"
+        )
     if saved is not None:
         lines.append(f"precomputation saved to {saved}")
     return lines
@@ -290,7 +293,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"crack: {breaker.name} on a {group.bits}-bit {source} group (p = {group.p:#x}), {n} keys of one dynamic-key sequence")
     cost = report.precomputation
     print(f"precomputation: {format_seconds(cost.seconds)}  ({_ops(dict(cost.operations))})")
-    for line in _phase_lines(pre, args.load_precomputation, save):
+    for line in _phase_lines(pre, getattr(breaker, "loaded", None), save):
         print(line)
     print(f"{'t':>5}  {'seconds':>12}  {'cpu seconds':>12}  {'method':<15} operations")
     for i, key in enumerate(report.keys):

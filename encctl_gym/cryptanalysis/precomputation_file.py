@@ -32,6 +32,7 @@ import dataclasses
 import json
 import os
 import tempfile
+import time
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -93,6 +94,8 @@ class SavedPrecomputation:
         Wall and CPU seconds per phase so far.
     path : str or None
         The file it was loaded from.
+    read_seconds : float
+        Wall seconds :func:`load_precomputation` took to read and check it (0 if not loaded).
     """
 
     group: GroupParams
@@ -104,6 +107,7 @@ class SavedPrecomputation:
     phase_seconds: dict[str, float] = dataclasses.field(default_factory=dict)
     phase_cpu_seconds: dict[str, float] = dataclasses.field(default_factory=dict)
     path: str | None = None
+    read_seconds: float = 0.0
 
     @property
     def complete(self) -> bool:
@@ -168,6 +172,9 @@ class SavedPrecomputation:
             try:
                 with os.fdopen(fd, "wb") as f:
                     np.savez_compressed(f, **arrays)  # type: ignore[arg-type]
+                mask = os.umask(0)
+                os.umask(mask)
+                os.chmod(tmp, 0o666 & ~mask)  # mkstemp's 0600 -> what open() would have given
                 os.replace(tmp, target)
             except BaseException:
                 Path(tmp).unlink(missing_ok=True)
@@ -263,6 +270,7 @@ def load_precomputation(path: str | os.PathLike[str]) -> SavedPrecomputation:
         the entry); :class:`~encctl_gym.errors.ResourceLimitError` if its arrays exceed
         :data:`MAX_FILE_BYTES`.
     """
+    start = time.perf_counter()
     name = check_regular_file("precomputation file", path)
     arrays = _read_arrays(name)
     header = _header(name, arrays)
@@ -322,4 +330,4 @@ def load_precomputation(path: str | os.PathLike[str]) -> SavedPrecomputation:
             relations.append(Relation((row, r)))
     else:
         raise _fail(name, "has a header that is neither complete nor a relation collection with its walk")
-    return SavedPrecomputation(group, bound, logs, relations, walk, cost, phases[0], phases[1], name)
+    return SavedPrecomputation(group, bound, logs, relations, walk, cost, phases[0], phases[1], name, time.perf_counter() - start)
