@@ -256,6 +256,7 @@ def test_crack_with_a_loaded_file_does_not_sieve(saved, capsys, monkeypatch) -> 
 
 
 # ----------------------------------------------------------------------------- environment
+@pytest.mark.slow
 def test_the_environment_loads_the_file_and_recovers_the_plant_keys(saved, monkeypatch) -> None:
     from encctl_gym.envs import EncryptedLTIAttackEnv
 
