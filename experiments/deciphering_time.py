@@ -47,8 +47,18 @@ CSV ``deciphering_time_fit.csv``, one row per (breaker, bits), from the CPU time
 ``N_max``, ``precompute`` (the sequence group's), ``fresh`` (number of fresh groups), and
 ``T_first_wall``, ``T_1_wall``, ``ratio_wall`` from the wall-clock times.
 
+``deciphering_lp_fit.txt``: the first key's CPU time of the index calculus and of PARI fitted to
+``L_p[1/2, c]`` from 64 bits (:func:`experiments.deciphering_models.fit_lp_half`: a and c with
+95% intervals), also drawn in ``deciphering_models.png``.
+
 Usage: ``python experiments/deciphering_time.py [--quick] [--out DIR] [--seed S] [--n-jobs J]``
-(also ``encctl-gym reproduce --only deciphering``).
+(also ``encctl-gym reproduce --only deciphering``). ``--large`` adds the index calculus at 112 and
+128 bits (:data:`LARGE_PLAN`, about 6 minutes of CPU more); ``--breakers NAME ...`` measures only
+those breakers' plans; with ``--from-csv PATH`` as well, the measured rows replace those of the
+same (breaker, bits) in the recorded file and the rest is kept::
+
+    python experiments/deciphering_time.py --from-csv docs/figures/deciphering_time.csv
+        --breakers index-calculus --large --out docs/figures
 """
 
 from __future__ import annotations
