@@ -56,6 +56,10 @@ class LpFit:
     a_interval, c_interval : tuple of float
         Confidence intervals at ``level`` (Student t, ``len(bits) - 2`` degrees of freedom).
     level : float
+    cov : tuple of tuple of float
+        The covariance of ``(ln a, c)`` (residual variance times ``(X^T X)^-1``).
+    t : float
+        The Student quantile of the intervals.
     """
 
     breaker: str
@@ -66,10 +70,21 @@ class LpFit:
     a_interval: tuple[float, float]
     c_interval: tuple[float, float]
     level: float
+    cov: tuple[tuple[float, float], tuple[float, float]] = ((math.nan, math.nan), (math.nan, math.nan))
+    t: float = math.nan
 
     def __call__(self, bits: Any) -> np.ndarray:
         """The fitted time at ``bits``."""
         return self.a * np.exp(self.c * lp_half_exponent(bits))
+
+    def band(self, bits: Any) -> tuple[np.ndarray, np.ndarray]:
+        """The confidence band of the fitted time at ``bits`` (at :attr:`level`):
+        ``exp(ln fit -+ t sqrt(x^T cov x))`` with ``x = (1, sqrt(ln p ln ln p))``."""
+        x = lp_half_exponent(bits)
+        cov = np.array(self.cov)
+        se = np.sqrt(cov[0, 0] + 2 * x * cov[0, 1] + x * x * cov[1, 1])
+        mid = self(bits)
+        return mid * np.exp(-self.t * se), mid * np.exp(self.t * se)
 
 
 def fit_lp_half(breaker: str, bits: Sequence[int], seconds: Sequence[float], *, level: float = 0.95) -> LpFit:
@@ -107,6 +122,8 @@ def fit_lp_half(breaker: str, bits: Sequence[int], seconds: Sequence[float], *, 
         (math.exp(ln_a - half[0]), math.exp(ln_a + half[0])),
         (c - half[1], c + half[1]),
         level,
+        ((float(cov[0, 0]), float(cov[0, 1])), (float(cov[1, 0]), float(cov[1, 1]))),
+        t,
     )
 
 
@@ -182,20 +199,19 @@ def _first_key_panel(
     # first measured size in range (they count operations, not seconds).
     from encctl_gym.cryptanalysis.index_calculus import choose_bound, cost_model
 
+    colors = {"index-calculus": "tab:blue", "pari": "tab:orange"}
+    measured = []
     for breaker, marker in (("index-calculus", "o"), ("pari", "s")):
         mine = sorted((f for f in fits if f["breaker"] == breaker), key=lambda f: f["bits"])
+        measured += [float(f["T_first"]) for f in mine]
         if mine:
-            ax.semilogy([f["bits"] for f in mine], [f["T_first"] for f in mine], marker, ms=5, label=f"measured: {breaker}")
+            ax.semilogy([f["bits"] for f in mine], [f["T_first"] for f in mine], marker, ms=5, color=colors[breaker],
+                        label=f"measured: {breaker}")  # fmt: skip
     for f in lp_fits(fits):
         b = np.arange(min(f.bits), max(f.bits) + 1)
-        ax.semilogy(
-            b, f(b), lw=1.6, label=f"fit {f.breaker}: $L_p[1/2, {f.c:.2f}]$ [{f.c_interval[0]:.2f}, {f.c_interval[1]:.2f}]"
-        )
-        if f.breaker == "index-calculus":
-            x, x0 = lp_half_exponent(b), lp_half_exponent(f.bits[0])
-            t0 = float(f(f.bits[0]))
-            lo, hi = (t0 * np.exp(c * (x - x0)) for c in f.c_interval)
-            ax.fill_between(b, np.minimum(lo, hi), np.maximum(lo, hi), alpha=0.15, color="tab:blue")
+        label = f"fit {f.breaker}: $L_p[1/2, {f.c:.2f}]$, c in [{f.c_interval[0]:.2f}, {f.c_interval[1]:.2f}] ({f.level:.0%})"
+        ax.semilogy(b, f(b), lw=1.6, color=colors[f.breaker], label=label)
+        ax.fill_between(b, *f.band(b), alpha=0.15, color=colors[f.breaker])
     ic = sorted((f for f in fits if f["breaker"] == "index-calculus"), key=lambda f: f["bits"])
     if ic:
         lo_bits = max(int(grid_bits[0]), 24)
@@ -210,6 +226,8 @@ def _first_key_panel(
                 continue  # the precomputation model's first key is the paper's
             ax.semilogy(grid_bits, anchor["T_first"] * np.exp2(first - first[at]), color=color, ls=ls, lw=1.2,
                         label=f"model {name}: shape, scaled at {anchor['bits']} bits")  # fmt: skip
+    if measured:  # the models' shapes leave the measured range quickly: keep the data readable
+        ax.set_ylim(min(measured) / 10, max(measured) * 100)
     ax.set_xlabel("bit length of $p$")
     ax.set_ylabel("first key $T_{first}$ (CPU seconds)")
     ax.set_title(r"one key from scratch: measured, fitted $L_p[1/2, c]$ and the cost models", fontsize=9)
