@@ -497,6 +497,12 @@ def test_lp_half_fit_against_scipy_linregress() -> None:
     assert f.c_interval == pytest.approx((ref.slope - t * ref.stderr, ref.slope + t * ref.stderr), rel=1e-10)
     lo, hi = f.a_interval
     assert lo < f.a < hi and math.log(hi / f.a) == pytest.approx(t * ref.intercept_stderr, rel=1e-10)
+    resid = np.log(seconds) - (ref.intercept + ref.slope * x)
+    s2 = float(resid @ resid) / (len(bits) - 2)
+    for b, xb in ((72, x[1]), (160, math.sqrt(160 * math.log(2) * math.log(160 * math.log(2))))):
+        se = math.sqrt(s2 * (1 / len(bits) + (xb - x.mean()) ** 2 / float(((x - x.mean()) ** 2).sum())))
+        lo, hi = f.band([b])
+        assert float(hi[0]) / float(f(b)) == pytest.approx(math.exp(t * se), rel=1e-9) and lo[0] < f(b) < hi[0]
     exact = fit_lp_half("x", bits[:3], 2e-6 * np.exp(0.9 * x[:3]))
     assert exact.c == pytest.approx(0.9, rel=1e-10) and exact.a == pytest.approx(2e-6, rel=1e-8)
     with pytest.raises(ParameterError, match="at least three sizes"):
