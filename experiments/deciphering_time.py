@@ -47,8 +47,18 @@ CSV ``deciphering_time_fit.csv``, one row per (breaker, bits), from the CPU time
 ``N_max``, ``precompute`` (the sequence group's), ``fresh`` (number of fresh groups), and
 ``T_first_wall``, ``T_1_wall``, ``ratio_wall`` from the wall-clock times.
 
+``deciphering_lp_fit.txt``: the first key's CPU time of the index calculus and of PARI fitted to
+``L_p[1/2, c]`` from 64 bits (:func:`experiments.deciphering_models.fit_lp_half`: a and c with
+95% intervals), also drawn in ``deciphering_models.png``.
+
 Usage: ``python experiments/deciphering_time.py [--quick] [--out DIR] [--seed S] [--n-jobs J]``
-(also ``encctl-gym reproduce --only deciphering``).
+(also ``encctl-gym reproduce --only deciphering``). ``--large`` adds the index calculus at 112 and
+128 bits (:data:`LARGE_PLAN`, about 6 minutes of CPU more); ``--breakers NAME ...`` measures only
+those breakers' plans; with ``--from-csv PATH`` as well, the measured rows replace those of the
+same (breaker, bits) in the recorded file and the rest is kept::
+
+    python experiments/deciphering_time.py --from-csv docs/figures/deciphering_time.csv
+        --breakers index-calculus --large --out docs/figures
 """
 
 from __future__ import annotations
@@ -68,6 +78,7 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 import numpy as np
 from encctl_gym.experiments.common import add_common_arguments, ensure_out_dir, entry_point
+from encctl_gym.experiments.deciphering_models import format_lp_fits, lp_fits, model_curves, plot_models
 
 from encctl_gym.cryptanalysis import get_breaker, pari_available
 from encctl_gym.cryptanalysis.keys import key_sequence
@@ -82,6 +93,9 @@ __all__ = [
     "Plan",
     "FULL_PLAN",
     "QUICK_PLAN",
+    "LARGE_PLAN",
+    "select_plan",
+    "merge_rows",
     "COLUMNS",
     "FIT_COLUMNS",
     "n_grid",
@@ -161,10 +175,49 @@ FULL_PLAN: tuple[Plan, ...] = (
     )
     + _plans("token-chain", ((32, 64, 1), (48, 64, 1), (64, 64, 1), (80, 64, 1)))
 )
+#: The index calculus's large sizes (``--large``): about 30 s of CPU for the first key at 112 bits
+#: and 4 to 5 minutes at 128 (one sequence, no fresh group: T_first is the sequence's first key).
+LARGE_PLAN: tuple[Plan, ...] = _plans("index-calculus", ((112, 16, 1), (128, 8, 0)))
 #: A smoke test of a few seconds (``--quick``; run by ``reproduce --quick`` in the tests).
 QUICK_PLAN: tuple[Plan, ...] = tuple(
     Plan(b, bits, 8, 1) for b in ("bsgs", "rho", "rho-multi", "pari", "index-calculus", "token-chain") for bits in (24, 32)
 )
+
+
+def select_plan(quick: bool, large: bool, breakers: Sequence[str] | None) -> list[Plan]:
+    """The plans of a run: :data:`QUICK_PLAN` or :data:`FULL_PLAN`, with :data:`LARGE_PLAN` if
+    ``large``, restricted to ``breakers`` (all when ``None``).
+
+    Raises
+    ------
+    ParameterError
+        For ``quick`` with ``large``, an unknown breaker, or a selection with no plan.
+    """
+    if quick and large:
+        raise ParameterError("--large measures the large sizes and --quick a smoke test: choose one")
+    plan = list(QUICK_PLAN if quick else FULL_PLAN) + (list(LARGE_PLAN) if large else [])
+    if breakers is not None:
+        known = sorted({p.breaker for p in FULL_PLAN})
+        unknown = [b for b in breakers if b not in known]
+        if unknown:
+            raise ParameterError(f"--breakers: unknown {', '.join(map(repr, unknown))}; choose from {', '.join(known)}")
+        plan = [p for p in plan if p.breaker in breakers]
+    if not plan:
+        raise ParameterError("the plan is empty")
+    return plan
+
+
+def merge_rows(recorded: Sequence[dict[str, Any]], measured: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """``recorded`` rows with those of every (breaker, bits) measured anew replaced by ``measured``
+    (the recorded order kept, new sizes after their breaker's rows)."""
+    new = {(r["breaker"], int(r["bits"])) for r in measured}
+    kept = [r for r in recorded if (r["breaker"], int(r["bits"])) not in new]
+    order = list(dict.fromkeys(r["breaker"] for r in [*recorded, *measured]))
+    out = []
+    for breaker in order:
+        rows = [r for r in kept if r["breaker"] == breaker] + [r for r in measured if r["breaker"] == breaker]
+        out += sorted(rows, key=lambda r: int(r["bits"]))  # stable: a size's rows keep their order
+    return out
 
 
 def n_grid(keys: int) -> list[int]:
@@ -456,99 +509,6 @@ def plot(rows: Sequence[dict[str, Any]], path: str | Path) -> Path:
     return path
 
 
-def model_curves(
-    bits: Sequence[int] | np.ndarray, n: Sequence[int] | np.ndarray, *, model_bits: int
-) -> dict[str, dict[str, np.ndarray]]:
-    """What each deciphering-cost model of :mod:`encctl_gym.security.cost_models` predicts, in the
-    units the measurements can be compared with (ratios: the models count abstract operations):
-
-    ``ratio``: ``T_1 / T_first`` of a key length, ``C_next / C_first`` (nan where the model's
-    formula is not valid, the GNFS models below 40 bits); ``tau``: ``tau(N) / T_first`` at
-    ``model_bits``, ``(C_first + (N - 1) C_next) / C_first``.
-    """
-    from encctl_gym.errors import ModelRangeError
-    from encctl_gym.security.cost_models import DECIPHERING_MODELS, deciphering_model
-
-    out: dict[str, dict[str, np.ndarray]] = {}
-    n_arr = np.asarray(n, dtype=float)
-    for name in DECIPHERING_MODELS:
-        model = deciphering_model(name)
-        ratio = []
-        for k in bits:
-            try:
-                c = model.break_cost(int(k))
-            except ModelRangeError:
-                ratio.append(float("nan"))
-            else:
-                ratio.append(float(c.next / c.first))
-        c = model.break_cost(int(model_bits))
-        r = float(c.next / c.first)
-        out[name] = {"ratio": np.array(ratio), "tau": 1.0 + (n_arr - 1.0) * r}
-    return out
-
-
-def plot_models(rows: Sequence[dict[str, Any]], path: str | Path, *, model_bits: int = 64) -> Path:
-    """The measured deciphering time overlaid on each cost model, in one figure.
-
-    Left: ``T_1 / T_first`` against the bit length, measured per breaker (markers) and predicted
-    by the ``paper``, ``precomputation`` and ``generic`` models (lines). Right: ``tau(N) / T_first``
-    of each breaker's largest size against N, with the models' ``tau(N) / T_first`` at
-    ``model_bits``. Ratios only: the models count abstract operations, the breakers CPU seconds.
-    """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fits = fit(rows)
-    breakers = list(dict.fromkeys(r["breaker"] for r in rows))
-    all_bits = sorted({int(f["bits"]) for f in fits})
-    grid_bits = np.arange(min(all_bits), max(all_bits) + 1)
-    n_max = max(int(r["N"]) for r in rows)
-    n_line = np.unique(np.geomspace(1, n_max, 50).round())
-    curves = model_curves(grid_bits, n_line, model_bits=model_bits)
-    styles = {"paper": ("k", "-"), "precomputation": ("tab:red", "--"), "generic": ("tab:gray", ":")}
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 5.8))
-    for breaker in breakers:
-        mine = sorted((f for f in fits if f["breaker"] == breaker), key=lambda f: f["bits"])
-        ratio = np.array([f["ratio"] for f in mine])
-        ax1.semilogy([f["bits"] for f in mine], np.where(ratio > 0, ratio, np.nan), "o", ms=5, label=f"measured: {breaker}")
-        bits = max(f["bits"] for f in mine)
-        t_first = next(f["T_first"] for f in mine if f["bits"] == bits)
-        seq = sorted(
-            (r for r in rows if r["breaker"] == breaker and int(r["bits"]) == bits and r["kind"] == "sequence"),
-            key=lambda r: int(r["N"]),
-        )
-        ax2.loglog(
-            [int(r["N"]) for r in seq],
-            [float(r["tau"]) / t_first for r in seq],
-            "o-",
-            ms=3,
-            lw=1.2,
-            label=f"{breaker}, {bits} bits",
-        )
-    for name, (color, ls) in styles.items():
-        if name not in curves:
-            continue
-        ax1.semilogy(grid_bits, curves[name]["ratio"], color=color, ls=ls, lw=1.6, label=f"model: {name}")
-        ax2.loglog(n_line, curves[name]["tau"], color=color, ls=ls, lw=1.6, label=f"model: {name} ({model_bits} bits)")
-    ax1.set_xlabel("bit length of $p$")
-    ax1.set_ylabel("$T_1 / T_{first}$")
-    ax1.set_title("each further key relative to the first: breakers (markers) and cost models (lines)", fontsize=9)
-    ax1.grid(True, which="both", alpha=0.3)
-    ax1.legend(fontsize=7, ncol=3, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.14))
-    ax2.set_xlabel("keys broken $N$")
-    ax2.set_ylabel(r"$\tau(N) / T_{first}$")
-    ax2.set_title(r"$\tau(N)$ of one dynamic-key sequence, in units of one key from scratch", fontsize=9)
-    ax2.grid(True, which="major", alpha=0.3)
-    ax2.legend(fontsize=7, ncol=3, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.14))
-    fig.tight_layout()
-    path = Path(path)
-    save_figure(fig, path, dpi=120)
-    plt.close(fig)
-    return path
-
-
 def format_table(fits: Sequence[dict[str, Any]]) -> str:
     """The measured table: bits, breaker, T_first, T_1, T_1 / T_first, and each breaker's largest size."""
     largest: dict[str, int] = {}
@@ -570,8 +530,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--from-csv",
         default=None,
         metavar="PATH",
-        help="redraw the figures and the table from a recorded deciphering_time.csv instead of measuring",
+        help="redraw the figures and the table from a recorded deciphering_time.csv instead of measuring "
+        "(with --large or --breakers: measure those and replace their rows of the recorded file)",
     )
+    parser.add_argument(
+        "--large",
+        action="store_true",
+        help="also measure the index calculus at 112 and 128 bits (LARGE_PLAN: about 6 minutes of CPU)",
+    )
+    parser.add_argument("--breakers", nargs="+", default=None, metavar="NAME", help="measure only these breakers' plans")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -580,27 +547,36 @@ def run(args: argparse.Namespace) -> int:
     out = ensure_out_dir(args.out)
     t0 = time.perf_counter()
     source = getattr(args, "from_csv", None)
+    large, breakers = getattr(args, "large", False), getattr(args, "breakers", None)
+    measuring = source is None or large or breakers is not None
+    plan = select_plan(args.quick, large, breakers) if measuring else []
+    recorded: list[dict[str, Any]] = []
     if source is not None:
         if not Path(source).is_file():
             raise ParameterError(f"--from-csv: no such file {source!r}")
-        rows = read_csv(source)
-    else:
-        rows = compute(
-            QUICK_PLAN if args.quick else FULL_PLAN,
-            seed=args.seed,
-            n_jobs=args.n_jobs,
-            scheduler=args.scheduler,
-            progress=not args.no_progress,
-        )
+        recorded = read_csv(source)
+    rows = recorded
+    if measuring:
+        measured = compute(plan, seed=args.seed, n_jobs=args.n_jobs, scheduler=args.scheduler, progress=not args.no_progress)
+        rows = merge_rows(recorded, measured)
     elapsed = time.perf_counter() - t0
     fits = fit(rows)
     csv_path = _write_csv_if_changed(rows, out / "deciphering_time.csv", COLUMNS)
     fit_path = _write_csv_if_changed(fits, out / "deciphering_time_fit.csv", FIT_COLUMNS)
     png_path = plot(rows, out / "deciphering_time.png")
-    models_path = plot_models(rows, out / "deciphering_models.png")
-    print(f"Deciphering time: {len(rows)} rows in {elapsed:.1f} s" + (f" (read from {source})" if source else ""))
+    models_path = plot_models(rows, fits, out / "deciphering_models.png")
+    lp_text = format_lp_fits(lp_fits(fits))
+    lp_path = out / "deciphering_lp_fit.txt"
+    lp_path.write_text(lp_text + "\n")
+    how = (
+        f" (read from {source})"
+        if source and not measuring
+        else (f" ({len(plan)} plans measured, the rest from {source})" if source else "")
+    )
+    print(f"Deciphering time: {len(rows)} rows in {elapsed:.1f} s" + how)
     print(format_table(fits))
-    for path in (csv_path, fit_path, png_path, models_path):
+    print(lp_text)
+    for path in (csv_path, fit_path, png_path, models_path, lp_path):
         print(f"  wrote {path}")
     return 0
 

@@ -230,7 +230,7 @@ def test_model_curves_against_hand_computation() -> None:
 
 def test_models_figure_and_from_csv(quick_rows: list, tmp_path) -> None:
     path = deciphering_time.write_csv(quick_rows, tmp_path / "rec.csv")
-    png = deciphering_time.plot_models(quick_rows, tmp_path / "m.png", model_bits=40)
+    png = deciphering_time.plot_models(quick_rows, deciphering_time.fit(quick_rows), tmp_path / "m.png", model_bits=40)
     assert png.stat().st_size > 10_000
     out = tmp_path / "redraw"
     assert deciphering_time.main(["--from-csv", str(path), "--out", str(out), "--no-progress"]) == 0
@@ -477,3 +477,60 @@ def test_lattice_sieve_pairs_satisfy_the_congruence() -> None:
         and i * b1 + j * b2
     }
     assert smooth and smooth <= set(sieve_candidates(y, p, plan, slack=40.0)[1])
+
+
+# ----------------------------------------------------------------------------- L_p[1/2, c] fit, large sizes
+def test_lp_half_fit_against_scipy_linregress() -> None:
+    from encctl_gym.experiments.deciphering_models import fit_lp_half, lp_half_exponent
+    from scipy import stats
+
+    bits = [64, 72, 80, 88, 96, 112, 128]
+    x = np.array([math.sqrt(b * math.log(2) * math.log(b * math.log(2))) for b in bits])
+    assert np.allclose(lp_half_exponent(bits), x, rtol=1e-15)
+    noise = np.array([0.1, -0.05, 0.02, -0.1, 0.08, 0.0, -0.03])
+    seconds = 3e-7 * np.exp(1.1 * x + noise)
+    f = fit_lp_half("index-calculus", bits, seconds)
+    ref = stats.linregress(x, np.log(seconds))
+    t = stats.t.ppf(0.975, len(bits) - 2)
+    assert f.c == pytest.approx(ref.slope, rel=1e-10) and f.a == pytest.approx(math.exp(ref.intercept), rel=1e-10)
+    assert f.c_interval == pytest.approx((ref.slope - t * ref.stderr, ref.slope + t * ref.stderr), rel=1e-10)
+    lo, hi = f.a_interval
+    assert lo < f.a < hi and math.log(hi / f.a) == pytest.approx(t * ref.intercept_stderr, rel=1e-10)
+    resid = np.log(seconds) - (ref.intercept + ref.slope * x)
+    s2 = float(resid @ resid) / (len(bits) - 2)
+    for b, xb in ((72, x[1]), (160, math.sqrt(160 * math.log(2) * math.log(160 * math.log(2))))):
+        se = math.sqrt(s2 * (1 / len(bits) + (xb - x.mean()) ** 2 / float(((x - x.mean()) ** 2).sum())))
+        lo, hi = f.band([b])
+        assert float(hi[0]) / float(f(b)) == pytest.approx(math.exp(t * se), rel=1e-9) and lo[0] < f(b) < hi[0]
+    exact = fit_lp_half("x", bits[:3], 2e-6 * np.exp(0.9 * x[:3]))
+    assert exact.c == pytest.approx(0.9, rel=1e-10) and exact.a == pytest.approx(2e-6, rel=1e-8)
+    with pytest.raises(ParameterError, match="at least three sizes"):
+        fit_lp_half("x", bits[:2], seconds[:2])
+    with pytest.raises(ParameterError, match="positive times"):
+        fit_lp_half("x", bits[:3], [1.0, 0.0, 2.0])
+
+
+def test_plan_selection_and_merging_of_recorded_rows() -> None:
+    plan = deciphering_time.select_plan(False, True, ["index-calculus"])
+    assert {p.breaker for p in plan} == {"index-calculus"} and {112, 128} <= {p.bits for p in plan}
+    assert not any(p.bits > 96 for p in deciphering_time.select_plan(False, False, None))
+    with pytest.raises(ParameterError, match="choose one"):
+        deciphering_time.select_plan(True, True, None)
+    with pytest.raises(ParameterError, match="unknown 'nfs'"):
+        deciphering_time.select_plan(False, False, ["nfs"])
+    recorded = [
+        {"breaker": "pari", "bits": 64, "kind": "sequence"},
+        {"breaker": "index-calculus", "bits": 64, "kind": "sequence"},
+        {"breaker": "index-calculus", "bits": 80, "kind": "sequence"},
+    ]
+    measured = [
+        {"breaker": "index-calculus", "bits": 80, "kind": "new"},
+        {"breaker": "index-calculus", "bits": 128, "kind": "new"},
+    ]
+    merged = deciphering_time.merge_rows(recorded, measured)
+    assert [(r["breaker"], r["bits"], r["kind"]) for r in merged] == [
+        ("pari", 64, "sequence"),
+        ("index-calculus", 64, "sequence"),
+        ("index-calculus", 80, "new"),
+        ("index-calculus", 128, "new"),
+    ]

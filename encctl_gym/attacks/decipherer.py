@@ -107,6 +107,9 @@ class KeyBreaking:
         :class:`~encctl_gym.errors.BreakerTimeoutError`.
     rng
         The breaker's random source (its walks, its randomised descents).
+    precomputation : str, optional
+        A precomputation file the breaker loads (``breaker_precomputation``; the index calculus),
+        checked against ``group`` here.
 
     Raises
     ------
@@ -126,10 +129,12 @@ class KeyBreaking:
         adversary: str,
         time_limit: float = DEFAULT_BREAKER_TIME_LIMIT,
         rng: Any = None,
+        precomputation: Any = None,
     ) -> None:
         from ..cryptanalysis import TokenChain, get_breaker
 
-        b = scheme.breaker_for(get_breaker(breaker, rng=rng), adversary, rng)
+        found = get_breaker(breaker, rng=rng, **({} if precomputation is None else {"precomputation": precomputation}))
+        b = scheme.breaker_for(found, adversary, rng)
         b.check_time(
             group,
             time_limit,
@@ -201,9 +206,11 @@ def make_decipherer(
     adversary: str,
     time_limit: float = DEFAULT_BREAKER_TIME_LIMIT,
     rng: Any = None,
+    precomputation: Any = None,
 ) -> Decipherer:
     """The decipherer of a loop: :class:`KeyBreaking` with a ``breaker`` name, else the
     :class:`KeyOracle` over ``read_key`` (the scheme's ``oracle_secret`` of the plant).
+    ``precomputation``: a file the breaker loads (``breaker_precomputation``).
 
     Raises
     ------
@@ -214,4 +221,6 @@ def make_decipherer(
         return KeyOracle(read_key)
     if not isinstance(breaker, str):
         raise ParameterError(f"breaker must be a breaker name, got {breaker!r}")
-    return KeyBreaking(breaker, group, scheme=scheme, adversary=adversary, time_limit=time_limit, rng=rng)
+    return KeyBreaking(
+        breaker, group, scheme=scheme, adversary=adversary, time_limit=time_limit, rng=rng, precomputation=precomputation
+    )

@@ -11,8 +11,12 @@ A layer beside :mod:`encctl_gym.crypto` (it imports only ``crypto.arith``, ``cry
   ``pari`` (optional extra ``cryptanalysis``), ``index-calculus``, ``token-chain``;
   :func:`get_breaker`.
 * :mod:`.sequence` - :func:`break_sequence` and its :class:`BreakReport` (the measured tau(N)).
-* :mod:`.smoothness`, :mod:`.linalg` - factor base, smoothness tests, rational reconstruction,
-  Dickman's rho; linear algebra modulo q on python-flint.
+* :mod:`.smoothness`, :mod:`.relations`, :mod:`.linalg` - factor base, smoothness tests,
+  rational reconstruction, Dickman's rho; the index calculus's relations (lattice sieve); linear
+  algebra modulo q on python-flint.
+* :mod:`.precomputation_file` - the index calculus's precomputation saved to a file and loaded
+  checked against its group (:func:`load_precomputation`, :class:`PrecomputationInterrupted`).
+* :mod:`.progress` - progress of the phases (:class:`PhaseBars`, silent by default).
 * :mod:`.cli` - the ``encctl-gym crack`` command.
 """
 
@@ -22,6 +26,8 @@ from .base import Breaker, Cost, Deadline, Precomputation, RecoveredKey, check_e
 from .bsgs import BabyStepGiantStep
 from .index_calculus import IndexCalculus
 from .pari import PariZnlog, pari_available
+from .precomputation_file import PrecomputationInterrupted, SavedPrecomputation, load_precomputation
+from .progress import PhaseBars
 from .registry import BREAKERS, get_breaker
 from .rho import MultiLogRho, PollardRho
 from .sequence import BreakReport, break_sequence
@@ -47,6 +53,10 @@ __all__ = [
     "pari_available",
     "IndexCalculus",
     "TokenChain",
+    "load_precomputation",
+    "SavedPrecomputation",
+    "PrecomputationInterrupted",
+    "PhaseBars",
     "FactorBase",
     "dickman_rho",
     "rational_reconstruction",

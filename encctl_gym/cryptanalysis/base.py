@@ -43,6 +43,7 @@ from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, KeyMismatchError, ParameterError
 from ..resources import format_bytes
+from .progress import ProgressCallback, check_progress
 
 __all__ = [
     "Cost",
@@ -126,7 +127,8 @@ def format_seconds(seconds: float) -> str:
 
 
 class Deadline:
-    """The time limit of one breaker call; :meth:`check` raises once it has passed.
+    """The time limit and the progress of one breaker call: :meth:`check` raises once the limit
+    has passed, :meth:`report` tells the caller's progress callback how far a phase is.
 
     Parameters
     ----------
@@ -134,13 +136,17 @@ class Deadline:
         Seconds allowed (``None``: no limit).
     what : str
         Named in the error message (``"index-calculus precomputation"``).
+    progress : callable, optional
+        ``progress(phase, done, total)`` (:data:`~.progress.ProgressCallback`), called by the
+        breaker as a phase advances (``None``: silent, the default of library use).
     """
 
-    __slots__ = ("limit", "what", "start", "cpu_start", "_end")
+    __slots__ = ("limit", "what", "start", "cpu_start", "_end", "progress")
 
-    def __init__(self, time_limit: float | None, what: str) -> None:
+    def __init__(self, time_limit: float | None, what: str, progress: ProgressCallback | None = None) -> None:
         self.limit = None if time_limit is None else check_positive("time_limit", time_limit)
         self.what = what
+        self.progress = check_progress(progress)
         self.cpu_start = time.process_time()
         self.start = time.perf_counter()
         self._end = math.inf if self.limit is None else self.start + self.limit
@@ -153,6 +159,13 @@ class Deadline:
     def cost(self, operations: Mapping[str, int]) -> Cost:
         """The :class:`Cost` of the call so far: wall and CPU time since the start, ``operations``."""
         return Cost(time.perf_counter() - self.start, dict(operations), time.process_time() - self.cpu_start)
+
+    def report(self, phase: str, done: float, total: float | None = None) -> None:
+        """Tell the progress callback (if any) that ``phase`` has done ``done`` of ``total`` units
+        (``None``: a total not known in advance). An exception the callback raises (a
+        ``KeyboardInterrupt``) propagates to the breaker, which stops there."""
+        if self.progress is not None:
+            self.progress(phase, done, total)
 
     def check(self) -> None:
         """Raise :class:`~encctl_gym.errors.BreakerTimeoutError` if the limit has passed."""
@@ -407,7 +420,9 @@ class Breaker(abc.ABC):
         """Further structural requirements of a breaker (raise GroupError); none by default."""
 
     # ------------------------------------------------------------------ the two phases
-    def precompute(self, group: GroupParams, *, time_limit: float | None = None) -> Precomputation:
+    def precompute(
+        self, group: GroupParams, *, time_limit: float | None = None, progress: ProgressCallback | None = None
+    ) -> Precomputation:
         """Phase 1: the work that depends only on the group (once per group).
 
         Parameters
@@ -416,6 +431,10 @@ class Breaker(abc.ABC):
             The group (verified here).
         time_limit : float, optional
             Seconds allowed for this call.
+        progress : callable, optional
+            ``progress(phase, done, total)``, called as the phases advance (the index calculus
+            reports ``"relations"`` and ``"linear algebra"``; :class:`~.progress.PhaseBars`
+            draws them); ``None`` (default): silent.
 
         Returns
         -------
@@ -437,7 +456,7 @@ class Breaker(abc.ABC):
         self.check_feasible(group)
         self._check_group(group)
         self._check_thread()
-        deadline = Deadline(_check_time_limit(time_limit), f"{self.name} precomputation")
+        deadline = Deadline(_check_time_limit(time_limit), f"{self.name} precomputation", progress)
         pre, ops = self._precompute(group, deadline)
         pre.cost = deadline.cost(ops)
         return pre

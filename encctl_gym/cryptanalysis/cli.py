@@ -5,6 +5,7 @@ Usage::
     encctl-gym crack --bits 64 --keys 32 --breaker index-calculus [--json]
                      [--group auto|shipped|fresh] [--seed S] [--time-limit T]
                      [--scheduler local|tcp://host:port] [--n-jobs J] [--inner NAME]
+                     [--save-precomputation PATH] [--load-precomputation PATH] [--no-progress]
 
 The group is the shipped safe-prime group of that bit length (``--group auto`` when one is
 shipped, or ``shipped``) or a fresh one from ``generate_safe_prime_group(bits, rng=seed)``
@@ -23,6 +24,15 @@ longer than ``--max-seconds`` (default :data:`DEFAULT_MAX_SECONDS`; the same est
 environment's ``breaker_time_limit``). The estimate is printed before the work (on stderr with
 ``--json``).
 
+The index calculus's precomputation can be kept (:mod:`.precomputation_file`):
+``--save-precomputation PATH`` writes the solved factor base once it is done, and
+``--load-precomputation PATH`` uses it in a later run on the same group (a file of another group
+is refused in one line, naming what differs). Progress goes to stderr, one bar per phase
+(relations, linear algebra, then the keys, each key one descent), with the time left from the rate
+so far. Ctrl-C stops the run with one line and exit code 130; during the precomputation it first
+saves the relations collected so far to the ``--save-precomputation`` file, and
+``--load-precomputation`` of that file resumes the collection where it stopped.
+
 With ``--scheduler`` (``local`` starts a Dask ``LocalCluster``; needs ``encctl-gym[dask]``) the
 keys are split into chunks that run as tasks of :func:`encctl_gym.parallel.run_tasks`, each with
 a copy of the precomputation; ``--n-jobs`` above 1 alone uses joblib processes.
@@ -34,6 +44,7 @@ import argparse
 import json
 import math
 import sys
+from pathlib import Path
 from typing import Any
 
 from .._validation import check_int, check_positive
@@ -42,7 +53,10 @@ from ..crypto.group import SHIPPED_BITS, GroupParams, generate_safe_prime_group,
 from ..errors import BreakerError, ParameterError
 from ..parallel import check_n_jobs, check_scheduler
 from .base import format_seconds
+from .index_calculus import FactorBaseLogs
 from .keys import MAX_KEYS, check_keys, key_sequence
+from .precomputation_file import PrecomputationInterrupted
+from .progress import PhaseBars
 from .registry import BREAKERS, get_breaker
 from .sequence import BreakReport, break_sequence
 
@@ -119,12 +133,77 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=1,
         help="workers of the parallel path (default 1: keys in this process; -1: all cores)",
     )
+    parser.add_argument(
+        "--save-precomputation",
+        dest="save_precomputation",
+        default=None,
+        metavar="PATH",
+        help="index-calculus: write the precomputation to PATH (on Ctrl-C: the relations so far, to resume from)",
+    )
+    parser.add_argument(
+        "--load-precomputation",
+        dest="load_precomputation",
+        default=None,
+        metavar="PATH",
+        help="index-calculus: use (or resume) the precomputation saved in PATH; it must be of this group",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 
 
 def _ops(ops: dict[str, int]) -> str:
     return " ".join(f"{k}={v}" for k, v in ops.items()) or "-"
+
+
+def _check_save_path(args: argparse.Namespace) -> str | None:
+    # The precomputation files are the index calculus's: refused for the others before any work.
+    for option in ("save_precomputation", "load_precomputation"):
+        if getattr(args, option) is not None and args.breaker != "index-calculus":
+            raise ParameterError(
+                f"--{option.replace('_', '-')} is for --breaker index-calculus (the precomputation saved is its factor base), "
+                f"not {args.breaker}"
+            )
+    save = args.save_precomputation
+    if save is not None:
+        parent = Path(save).resolve().parent
+        if not parent.is_dir():
+            raise ParameterError(f"--save-precomputation {save!r}: the directory {str(parent)!r} does not exist")
+        if Path(save).is_dir():
+            raise ParameterError(f"--save-precomputation {save!r} is a directory, not a file")
+    return save
+
+
+def _interrupted(stop: PrecomputationInterrupted, save: str | None) -> int:
+    # Ctrl-C during the precomputation: one line, the relations saved if asked, exit code 130.
+    state = stop.state
+    done = f"{len(state.relations)} relations after {format_seconds(state.cost.seconds)}"
+    if save is not None:
+        state.save(save)
+        then = f"saved to {save}: rerun with --load-precomputation {save} to resume"
+    else:
+        then = "not saved (with --save-precomputation PATH a rerun can resume)"
+    print(f"encctl-gym crack: interrupted in the {stop.phase}, {done}; {then}", file=sys.stderr)
+    return 130
+
+
+def _phase_lines(pre: Any, loaded: Any, saved: str | None) -> list[str]:
+    # The time of each phase of the index calculus's precomputation, and where it came from or went.
+    lines = []
+    if isinstance(pre, FactorBaseLogs) and pre.phase_seconds:
+        phases = ", ".join(
+            f"{name.replace('_', ' ')} {format_seconds(pre.phase_seconds[name])} ({format_seconds(pre.phase_cpu_seconds.get(name, 0.0))} CPU)"
+            for name in pre.phase_seconds
+        )
+        lines.append(f"phases (wall, CPU): {phases}; the descent is each key's time below")
+        lines.append(f"factor base: {len(pre.logs)} primes up to {pre.bound}, {pre.solved} logarithms solved")
+    if loaded is not None:
+        lines.append(
+            f"precomputation loaded from {loaded.path} in {format_seconds(loaded.read_seconds)} (read and checked: "
+            "every logarithm, and the group); the time shown above is the file's"
+        )
+    if saved is not None:
+        lines.append(f"precomputation saved to {saved}")
+    return lines
 
 
 def summary(report: BreakReport) -> dict[str, float]:
@@ -152,6 +231,9 @@ def run(args: argparse.Namespace) -> int:
         kwargs["max_bits"] = args.max_bits
     if args.breaker == "token-chain":
         kwargs["inner"] = args.inner
+    save = _check_save_path(args)
+    if args.load_precomputation is not None:
+        kwargs["precomputation"] = args.load_precomputation
     breaker = get_breaker(args.breaker, **kwargs)
     group, source = crack_group(args.bits, args.group, seed)
     check_scheduler(args.scheduler)  # every refusal comes before the estimate is printed
@@ -165,11 +247,30 @@ def run(args: argparse.Namespace) -> int:
         file=sys.stderr if args.json else sys.stdout,  # --json keeps stdout to the JSON document
         flush=True,
     )
+    if save is not None and getattr(breaker, "uses_baby_steps", lambda g: False)(group):
+        raise ParameterError(
+            f"--save-precomputation: the {group.bits}-bit group's q is too small for relations, so the index calculus "
+            "breaks it by baby-step giant-step, whose table is not saved (a factor base is)"
+        )
     hs, secrets, tokens = key_sequence(group, n, arith.seeded_random(seed + 1))
+    bars = PhaseBars(prefix=f"{breaker.name} ") if not args.no_progress and not args.json else None
+    try:
+        pre = breaker.precompute(group, time_limit=args.time_limit, progress=bars)
+    except PrecomputationInterrupted as stop:
+        if bars is not None:
+            bars.close()
+        return _interrupted(stop, save)
+    finally:
+        if bars is not None:
+            bars.close()
+    if save is not None:
+        assert isinstance(pre, FactorBaseLogs)  # checked before the work
+        pre.save(save)
     report = break_sequence(
         breaker,
         group,
         hs,
+        pre=pre,
         tokens=tokens if args.breaker == "token-chain" else None,
         time_limit=args.time_limit,
         progress=not args.no_progress and not args.json,
@@ -182,14 +283,18 @@ def run(args: argparse.Namespace) -> int:
     stats = summary(report)
     if args.json:
         out = report.to_dict()
+        if isinstance(pre, FactorBaseLogs):
+            out["phase_seconds"], out["phase_cpu_seconds"] = pre.phase_seconds, pre.phase_cpu_seconds
         # JSON has no NaN: a figure without a value (the later keys of a one-key run) is null.
         finite = {k: (v if math.isfinite(v) else None) for k, v in stats.items()}
         out.update({"bits": group.bits, "group_source": source, "keys_match": True, **finite})
         print(json.dumps(out, indent=1))
         return 0
     print(f"crack: {breaker.name} on a {group.bits}-bit {source} group (p = {group.p:#x}), {n} keys of one dynamic-key sequence")
-    pre = report.precomputation
-    print(f"precomputation: {format_seconds(pre.seconds)}  ({_ops(dict(pre.operations))})")
+    cost = report.precomputation
+    print(f"precomputation: {format_seconds(cost.seconds)}  ({_ops(dict(cost.operations))})")
+    for line in _phase_lines(pre, getattr(breaker, "loaded", None), save):
+        print(line)
     print(f"{'t':>5}  {'seconds':>12}  {'cpu seconds':>12}  {'method':<15} operations")
     for i, key in enumerate(report.keys):
         print(

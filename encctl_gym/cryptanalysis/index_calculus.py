@@ -28,7 +28,7 @@ The phases
 1. **Factor base** (:class:`~.smoothness.FactorBase`): the primes ``l <= B``, with B chosen by
    the cost model :func:`choose_bound` (Dickman's rho for the smoothness probability, the
    measured cost of a sieved cell and of the linear algebra).
-2. **Relation collection** (:func:`collect_relations`): for ``y = g^e`` every pair
+2. **Relation collection** (:func:`~.relations.collect_relations`): for ``y = g^e`` every pair
    ``a = b y (mod p)`` of y's lattice (:mod:`.lattice_sieve`: a reduced basis of about
    ``sqrt(p)``, a region of small combinations sieved row by row) with a and b B-smooth gives
    ``lambda(y) = lambda(|a|) - lambda(|b|)`` (by (i) and (ii)), the relation
@@ -43,11 +43,19 @@ Phases 1-3 depend only on (p, q, g): they are the precomputation. Phase 4 needs 
 relation's worth of sieving per key (usually one lattice), a small fraction of the
 precomputation, so after the first key a dynamic-key sequence (Example ex:dyn_elgamal) costs
 little per key.
+
+The precomputation is plain data: :meth:`FactorBaseLogs.save` writes it to a file that
+``IndexCalculus(precomputation=path)`` loads, checked against its group
+(:mod:`.precomputation_file`); phases 2 and 3 report their progress to a callback
+(:mod:`.progress`), and a ``KeyboardInterrupt`` there ends the call with
+:class:`~.precomputation_file.PrecomputationInterrupted`, which carries the relations collected
+so far and the position of the residue walk, to save and resume from.
 """
 
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Mapping
 from typing import ClassVar
@@ -59,10 +67,12 @@ from ..crypto import arith
 from ..crypto.arith import RandomSource, RngLike, format_int
 from ..crypto.group import GroupParams
 from ..errors import BreakerError, BreakerLimitError, BreakerTimeoutError, GroupError, ParameterError
-from .base import Breaker, Deadline, Precomputation, format_bytes
+from .base import Breaker, Cost, Deadline, Precomputation, format_bytes
 from .bsgs import BabyStepGiantStep, BabyStepTable
-from .lattice_sieve import SievePlan, sieve_candidates
-from .linalg import flint_backend, solve_mod_prime
+from .linalg import DENSE_BYTES_PER_ENTRY, flint_backend, solve_mod_prime
+from .precomputation_file import PrecomputationInterrupted, SavedPrecomputation, load_precomputation
+from .progress import ProgressCallback
+from .relations import Relation, RelationWalk, collect_relations, sieve_plan, sieve_region, smooth_pairs
 from .smoothness import RHO_MAX_U, FactorBase, check_bound, dickman_rho
 
 __all__ = [
@@ -99,10 +109,8 @@ ELIMINATION_PER_UNKNOWN = 1.8e-4
 #: Relations collected beyond the number of unknowns (fraction, plus a constant).
 EXTRA_FRACTION = 0.05
 EXTRA_CONSTANT = 20
-#: Peak bytes per entry of the dense system ``[R | r]`` in :func:`~.linalg.solve_mod_prime` (the
-#: Python entry list, the FLINT matrix, its echelon form and the entries read back), measured for
-#: a 2120 x 2001 system with a 61-bit q: 91 bytes.
-MATRIX_BYTES_PER_ENTRY = 91
+#: Peak bytes per entry of the dense system (:data:`~.linalg.DENSE_BYTES_PER_ENTRY`).
+MATRIX_BYTES_PER_ENTRY = DENSE_BYTES_PER_ENTRY
 #: Share of the rows and of the unknowns left to the dense elimination by the structured one
 #: (:func:`~.linalg.structured_elimination`): measured 0.38 of the rows and 0.30 of the unknowns
 #: at 80 and 96 bits; 0.4 for both, with a margin.
@@ -151,15 +159,6 @@ def relation_probability(bits: int, bound: float) -> float:
 
 def _prime_count(bound: float) -> float:
     return bound / (math.log(bound) - 1.08) if bound > 10 else 4.0
-
-
-def sieve_region(bits: int) -> tuple[int, int]:
-    """``(rows, half_width)`` of the region ``1 <= i <= rows``, ``|j| <= half_width`` sieved in
-    each residue's lattice (:mod:`.lattice_sieve`): ``half_width = 2^min(11, max(4, bits // 7))``
-    and ``rows = max(2, half_width // 32)``; the pairs are about ``half_width sqrt(p)``."""
-    bits = check_int("bits", bits, minimum=2, maximum=MAX_MODEL_BITS)
-    half = 1 << min(11, max(4, bits // 7))
-    return max(2, half // 32), half
 
 
 def sieve_probability(bits: int, bound: float) -> float:
@@ -216,14 +215,20 @@ def choose_bound(bits: int) -> int:
 class _PhaseClock:
     """Wall and CPU seconds per named phase (``with clock("relations"): ...``), accumulated."""
 
-    def __init__(self) -> None:
-        self.wall: dict[str, float] = {"factor_base": 0.0, "relations": 0.0, "linear_algebra": 0.0}
-        self.cpu = dict(self.wall)
+    def __init__(self, wall: Mapping[str, float] | None = None, cpu: Mapping[str, float] | None = None) -> None:
+        # Resumed from a file: the seconds of the earlier runs, per phase.
+        self.wall: dict[str, float] = {"factor_base": 0.0, "relations": 0.0, "linear_algebra": 0.0, **(wall or {})}
+        self.cpu: dict[str, float] = {"factor_base": 0.0, "relations": 0.0, "linear_algebra": 0.0, **(cpu or {})}
         self._name = ""
 
     def __call__(self, name: str) -> _PhaseClock:
         self._name = name
         return self
+
+    @property
+    def current(self) -> str:
+        """The phase entered last (running, or ended by an exception), with a space for the underscore."""
+        return self._name.replace("_", " ")
 
     def __enter__(self) -> None:
         self._t0, self._c0 = time.perf_counter(), time.process_time()
@@ -231,86 +236,6 @@ class _PhaseClock:
     def __exit__(self, *exc: object) -> None:
         self.wall[self._name] += time.perf_counter() - self._t0
         self.cpu[self._name] += time.process_time() - self._c0
-
-
-class Relation(tuple):
-    """One relation ``(row, rhs)``: ``sum_j row[j] lambda_j = rhs (mod q)``."""
-
-    __slots__ = ()
-
-    @property
-    def row(self) -> dict[int, int]:
-        return self[0]
-
-    @property
-    def rhs(self) -> int:
-        return self[1]
-
-
-def _pair_row(fb: FactorBase, a: int, b: int) -> dict[int, int] | None:
-    """The exponent vector of lambda(|a|) - lambda(|b|), or None if a or b is not smooth (or 0)."""
-    if a == 0 or b == 0 or not (fb._is_smooth(a) and fb._is_smooth(b)):
-        return None
-    fa, fb_ = fb.factor(a), fb.factor(b)
-    assert fa is not None and fb_ is not None  # both smooth
-    row = dict(fa)
-    for j, e in fb_.items():
-        row[j] = row.get(j, 0) - e
-    return {j: e for j, e in row.items() if e}
-
-
-def _sieve_slack(fb: FactorBase) -> float:
-    # Bits a sieve sum may fall short of log2 |a|: prime powers above 2^16 and rounding.
-    return 0.8 * math.log2(fb.bound) + 2.0
-
-
-def _smooth_pairs(fb: FactorBase, plan: SievePlan, y: int, p: int) -> tuple[list[dict[int, int]], int]:
-    """The rows lambda(|a|) - lambda(|b|) = lambda(y) of the smooth pairs of y's lattice, and the
-    number of candidates the sieve reported (each tested exactly)."""
-    (a1, b1, a2, b2), pairs = sieve_candidates(y, p, plan, _sieve_slack(fb))
-    rows = [_pair_row(fb, i * a1 + j * a2, i * b1 + j * b2) for i, j in pairs]
-    return [row for row in rows if row is not None], len(pairs)
-
-
-def _plan(group: GroupParams, fb: FactorBase) -> SievePlan:
-    rows, half = sieve_region(group.bits)
-    return SievePlan(fb.primes, rows, half)
-
-
-def collect_relations(
-    group: GroupParams, fb: FactorBase, count: int, src: RandomSource, deadline: Deadline
-) -> tuple[list[Relation], int, int]:
-    """Phase 2: ``count`` relations ``sum (alpha_l - beta_l) lambda_l = n e (mod q)``.
-
-    For residues ``y = g^e`` with ``e = e_0 + i c`` (random e_0 and c; one multiplication by
-    ``g^c`` per residue) it sieves the region :func:`sieve_region` of y's lattice
-    (:func:`~.lattice_sieve.sieve_candidates`) and keeps every pair ``a = b y (mod p)`` with a
-    and b smooth (checked exactly). (Consecutive exponents would not do: with g = 4, ``4y`` has
-    the lattice of y scaled by 4 and repeats its relations plus that of 4.)
-
-    Returns
-    -------
-    (list of Relation, int, int)
-        The relations, the number of residues sieved and of candidates tested exactly.
-    """
-    p, q, n = group.p, group.q, group.cofactor
-    plan = _plan(group, fb)
-    e, c = src.between(1, q), src.between(1, q)
-    y = gmpy2.powmod(group.g, e, p)
-    step = gmpy2.powmod(group.g, c, p)
-    pm = gmpy2.mpz(p)
-    relations: list[Relation] = []
-    lattices = tests = 0
-    while len(relations) < count:
-        lattices += 1
-        rhs = n * e % q
-        rows, tested = _smooth_pairs(fb, plan, int(y), p)
-        tests += tested
-        relations += [Relation((row, rhs)) for row in rows]
-        y = y * step % pm
-        e += c
-        deadline.check()
-    return relations, lattices, tests
 
 
 class FactorBaseLogs(Precomputation):
@@ -355,6 +280,17 @@ class FactorBaseLogs(Precomputation):
         """Number of factor-base primes whose lambda is known."""
         return sum(v is not None for v in self.logs)
 
+    def saved(self) -> SavedPrecomputation:
+        """Its content as a :class:`~.precomputation_file.SavedPrecomputation` (``.save(path)``
+        writes the file a later run loads with ``IndexCalculus(precomputation=path)``)."""
+        return SavedPrecomputation(
+            self.group, self.bound, list(self.logs), [], None, self.cost, dict(self.phase_seconds), dict(self.phase_cpu_seconds)
+        )
+
+    def save(self, path: str | os.PathLike[str]) -> str:
+        """Write the solved factor base to ``path`` (:mod:`.precomputation_file`); returns the path."""
+        return self.saved().save(path)
+
     def _solve(self, h: int, deadline: Deadline, src: RandomSource) -> tuple[int, Mapping[str, int], str]:
         # Phase 4, the descent: a pair a = b z (mod p) of the lattice of z = h g^r with a, b
         # smooth over the solved primes gives n (log h + r) = lambda(a) - lambda(|b|).
@@ -362,7 +298,7 @@ class FactorBaseLogs(Precomputation):
         p, q = group.p, group.q
         n_inv = pow(group.cofactor, -1, q)
         pm = gmpy2.mpz(p)
-        plan = _plan(group, fb)
+        plan = sieve_plan(group, fb)
         r, c = src.between(0, q), src.between(1, q)  # z = h g^r, then r += c (see collect_relations)
         z = gmpy2.mpz(h) * gmpy2.powmod(group.g, r, p) % pm
         step = gmpy2.powmod(group.g, c, p)
@@ -370,7 +306,7 @@ class FactorBaseLogs(Precomputation):
         give_up = 1000 * cost_model(group.bits, self.bound)["cells_per_relation"] / (2 * plan.rows * plan.half_width) + 1000
         while True:
             lattices += 1
-            rows, tested = _smooth_pairs(fb, plan, int(z), p)
+            rows, tested = smooth_pairs(fb, plan, int(z), p)
             tests += tested
             for row in rows:
                 known = [(e, logs[j]) for j, e in row.items()]
@@ -418,13 +354,20 @@ class IndexCalculus(Breaker):
     Parameters
     ----------
     bound : int, optional
-        The factor-base bound B, at most :data:`~.smoothness.MAX_BOUND` (default:
-        :func:`choose_bound` for the group's size); a bound whose linear algebra would need more
-        than :data:`MAX_MATRIX_BYTES` is refused by :meth:`check_feasible`.
+        The factor-base bound B, at most :data:`~.smoothness.MAX_BOUND` (default: that of the
+        ``precomputation`` file, else :func:`choose_bound` for the group's size); a bound whose
+        linear algebra would need more than :data:`MAX_MATRIX_BYTES` is refused by
+        :meth:`check_feasible`.
     max_bits : int, optional
         Size limit (default and at most 128 bits: measured on this machine, the first key of a
         112-bit group takes about 33 s of CPU time, of a 128-bit group about 260 s, with a
         factor base of about 9700 primes, and each further key about 0.06 s).
+    precomputation : str or path, optional
+        A file written by :meth:`FactorBaseLogs.save` or after an interruption
+        (:class:`~.precomputation_file.PrecomputationInterrupted`), read and checked here
+        (:func:`~.precomputation_file.load_precomputation`). :meth:`precompute` then uses its
+        solved factor base, or resumes its relation collection; a group (or ``bound``) other than
+        the file's is refused by :meth:`check_feasible` (``ConfigError``).
     rng
         See :class:`~encctl_gym.cryptanalysis.base.Breaker`.
     """
@@ -434,15 +377,25 @@ class IndexCalculus(Breaker):
     #: Rounds of extra relations collected when the system leaves too many unknowns free.
     MAX_ROUNDS: ClassVar[int] = 6
 
-    def __init__(self, *, bound: int | None = None, max_bits: int | None = None, rng: RngLike = None) -> None:
+    def __init__(
+        self,
+        *,
+        bound: int | None = None,
+        max_bits: int | None = None,
+        precomputation: str | os.PathLike[str] | None = None,
+        rng: RngLike = None,
+    ) -> None:
         super().__init__(max_bits=max_bits, rng=rng)
         if self.max_bits > 128:
             raise BreakerLimitError(f"index-calculus supports at most 128 bits (max_bits), got {self.max_bits}")
         self.bound = None if bound is None else check_bound(bound)
+        #: The file given as ``precomputation`` (checked), or ``None``.
+        self.loaded: SavedPrecomputation | None = None if precomputation is None else load_precomputation(precomputation)
 
     def factor_base_bound(self, group: GroupParams) -> int:
-        """B for this group: the ``bound`` given, else :func:`choose_bound` (at least 2, below p)."""
-        bound = self.bound or choose_bound(group.bits)
+        """B for this group: the ``bound`` given, else the loaded file's, else :func:`choose_bound`
+        (at least 2, below p)."""
+        bound = self.bound or (self.loaded.bound if self.loaded is not None else choose_bound(group.bits))
         return max(2, min(bound, group.p - 1))
 
     def _baby_steps(self, group: GroupParams) -> BabyStepGiantStep:
@@ -453,6 +406,8 @@ class IndexCalculus(Breaker):
         times the residues whose lattices the relations are expected to take (:func:`cost_model`),
         where the walk over G would revisit its elements, and the baby-step table of
         :mod:`.bsgs` fits. The precomputation is then a :class:`SmallOrderLogs`."""
+        if self.loaded is not None:
+            return False
         bsgs = self._baby_steps(group)
         if bsgs.table_size(group) > bsgs.max_table:
             return False
@@ -465,11 +420,22 @@ class IndexCalculus(Breaker):
 
     def expected_seconds(self, group: GroupParams) -> tuple[float, float]:
         """``(first, per_key)`` of :func:`cost_model` at :meth:`factor_base_bound`, or of
-        baby-step giant-step when :meth:`uses_baby_steps`."""
+        baby-step giant-step when :meth:`uses_baby_steps`. With a loaded file of this group the
+        first key costs one descent (a complete file) or the relations still missing, the linear
+        algebra and a descent (an interrupted one)."""
         if self.uses_baby_steps(group):
             return self._baby_steps(group).expected_seconds(group)
-        model = cost_model(group.bits, self.factor_base_bound(group))
-        return model["first"], model["per_key"]
+        bound = self.factor_base_bound(group)
+        model = cost_model(group.bits, bound)
+        first = model["first"]
+        if self.loaded is not None and self.loaded.group == group:
+            if self.loaded.complete:
+                first = model["per_key"]
+            else:
+                need = model["factor_base"] * (1 + EXTRA_FRACTION) + EXTRA_CONSTANT
+                share = max(0.0, 1.0 - len(self.loaded.relations) / need)
+                first = share * model["relations"] + model["linear_algebra"] + model["descent"]
+        return first, model["per_key"]
 
     def matrix_bytes(self, group: GroupParams) -> float:
         """Expected peak memory of the first linear algebra (bytes): the dense core of
@@ -481,10 +447,14 @@ class IndexCalculus(Breaker):
         return rows * (CORE_FRACTION * k + 1) * MATRIX_BYTES_PER_ENTRY
 
     def check_feasible(self, group: GroupParams) -> None:
-        """The limits of :class:`~.base.Breaker`, and the memory of the dense linear algebra
-        (:meth:`matrix_bytes` at most :data:`MAX_MATRIX_BYTES`; none when :meth:`uses_baby_steps`)."""
+        """The limits of :class:`~.base.Breaker`, the loaded file's group and bound
+        (:meth:`~.precomputation_file.SavedPrecomputation.check_group`), and the memory of the
+        dense linear algebra (:meth:`matrix_bytes` at most :data:`MAX_MATRIX_BYTES`; none when
+        :meth:`uses_baby_steps`, or when a complete file is loaded)."""
+        if self.loaded is not None:
+            self.loaded.check_group(group, self.bound)
         super().check_feasible(group)
-        if self.uses_baby_steps(group):
+        if self.uses_baby_steps(group) or (self.loaded is not None and self.loaded.complete):
             return
         need = self.matrix_bytes(group)
         if need > MAX_MATRIX_BYTES:
@@ -502,31 +472,90 @@ class IndexCalculus(Breaker):
                 f"index-calculus needs an odd q that does not divide the cofactor (p - 1) / q; got q = {group.q}, cofactor = {n}"
             )
 
+    def precompute(
+        self, group: GroupParams, *, time_limit: float | None = None, progress: ProgressCallback | None = None
+    ) -> Precomputation:
+        """:meth:`~.base.Breaker.precompute`; with a loaded file, its cost is the file's (the work
+        it took, as an attack from scratch pays it) plus this call's.
+
+        Raises
+        ------
+        PrecomputationInterrupted
+            On ``KeyboardInterrupt`` during the relations or the linear algebra (Ctrl-C, or
+            raised by ``progress``): it carries the relations collected so far, to
+            :meth:`~.precomputation_file.SavedPrecomputation.save` and resume from.
+        """
+        pre = super().precompute(group, time_limit=time_limit, progress=progress)
+        if self.loaded is not None:
+            prior, now = self.loaded.cost, pre.cost
+            ops = {**now.operations, **({"loaded_logs": 1} if self.loaded.complete else {})}
+            pre.cost = Cost(prior.seconds + now.seconds, ops, prior.cpu_seconds + now.cpu_seconds)
+        return pre
+
     def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[Precomputation, Mapping[str, int]]:
         if self.uses_baby_steps(group):
             table, ops = self._baby_steps(group)._precompute(group, deadline)
             return SmallOrderLogs(group, table, self.rng), ops
+        saved = self.loaded
+        if saved is not None and saved.complete:
+            assert saved.logs is not None
+            pre = FactorBaseLogs(group, saved.bound, list(saved.logs), self.rng)
+            pre.phase_seconds, pre.phase_cpu_seconds = dict(saved.phase_seconds), dict(saved.phase_cpu_seconds)
+            return pre, dict(saved.cost.operations)
         src = self.rng or arith.secure_random()
-        clock = _PhaseClock()
+        clock = _PhaseClock(*((saved.phase_seconds, saved.phase_cpu_seconds) if saved is not None else ()))
         # Phase 1: the factor base.
         with clock("factor_base"):
             fb = FactorBase(self.factor_base_bound(group))
-        k = len(fb)
+        relations: list[Relation] = []
+        counts = {"sieved_lattices": 0, "smoothness_tests": 0}
+        if saved is not None:  # resume: the relations so far (once each) and the walk's position
+            assert saved.walk is not None
+            relations = list({(tuple(sorted(r.row.items())), r.rhs): r for r in saved.relations}.values())
+            walk = RelationWalk(saved.walk.e, saved.walk.c)
+            counts.update({k: saved.cost.operations.get(k, 0) for k in counts})
+        else:
+            walk = RelationWalk.start(group, src)
+        phase = "relations"
+        try:
+            return self._relations_and_logs(group, fb, relations, walk, counts, clock, deadline)
+        except KeyboardInterrupt:
+            cost = deadline.cost({**counts, "relations": len(relations)})
+            prior = saved.cost if saved is not None else Cost(0.0)
+            state = SavedPrecomputation(
+                group,
+                fb.bound,
+                None,
+                relations,
+                walk,
+                Cost(prior.seconds + cost.seconds, cost.operations, prior.cpu_seconds + cost.cpu_seconds),
+                clock.wall,
+                clock.cpu,
+            )
+            raise PrecomputationInterrupted(clock.current or phase, state) from None
+
+    def _relations_and_logs(
+        self,
+        group: GroupParams,
+        fb: FactorBase,
+        relations: list[Relation],
+        walk: RelationWalk,
+        counts: dict[str, int],
+        clock: _PhaseClock,
+        deadline: Deadline,
+    ) -> tuple[Precomputation, Mapping[str, int]]:
         # Phase 2: relations; phase 3: linear algebra. More relations while a prime below
         # sqrt(B) (and sqrt(p), for toy groups) is undetermined, or more than SOLVED_FRACTION of
         # the primes that occur in the relations are: the descent needs those.
+        k = len(fb)
         need = int(k * (1 + EXTRA_FRACTION)) + EXTRA_CONSTANT
-        relations: list[Relation] = []
-        lattices = tests = 0
         rank = 0
         logs: list[int | None] = [None] * k
         small = sum(1 for ell in fb.primes if ell <= max(2, math.isqrt(min(fb.bound, group.p))))
         for _ in range(self.MAX_ROUNDS):
-            with clock("relations"):
-                more, t, tested = collect_relations(group, fb, need - len(relations), src, deadline)
-            relations += more
-            lattices += t
-            tests += tested
+            if len(relations) < need:  # a resumed collection may have them all
+                with clock("relations"):
+                    collect_relations(group, fb, relations, need, walk, deadline, counts)
             # The elimination runs inside FLINT and cannot be interrupted: refuse it up front
             # when the cost model says it would overrun the time limit.
             expected = cost_model(group.bits, fb.bound)["linear_algebra"]
@@ -536,7 +565,9 @@ class IndexCalculus(Breaker):
                     f"{max(deadline.remaining, 0.0):.3g} s of its time limit of {deadline.limit:g} s remain"
                 )
             with clock("linear_algebra"):
-                logs, rank = solve_mod_prime([r.row for r in relations], [r.rhs for r in relations], k, group.q)
+                logs, rank = solve_mod_prime(
+                    [r.row for r in relations], [r.rhs for r in relations], k, group.q, report=deadline.report
+                )
             occurring = len({j for r in relations for j in r.row})
             solved = sum(v is not None for v in logs)
             if all(v is not None for v in logs[:small]) and solved >= SOLVED_FRACTION * occurring:
@@ -551,12 +582,5 @@ class IndexCalculus(Breaker):
         pre = FactorBaseLogs(group, fb.bound, logs, self.rng)
         pre._fb = fb
         pre.phase_seconds, pre.phase_cpu_seconds = clock.wall, clock.cpu
-        ops = {
-            "factor_base": k,
-            "sieved_lattices": lattices,
-            "smoothness_tests": tests,
-            "relations": len(relations),
-            "rank": rank,
-            "solved_logs": pre.solved,
-        }
+        ops = {"factor_base": k, **counts, "relations": len(relations), "rank": rank, "solved_logs": pre.solved}
         return pre, ops

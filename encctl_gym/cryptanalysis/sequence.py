@@ -28,6 +28,7 @@ from ..crypto.group import GroupParams
 from ..errors import ParameterError
 from ..parallel import check_n_jobs, check_scheduler
 from .base import Breaker, Cost, Precomputation, RecoveredKey, as_list, check_element
+from .progress import PhaseBars
 from .registry import get_breaker
 
 __all__ = ["BreakReport", "break_sequence"]
@@ -127,7 +128,8 @@ def break_sequence(
     time_limit : float, optional
         Seconds allowed for the precomputation and for each key.
     progress : bool
-        Show a tqdm progress bar (stderr).
+        Show tqdm progress bars on stderr: the phases of the precomputation
+        (:class:`~.progress.PhaseBars`) and the keys.
     scheduler : None, "local", address or distributed.Client
         Run the per-key work through :func:`~encctl_gym.parallel.run_tasks` (with ``n_jobs``):
         ``None`` and ``n_jobs == 1`` break the keys in this process, in order.
@@ -175,7 +177,12 @@ def break_sequence(
         )
     progress = check_bool("progress", progress)
     if pre is None:
-        pre = breaker.precompute(group, time_limit=time_limit)
+        bars = PhaseBars(prefix=f"{breaker.name} ") if progress else None
+        try:
+            pre = breaker.precompute(group, time_limit=time_limit, progress=bars)
+        finally:
+            if bars is not None:
+                bars.close()
     elif not isinstance(pre, Precomputation):
         raise ParameterError(f"pre must be a Precomputation, got {format_value(pre)}")
     elif pre.breaker != breaker.name or pre.group != group:

@@ -165,5 +165,5 @@ class TokenChain(Breaker):
         self.inner.check_feasible(group)
 
     def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[TokenChainState, Mapping[str, int]]:
-        inner = self.inner.precompute(group, time_limit=deadline.limit)
+        inner = self.inner.precompute(group, time_limit=deadline.limit, progress=deadline.progress)
         return TokenChainState(inner, self.rng), dict(inner.cost.operations)

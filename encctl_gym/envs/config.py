@@ -8,6 +8,7 @@ the user's ``config`` and keyword arguments and resolved once into an immutable
 from __future__ import annotations
 
 import math
+import os
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -16,7 +17,16 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_bool, check_int, check_nonnegative, check_positive, check_schur_stable, check_system, format_value
+from .._validation import (
+    check_bool,
+    check_int,
+    check_nonnegative,
+    check_positive,
+    check_regular_file,
+    check_schur_stable,
+    check_system,
+    format_value,
+)
 from ..errors import BudgetError, ConfigError, ParameterError
 from ..ident.registry import make_estimator
 from ..loop import BACKENDS as _LOOP_BACKENDS
@@ -86,6 +96,12 @@ def default_config() -> dict[str, Any]:
                                   and a group the breaker can break (the loop's group has
                                   64 bits for ``key_length <= 64``: index calculus and PARI
                                   break it in about 0.5 s, then about 1 ms resp. 0.1 s per key)
+    ``breaker_precomputation``    ``None`` or a file saved by ``encctl-gym crack
+                                  --save-precomputation`` (the index calculus's factor base
+                                  of the loop's group, checked against it): the breaker loads
+                                  it instead of precomputing (needs
+                                  ``breaker="index-calculus"``); the time charged for the
+                                  precomputation is still the file's
     ``breaker_time_limit``        seconds (or a duration) the breaker may take for its
                                   precomputation and for each key; a breaker expected to take
                                   longer is refused when the environment is made
@@ -150,6 +166,7 @@ def default_config() -> dict[str, Any]:
         "gnfs_correction": 0.0,
         "breaker": None,
         "breaker_time_limit": 60.0,
+        "breaker_precomputation": None,
         "deciphering_clock": "model",
         "upsilon": None,
         "tau_c": None,
@@ -226,6 +243,7 @@ class AttackParams:
     defender: Any = "fixed"  # the defender policy specification (a name or a policy object), checked
     horizon_capped: bool = False  # no max_samples and a budget beyond MAX_DEFAULT_HORIZON: N is that cap
     rotate_group_every: int | None = None  # K: a fresh group every K attack steps (None: one group)
+    breaker_precomputation: str | None = None  # a precomputation file the breaker loads (index calculus)
     cost_model: CostModel | None = None  # the built deciphering model (its GNFS correction); None: the named one's defaults
 
     @cached_property
@@ -262,6 +280,7 @@ class AttackParams:
             crypto_seed=self.crypto_seed,
             defender=self.defender,
             rotate_group_every=self.rotate_group_every,
+            breaker_precomputation=self.breaker_precomputation,
         )
 
     def warn_if_capped(self) -> None:
@@ -361,6 +380,24 @@ def _breaking(cfg: Mapping[str, Any], crypto: str) -> tuple[str | None, str, flo
     if clock == "measured" and breaker is None:
         raise ParameterError("deciphering_clock='measured' needs a breaker: nothing is broken, so nothing is measured")
     return breaker, clock, parse_duration(cfg["breaker_time_limit"], "breaker_time_limit")
+
+
+def _breaker_file(cfg: Mapping[str, Any], breaker: str | None) -> str | None:
+    """The checked ``breaker_precomputation``: ``None``, or an existing regular file for a breaker
+    that loads one (its content is read and checked against the group when the breaker is built)."""
+    from ..cryptanalysis.registry import BREAKERS as breakers
+
+    path = cfg["breaker_precomputation"]
+    if path is None:
+        return None
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"breaker_precomputation must be a file name or None, got {format_value(path)}")
+    if breaker is None or "precomputation" not in breakers.options(breaker):
+        raise ParameterError(
+            f"breaker_precomputation is a file of the index calculus's precomputation; it needs "
+            f"breaker='index-calculus', got breaker={breaker!r}"
+        )
+    return check_regular_file("breaker_precomputation", path)
 
 
 def completion_preset(config: Mapping[str, Any]) -> Any:
@@ -615,4 +652,5 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         horizon_capped=max_samples is None and horizon < budget,
         rotate_group_every=rotate_every,
         cost_model=model,
+        breaker_precomputation=_breaker_file(cfg, breaker),
     )

@@ -108,6 +108,7 @@ class ElGamalLoop:
             adversary=params.adversary,
             time_limit=params.breaker_time_limit,
             rng=self.random_sources["breaker"],
+            precomputation=params.breaker_precomputation,
         )
         self.plant: Any = None
         self.server: Any = None

@@ -138,6 +138,7 @@ def rotate_elgamal_loop(loop: Any, group: GroupParams) -> ProvisioningCost:
                 adversary=loop.params.adversary,
                 time_limit=loop.params.breaker_time_limit,
                 rng=loop.random_sources["breaker"],
+                precomputation=None,  # a saved precomputation belongs to the first group: a new group is precomputed afresh
             ),
         )
     loop.group = group

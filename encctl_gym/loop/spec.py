@@ -50,6 +50,8 @@ class LoopSpec:
     rotate_group_every : int or None
         Group rotation: a fresh safe-prime group every ``K`` attack steps (``None``: one group;
         :mod:`encctl_gym.loop.rotation`).
+    breaker_precomputation : str or None
+        A precomputation file the breaker loads (the index calculus), checked against the group.
     """
 
     crypto: str
@@ -63,6 +65,7 @@ class LoopSpec:
     crypto_seed: int | None
     defender: Any = "fixed"
     rotate_group_every: int | None = None
+    breaker_precomputation: str | None = None
 
     def encryption(self) -> EncryptionScheme:
         """The scheme object (:func:`~encctl_gym.loop.scheme.make_scheme`)."""

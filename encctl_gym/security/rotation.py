@@ -70,7 +70,13 @@ def rotated_operations(
 
 
 def rotated_deciphering_time(
-    N: Any, cost: KeyBreakCost, upsilon: Any, every: Any, *, scheme: str | KeyExposure = "modified", adversary: str = "eavesdropper"
+    N: Any,
+    cost: KeyBreakCost,
+    upsilon: Any,
+    every: Any,
+    *,
+    scheme: str | KeyExposure = "modified",
+    adversary: str = "eavesdropper",
 ) -> float | np.ndarray:
     """``tau(N)`` in seconds under rotation every ``every`` steps (module docstring).
 
@@ -99,7 +105,13 @@ def rotated_deciphering_time(
 
 
 def rotated_affordable_samples(
-    tau_c: Any, cost: KeyBreakCost, upsilon: Any, every: Any, *, scheme: str | KeyExposure = "modified", adversary: str = "eavesdropper"
+    tau_c: Any,
+    cost: KeyBreakCost,
+    upsilon: Any,
+    every: Any,
+    *,
+    scheme: str | KeyExposure = "modified",
+    adversary: str = "eavesdropper",
 ) -> int:
     """The largest ``N`` with ``tau(N) <= tau_c`` under rotation every ``K = every`` steps, exactly.
 
@@ -141,7 +153,13 @@ class _GroupCharged(CostModel):
 
 
 def rotated_minimum_key_length(
-    model: CostModel, N_star: Any, every: Any, budget: Fraction, *, scheme: str | KeyExposure = "modified", adversary: str = "eavesdropper"
+    model: CostModel,
+    N_star: Any,
+    every: Any,
+    budget: Fraction,
+    *,
+    scheme: str | KeyExposure = "modified",
+    adversary: str = "eavesdropper",
 ) -> int:
     """The smallest key length ``k`` whose ``N*`` samples, in groups of ``K = every``, cost more than
     ``budget`` (``Upsilon tau_c``) operations under ``model`` (eq:opt_key with the work of the
