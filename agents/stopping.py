@@ -149,7 +149,13 @@ def decide(rule: StoppingRule, timesteps: Any, log_ratios: Any) -> StoppingDecis
         raise ConfigError(f"log_ratios must be (evaluations, episodes >= 2) with one timestep each, got {d.shape}")
     T = d.shape[0]
     last = paired_resolution(np.exp(d[-1]), np.ones(d.shape[1]))
-    base = {"evaluation": T - 1, "timestep": int(ts[-1]), "ratio": last.estimate, "low": last.low, "high": last.high}
+    base: dict[str, Any] = {
+        "evaluation": T - 1,
+        "timestep": int(ts[-1]),
+        "ratio": last.estimate,
+        "low": last.low,
+        "high": last.high,
+    }
     where = f"after {int(ts[-1])} steps: ratio to the oracle {last.estimate:.3f} [{last.low:.3f}, {last.high:.3f}]"
     if T < rule.min_evaluations:
         return StoppingDecision(
@@ -163,7 +169,7 @@ def decide(rule: StoppingRule, timesteps: Any, log_ratios: Any) -> StoppingDecis
         return StoppingDecision(False, "continue", f"{where}; {T} of {rule.window} evaluations for the plateau test", **base)
     slope, pessimistic = _slope_interval(d[-rule.window :].mean(axis=1))
     gain = -pessimistic * rule.window  # log improvement over another window at the favourable end
-    slopes = {"slope": slope, "slope_pessimistic": pessimistic}
+    slopes: dict[str, Any] = {"slope": slope, "slope_pessimistic": pessimistic}
     text = (
         f"{where}; slope over the last {rule.window} evaluations {slope:+.4f} per evaluation (log ratio; "
         f"95 % interval down to {pessimistic:+.4f})"
