@@ -125,3 +125,27 @@ def test_bad_samples_are_refused(x, y, match):
 def test_bad_reference_is_refused():
     with pytest.raises(ParameterError, match="reference"):
         reference_resolution([1.0, 2.0], 0.0)
+
+
+def test_evaluate_lines_warn_for_a_learned_attacker_whose_margin_the_episodes_cannot_resolve():
+    from experiments.compare.evaluate_run import resolution_lines
+    from experiments.compare.records import Curve, Result
+    from experiments.compare.settings import make_setting
+
+    setting = make_setting("paper-example", 0, 256)
+    N = setting.params.horizon
+    s = 0.13 * math.sqrt(100) / T99
+    x, y = paired_sample(100, math.log(1.04), s)
+    g = y * 1.3
+
+    def c(name: str, final: np.ndarray, oracle: bool = False) -> Curve:
+        return Curve(name, oracle, np.array([N]), final[None].mean(1), np.zeros(1), final.size, final, np.ones(final.size), 0.0)
+
+    result = Result([setting], {setting.key: [c("gaussian", g), c("optimal-cl", y, True), c("ars", x)]}, [], [], 0.0)
+    lines = resolution_lines(result, ["ars"], target=0.05)
+    assert len(lines) == 4
+    assert lines[0].startswith(f"paper-example, delay 0, N = {N}: ars / optimal-cl: 1.040 [")
+    assert "100 episodes resolve +-13.9 %: warning: the +4.0 % margin is not resolved" in lines[0]
+    assert "median (paired, bootstrap)" in lines[1]
+    assert lines[2].startswith(f"paper-example, delay 0, N = {N}: ars / gaussian: {1.04 / 1.3:.3f}")
+    assert "E[eps] / gamma_opt(N)" in lines[3]
