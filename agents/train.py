@@ -267,6 +267,14 @@ def training_budget(cfg: dict[str, Any], curve: Any) -> tuple[int, dict[str, Any
         curve.gamma_gauss, curve.gamma_opt, iterations_per_gain=float(st["iterations_per_gain"]), steps_per_iteration=per, cap=cap
     )
     gain = math.log(curve.gamma_gauss / curve.gamma_opt)
+    ipg = float(st["iterations_per_gain"])
+    if gain > 0:
+        text = f"budget scaled to the plant: {ipg:g} / log(gamma_gauss / gamma_opt) = {ipg:g} / {gain:.4f} = " + (
+            f"{math.ceil(ipg / gain)} iterations of {per} steps"
+            + (f": at the ceiling n_timesteps = {cap}" if total == cap else f" = {total} steps (ceiling {cap})")
+        )
+    else:
+        text = f"budget scaled to the plant: the optimal design gains nothing over the Gaussian attack; the ceiling {cap}"
     return total, {
         "how": "plant",
         "n_timesteps": total,
@@ -274,11 +282,7 @@ def training_budget(cfg: dict[str, Any], curve: Any) -> tuple[int, dict[str, Any
         "steps_per_iteration": per,
         "log_gain_over_gaussian": gain,
         "iterations_per_gain": float(st["iterations_per_gain"]),
-        "text": (
-            f"budget scaled to the plant: {float(st['iterations_per_gain']):g} / log(gamma_gauss / gamma_opt) = "
-            f"{float(st['iterations_per_gain']):g} / {gain:.4f} iterations of {per} steps = {total} steps"
-            + (" (the ceiling n_timesteps)" if total == cap else f" (ceiling {cap})")
-        ),
+        "text": text,
     }
 
 

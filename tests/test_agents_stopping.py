@@ -146,3 +146,22 @@ def test_a_real_ars_run_stops_when_the_rule_says_so(tmp_path):
     assert meta["timesteps_done"] < 200000
     assert len(meta["stopping"]["curve"]) == 2
     assert json.loads((run / "run.json").read_text())["stopping"]["oracle"].startswith("optimal")
+
+
+def test_the_ars_default_budget_is_scaled_to_the_plant_and_an_explicit_one_is_fixed():
+    from agents.config import apply_override, env_config, load_config
+    from agents.curves import curve_for
+    from agents.train import training_budget
+    from encctl_gym.envs.config import resolve_params
+
+    cfg = load_config("ars", "paper-example")
+    assert (cfg["stopping"]["rule"], cfg["stopping"]["budget"]) == ("oracle", "plant")
+    params = resolve_params(env_config(cfg))
+    c = curve_for(params, cfg["observation"], algo="ars", system="paper-example", seed=0)
+    hp = cfg["hyperparams"]
+    per = (2 * hp["n_delta"] + 1) * hp["n_eval_episodes"] * params.horizon
+    total, how = training_budget(cfg, c)
+    assert total == math.ceil(cfg["stopping"]["iterations_per_gain"] / math.log(c.gamma_gauss / c.gamma_opt)) * per
+    assert how["how"] == "plant" and how["steps_per_iteration"] == per and str(total) in how["text"]
+    apply_override(cfg, "stopping.budget=fixed")
+    assert training_budget(cfg, c) == (cfg["n_timesteps"], {"how": "fixed", "n_timesteps": cfg["n_timesteps"]})
