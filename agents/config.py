@@ -126,8 +126,8 @@ COMMON: dict[str, Any] = {
     "stopping": {
         "rule": "none",
         "tolerance": 0.02,
-        "window": 10,
-        "plateau_gain": 0.005,
+        "window": 20,
+        "plateau_gain": 0.02,
         "min_evaluations": 4,
         "budget": "fixed",
         "iterations_per_gain": 200.0,

@@ -63,8 +63,8 @@ class StoppingRule:
     """
 
     tolerance: float = 0.02
-    window: int = 5
-    plateau_gain: float = 0.005
+    window: int = 20
+    plateau_gain: float = 0.02
     min_evaluations: int = 4
 
     def __post_init__(self) -> None:
