@@ -149,3 +149,13 @@ def test_evaluate_lines_warn_for_a_learned_attacker_whose_margin_the_episodes_ca
     assert "median (paired, bootstrap)" in lines[1]
     assert lines[2].startswith(f"paper-example, delay 0, N = {N}: ars / gaussian: {1.04 / 1.3:.3f}")
     assert "E[eps] / gamma_opt(N)" in lines[3]
+
+
+def test_curve_table_reports_first_best_and_last_ratio_to_gamma_opt():
+    from agents.curves import LearningCurve, curve_table
+
+    c = LearningCurve("ars x s0", "ars", "x", 0, 256, 2.0, 3.0, 2.0, "closed_loop")
+    for step, eps in ((0, [4.0, 6.0]), (10, [2.0, 2.4]), (20, [2.4, 2.8])):
+        c.append(step, np.array(eps))
+    row = curve_table([c]).splitlines()[2]
+    assert row == "| ars x s0 | 256 | 20 | 3 | 2.500 | 1.100 (10) | 1.300 |"
