@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The runs behind docs/results/learned/ (issue 23): the learned attacker a user gets on their own
 # plant (ARS on the 3 x 2 plant with R_sigma = 10 of docs/results/learned/plant3x2_r10.yaml, the
-# old fixed 20M-step budget against the default stopping rule with its plant-scaled budget) and
-# the PPO recipe of the design example (agents/configs/ppo_paper-example.yaml). Every run is
+# old fixed 20M-step budget against the default stopping rule with its plant-scaled budget; the
+# default on the design example too) and the PPO recipe of the design example (agents/configs/ppo_paper-example.yaml). Every run is
 # evaluated with `encctl-gym evaluate` at the training length N = 256 on the paired seeds
 # 20000, ... with 100 and 500 episodes (the margin lines say what each resolves).
 # Usage: bash agents/learned_runs.sh [OUT=results/learned] [WHICH=all|ars|ppo]
@@ -28,6 +28,8 @@ if [[ $WHICH == all || $WHICH == ars ]]; then
   evaluate ars_3x2_fixed20M
   train ars_3x2_default --algo ars --system $PLANT
   evaluate ars_3x2_default
+  train ars_pe_default --algo ars --preset paper-example
+  evaluate ars_pe_default
 fi
 if [[ $WHICH == all || $WHICH == ppo ]]; then
   train ppo_pe_recipe --algo ppo --preset paper-example

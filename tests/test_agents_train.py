@@ -335,7 +335,7 @@ def test_evaluate_prints_the_compare_table_on_paired_seeds(ppo_run, tmp_path, ca
     to_oracle = np.exp(np.mean(np.log(learned.final_epsilon) - np.log(oracle.final_epsilon)))
     margin = [line for line in text.out.splitlines() if line.startswith("plant2, delay 0, N = 64: ppo / optimal-cl: ")]
     assert margin and margin[0].split(": ")[2].startswith(f"{to_oracle:.3f} [") and "6 episodes resolve +-" in margin[0]
-    assert (out / "resolution.md").read_text().count("* plant2") == 4
+    assert (out / "summary.md").read_text().count("* plant2, delay 0, N = 64: ppo") == 4
     assert (
         cli.main(
             ["evaluate", str(ppo_run), "--episodes", "2", "--points", "1", "--deterministic", "--out", str(out), "--no-progress"]

@@ -21,7 +21,7 @@ The margin it can resolve (:mod:`agents.resolution`): after the table, one line 
 attacker and reference (the oracle, the Gaussian attack, ``gamma_opt(N)``) with the ratio at
 the horizon, its 95 % interval, the half-width the episodes resolve and, when the interval
 contains 1, a warning with the episodes that would resolve the margin (and those for
-``--resolve``, +-5 % by default); also written to ``resolution.md``.
+``--resolve``, +-5 % by default); also appended to ``summary.md``.
 """
 
 from __future__ import annotations
@@ -243,10 +243,8 @@ def run(args: argparse.Namespace) -> int:
     if lines:
         print()
         print("\n".join(lines))
-        (out / "resolution.md").write_text(
-            f"Margins of `{' '.join(cmd)}` (95 % intervals; `agents.resolution`):\n\n" + "\n".join(f"* {x}" for x in lines) + "\n"
-        )
-        paths.append(out / "resolution.md")
+        with (out / "summary.md").open("a") as fh:
+            fh.write("\nWhat the episodes resolve (95 % intervals; `agents.resolution`):\n\n" + "\n".join(f"* {x}" for x in lines) + "\n")
     print(
         f"\n{episodes} episodes per attacker and attack length on environment seeds {args.seed}, {args.seed + 1}, ...; "
         f"{'deterministic' if args.deterministic else 'stochastic'} policy ({args.which} model)."
