@@ -244,7 +244,11 @@ def run(args: argparse.Namespace) -> int:
         print()
         print("\n".join(lines))
         with (out / "summary.md").open("a") as fh:
-            fh.write("\nWhat the episodes resolve (95 % intervals; `agents.resolution`):\n\n" + "\n".join(f"* {x}" for x in lines) + "\n")
+            fh.write(
+                "\nWhat the episodes resolve (95 % intervals; `agents.resolution`):\n\n"
+                + "\n".join(f"* {x}" for x in lines)
+                + "\n"
+            )
     print(
         f"\n{episodes} episodes per attacker and attack length on environment seeds {args.seed}, {args.seed + 1}, ...; "
         f"{'deterministic' if args.deterministic else 'stochastic'} policy ({args.which} model)."
