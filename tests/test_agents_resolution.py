@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from agents.resolution import median_resolution, paired_resolution, reference_resolution, resolution_line
+from encctl_gym.agents.resolution import median_resolution, paired_resolution, reference_resolution, resolution_line
 from encctl_gym.errors import ParameterError
 
 #: t_{0.975} with 99 and 399 degrees of freedom (statistical tables).
@@ -128,9 +128,9 @@ def test_bad_reference_is_refused():
 
 
 def test_evaluate_lines_warn_for_a_learned_attacker_whose_margin_the_episodes_cannot_resolve():
-    from experiments.compare.evaluate_run import resolution_lines
-    from experiments.compare.records import Curve, Result
-    from experiments.compare.settings import make_setting
+    from encctl_gym.experiments.compare.evaluate_run import resolution_lines
+    from encctl_gym.experiments.compare.records import Curve, Result
+    from encctl_gym.experiments.compare.settings import make_setting
 
     setting = make_setting("paper-example", 0, 256)
     N = setting.params.horizon
@@ -152,7 +152,7 @@ def test_evaluate_lines_warn_for_a_learned_attacker_whose_margin_the_episodes_ca
 
 
 def test_curve_table_reports_first_best_and_last_ratio_to_gamma_opt():
-    from agents.curves import LearningCurve, curve_table
+    from encctl_gym.agents.curves import LearningCurve, curve_table
 
     c = LearningCurve("ars x s0", "ars", "x", 0, 256, 2.0, 3.0, 2.0, "closed_loop")
     for step, eps in ((0, [4.0, 6.0]), (10, [2.0, 2.4]), (20, [2.4, 2.8])):

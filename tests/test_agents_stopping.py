@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from agents.stopping import OracleStopper, StoppingRule, decide, plant_budget
+from encctl_gym.agents.stopping import OracleStopper, StoppingRule, decide, plant_budget
 from encctl_gym.errors import ConfigError
 
 K = 32
@@ -124,9 +124,9 @@ def test_bad_rules_are_refused(kw, match):
 
 @pytest.mark.slow
 def test_a_real_ars_run_stops_when_the_rule_says_so(tmp_path):
-    from agents.config import apply_override, load_config
-    from agents.runs import read_run
-    from agents.train import train
+    from encctl_gym.agents.config import apply_override, load_config
+    from encctl_gym.agents.runs import read_run
+    from encctl_gym.agents.train import train
 
     cfg = load_config("ars", "paper-example", quick=True)
     for item in (
@@ -149,9 +149,9 @@ def test_a_real_ars_run_stops_when_the_rule_says_so(tmp_path):
 
 
 def test_the_ars_default_budget_is_scaled_to_the_plant_and_an_explicit_one_is_fixed():
-    from agents.config import apply_override, env_config, load_config
-    from agents.curves import curve_for
-    from agents.train import training_budget
+    from encctl_gym.agents.config import apply_override, env_config, load_config
+    from encctl_gym.agents.curves import curve_for
+    from encctl_gym.agents.train import training_budget
     from encctl_gym.envs.config import resolve_params
 
     cfg = load_config("ars", "paper-example")

@@ -61,7 +61,8 @@ def resolution_lines(result: Result, learned: Sequence[str], *, target: float = 
     paired ratio to the oracle (geometric mean with a t interval, and the median with a bootstrap
     interval), to the Gaussian attack, and ``E[eps] / gamma_opt(N)`` (the median where the mean
     is not reliable), each by :func:`agents.resolution.resolution_line`."""
-    from agents.resolution import median_resolution, paired_resolution, reference_resolution, resolution_line
+    from encctl_gym.agents.resolution import median_resolution, paired_resolution, reference_resolution, resolution_line
+
     from encctl_gym.ident.tails import error_tail_exponent
 
     out = []
