@@ -33,6 +33,11 @@ key               meaning
                   same seeds every time: ``seed``), ``final_episodes``, ``final_horizon``,
                   ``elgamal`` (``episodes``, ``max_samples``, ``key_length``) of the final
                   evaluation
+``stopping``      ``rule`` (``none``: train ``n_timesteps``; ``oracle``: the rule of
+                  :mod:`agents.stopping` on the learning curve, with ``tolerance``,
+                  ``window``, ``plateau_gain``, ``min_evaluations``), ``budget``
+                  (``fixed``: ``n_timesteps``; ``plant``: :func:`agents.stopping.plant_budget`
+                  with ``iterations_per_gain``, at most ``n_timesteps``)
 ================  ==========================================================================
 
 Every entry is checked (:func:`validate_config`): an unknown key, a value of the wrong type or
@@ -52,7 +57,7 @@ from typing import Any
 
 import yaml
 
-from encctl_gym._validation import check_int, format_value, read_bounded
+from encctl_gym._validation import check_int, check_nonnegative, check_positive, format_value, read_bounded
 from encctl_gym.envs.config import completion_preset, resolve_params
 from encctl_gym.envs.config import default_config as env_default_config
 from encctl_gym.errors import ConfigError, EncctlError, ParameterError
@@ -64,6 +69,7 @@ __all__ = [
     "DEFAULTS_DIR",
     "COMMON",
     "REWARD_SCALINGS",
+    "BUDGETS",
     "MAX_CONFIG_BYTES",
     "MAX_CONFIG_DEPTH",
     "MAX_STEPS",
@@ -91,6 +97,9 @@ MAX_STEPS = 2**53
 MAX_SEED = 2**32 - 1
 #: Choices of ``reward_scaling`` (:class:`agents.sb3.SB3VecEnv`).
 REWARD_SCALINGS = ("none", "samples")
+#: Choices of ``stopping.budget``: ``n_timesteps`` as given, or scaled to the plant
+#: (:func:`agents.stopping.plant_budget`) with ``n_timesteps`` as its ceiling.
+BUDGETS = ("fixed", "plant")
 
 #: The algorithm-independent entries and their defaults.
 COMMON: dict[str, Any] = {
@@ -112,6 +121,15 @@ COMMON: dict[str, Any] = {
         "final_episodes": 50,
         "final_horizon": None,
         "elgamal": {"episodes": 2, "max_samples": 40, "key_length": 64},
+    },
+    "stopping": {
+        "rule": "none",
+        "tolerance": 0.02,
+        "window": 20,
+        "plateau_gain": 0.02,
+        "min_evaluations": 4,
+        "budget": "fixed",
+        "iterations_per_gain": 200.0,
     },
 }
 
@@ -334,6 +352,25 @@ def _features(name: str, v: Any) -> Any:
 
 _str = _typed(str, "a string")
 
+
+def _checked(check: Callable[[str, Any], float]) -> Check:
+    """A number check of :mod:`encctl_gym._validation` raising :class:`ConfigError` instead."""
+
+    def run(name: str, v: Any) -> Any:
+        try:
+            return check(name, v)
+        except ParameterError as exc:
+            raise ConfigError(str(exc)) from None
+
+    return run
+
+
+def _stopping_rules() -> tuple[str, ...]:
+    from .stopping import RULES
+
+    return RULES
+
+
 #: Checks of every entry but ``env`` and ``hyperparams`` (checked against the environment and
 #: the algorithm). A nested mapping is a nested schema.
 SCHEMA: dict[str, Any] = {
@@ -357,6 +394,15 @@ SCHEMA: dict[str, Any] = {
         "final_episodes": _int(1, maximum=MAX_STEPS),
         "final_horizon": _int(2, optional=True, maximum=MAX_STEPS),
         "elgamal": {"episodes": _int(0, maximum=MAX_STEPS), "max_samples": _int(2, maximum=MAX_STEPS), "key_length": _int(16)},
+    },
+    "stopping": {
+        "rule": lambda name, v: _choice(_stopping_rules())(name, v),
+        "tolerance": _checked(check_nonnegative),
+        "window": _int(3, maximum=MAX_STEPS),
+        "plateau_gain": _checked(check_nonnegative),
+        "min_evaluations": _int(2, maximum=MAX_STEPS),
+        "budget": _choice(BUDGETS),
+        "iterations_per_gain": _checked(check_positive),
     },
 }
 

@@ -28,7 +28,15 @@ import numpy as np
 from encctl_gym.errors import ConfigError
 from encctl_gym.plotting import save_figure
 
-__all__ = ["CURVE_FILE", "LearningCurve", "reference_designs", "curve_for", "load_learning_curve", "plot_learning_curves"]
+__all__ = [
+    "CURVE_FILE",
+    "LearningCurve",
+    "reference_designs",
+    "curve_for",
+    "load_learning_curve",
+    "plot_learning_curves",
+    "curve_table",
+]
 
 #: File name of a run's learning curve (and ``.png`` for its plot).
 CURVE_FILE = "learning_curve.npz"
@@ -302,8 +310,28 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ConfigError as exc:
         print(f"python -m encctl_gym.agents.curves: error: {exc}", file=sys.stderr)
         return 2
+    print(curve_table(args.runs))
     print(f"wrote {path}")
     return 0
+
+
+def curve_table(curves: Sequence[LearningCurve | str | Path]) -> str:
+    """A markdown table of learning curves: per run its steps, evaluations and ``E[eps] /
+    gamma_opt(N)`` at the first, the best (with its step) and the last evaluation."""
+    rows = ["| run | N | steps | evaluations | first | best (step) | last |", "|---|---|---|---|---|---|---|"]
+    for c in curves:
+        curve = c if isinstance(c, LearningCurve) else load_learning_curve(c)
+        name = curve.label if isinstance(c, LearningCurve) else Path(c).name
+        if not len(curve.timesteps):
+            rows.append(f"| {name} | {curve.N} | 0 | 0 | | | |")
+            continue
+        r = curve.ratio()[0]
+        i = int(np.argmin(r))
+        rows.append(
+            f"| {name} | {curve.N} | {int(curve.timesteps[-1])} | {len(r)} | {r[0]:.3f} | {r[i]:.3f} ({int(curve.timesteps[i])}) "
+            f"| {r[-1]:.3f} |"
+        )
+    return "\n".join(rows)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -174,7 +174,11 @@ def train(
     }
     _write_meta(run_dir, meta)
     curve = curve_for(params, cfg["observation"], algo=cfg["algo"], system=cfg["system"], seed=seed)
-    total = int(cfg["n_timesteps"])
+    total, budget = training_budget(cfg, curve)
+    meta["n_timesteps"] = total
+    meta["budget"] = budget
+    stopper = _oracle_stopper(cfg, params, env_cfg, n_eval, int(ev["seed"]), log=print if progress else None)
+    hook = _both(stopper, on_evaluation)
     callbacks: list[Any] = [
         AttackMetricsCallback(),
         LearningCurveCallback(
@@ -188,7 +192,7 @@ def train(
             best_model_save_path=str(run_dir),
             deterministic=False,
             verbose=verbose,
-            on_evaluation=on_evaluation,
+            on_evaluation=hook,
         ),
     ]
     if progress:
@@ -218,9 +222,105 @@ def train(
             "last_ratio_to_gamma_opt": float(curve.ratio()[0][-1]) if len(curve.timesteps) else None,
         },
     )
+    if stopper is not None:
+        final = stopper.final()
+        meta["stopping"] = {
+            "rule": dict(cfg["stopping"]),
+            "oracle": stopper.oracle_name,
+            "oracle_mean_epsilon": float(np.mean(stopper.oracle_epsilon)),
+            "decision": final.as_dict() if final is not None else None,
+            "curve": [
+                {"timestep": d.timestep, "ratio": d.ratio, "low": d.low, "high": d.high, "reason": d.reason}
+                for d in stopper.decisions
+            ],
+        }
     _write_meta(run_dir, meta)
     env.close()
     return run_dir
+
+
+def steps_per_iteration(cfg: dict[str, Any], horizon: int) -> int:
+    """Environment steps of one update of the algorithm: ARS plays ``2 n_delta + 1`` policies on
+    ``n_eval_episodes`` episodes of ``horizon`` steps (:class:`agents.ars.PairedARS`); an
+    on-policy algorithm collects ``n_steps`` per copy; any other steps once per copy."""
+    hp = cfg["hyperparams"]
+    if cfg["algo"] == "ars":
+        return (2 * int(hp.get("n_delta", 8)) + 1) * int(hp.get("n_eval_episodes", 1)) * int(horizon)
+    return int(hp.get("n_steps", 1)) * int(cfg["n_envs"])
+
+
+def training_budget(cfg: dict[str, Any], curve: Any) -> tuple[int, dict[str, Any]]:
+    """The run's budget in environment steps and how it was set (``stopping.budget``).
+
+    ``fixed``: ``n_timesteps``. ``plant``: :func:`agents.stopping.plant_budget` of the curve's
+    references ``gamma_gauss(N) / gamma_opt(N)``, :func:`steps_per_iteration` and
+    ``stopping.iterations_per_gain``, at most ``n_timesteps``.
+    """
+    from .stopping import plant_budget
+
+    cap = int(cfg["n_timesteps"])
+    st = cfg["stopping"]
+    if st["budget"] != "plant":
+        return cap, {"how": "fixed", "n_timesteps": cap}
+    per = steps_per_iteration(cfg, curve.N)
+    total = plant_budget(
+        curve.gamma_gauss, curve.gamma_opt, iterations_per_gain=float(st["iterations_per_gain"]), steps_per_iteration=per, cap=cap
+    )
+    gain = math.log(curve.gamma_gauss / curve.gamma_opt)
+    ipg = float(st["iterations_per_gain"])
+    if gain > 0:
+        text = f"budget scaled to the plant: {ipg:g} / log(gamma_gauss / gamma_opt) = {ipg:g} / {gain:.4f} = " + (
+            f"{math.ceil(ipg / gain)} iterations of {per} steps"
+            + (f": at the ceiling n_timesteps = {cap}" if total == cap else f" = {total} steps (ceiling {cap})")
+        )
+    else:
+        text = f"budget scaled to the plant: the optimal design gains nothing over the Gaussian attack; the ceiling {cap}"
+    return total, {
+        "how": "plant",
+        "n_timesteps": total,
+        "ceiling": cap,
+        "steps_per_iteration": per,
+        "log_gain_over_gaussian": gain,
+        "iterations_per_gain": float(st["iterations_per_gain"]),
+        "text": text,
+    }
+
+
+def _oracle_stopper(cfg: dict[str, Any], params: Any, env_cfg: dict[str, Any], episodes: int, seed: int, *, log: Any) -> Any:
+    """The :class:`agents.stopping.OracleStopper` of ``stopping.rule = oracle`` (None for ``none``):
+    the oracle of the policy's class played once on the evaluation seeds."""
+    from .curves import reference_designs
+    from .evaluate import rollout
+    from .optimal import OptimalDesignAttacker
+    from .stopping import OracleStopper, StoppingRule
+
+    st = cfg["stopping"]
+    if st["rule"] == "none":
+        return None
+    if episodes < 2:
+        raise ConfigError(f"stopping.rule = oracle needs eval.episodes >= 2 (paired ratios), got {episodes}")
+    rule = StoppingRule(
+        tolerance=float(st["tolerance"]),
+        window=int(st["window"]),
+        plateau_gain=float(st["plateau_gain"]),
+        min_evaluations=int(st["min_evaluations"]),
+    )
+    design, _ = reference_designs(params, cfg["observation"])
+    oracle = OptimalDesignAttacker(params, design=design, feedback=design.kind == "closed_loop")
+    finals = rollout(oracle, env_cfg, episodes=episodes, seed=seed, record=False).final_epsilon
+    return OracleStopper(rule, finals, log=log, oracle_name=oracle.name)
+
+
+def _both(first: Any, second: Any) -> Callable[[Any], bool] | None:
+    """One ``on_evaluation`` hook calling both (either may be None); False if either says stop."""
+    hooks = [h for h in (first, second) if h is not None]
+    if not hooks:
+        return None
+
+    def hook(curve: Any) -> bool:
+        return all([h(curve) is not False for h in hooks])  # a list: every hook sees every evaluation
+
+    return hook
 
 
 # --------------------------------------------------------------------------- final evaluation
@@ -372,8 +472,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Train, save, evaluate; print a one-paragraph summary."""
     cfg = load_config(args.algo, args.preset, path=args.config, system=args.system, quick=args.quick)
-    if args.n_timesteps is not None:
+    if args.n_timesteps is not None:  # an explicit budget is used as given (the stopping rule still applies)
         apply_override(cfg, f"n_timesteps={args.n_timesteps}")
+        apply_override(cfg, "stopping.budget=fixed")
     if args.n_envs is not None:
         apply_override(cfg, f"n_envs={args.n_envs}")
     for item in args.overrides:
@@ -395,6 +496,11 @@ def run(args: argparse.Namespace) -> int:
         f"trained {cfg['algo']} for {meta['timesteps_done']} steps in {meta['train_seconds']} s "
         f"({meta['steps_per_second']} steps/s); saved to {run_dir}"
     )
+    if meta.get("budget", {}).get("how") == "plant":
+        print(meta["budget"]["text"])
+    stop = (meta.get("stopping") or {}).get("decision")
+    if stop is not None:
+        print(f"stopping rule ({cfg['stopping']['rule']}): {stop['reason']}: {stop['message']}")
     lc = meta["learning_curve"]
     if lc["last_ratio_to_gamma_opt"] is not None:
         print(

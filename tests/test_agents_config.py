@@ -61,11 +61,14 @@ def test_every_algorithm_has_a_default_and_every_file_resolves():
 def test_a_tuned_file_overrides_the_default_and_quick_overrides_both():
     default = default_config("ppo")
     tuned = load_config("ppo", "paper-example")
-    assert tuned["n_timesteps"] == 2 * default["n_timesteps"] == 1_000_000  # ppo_paper-example.yaml
-    assert tuned["hyperparams"] == default["hyperparams"]
+    recipe = read_yaml(CONFIG_DIR / "ppo_paper-example.yaml")  # the PPO recipe of the design example
+    assert tuned["n_timesteps"] == recipe["n_timesteps"] != default["n_timesteps"]
+    assert tuned["hyperparams"]["policy_kwargs"]["net_arch"] == recipe["hyperparams"]["policy_kwargs"]["net_arch"]
+    assert tuned["hyperparams"]["learning_rate"] == recipe["hyperparams"]["learning_rate"]
+    assert tuned["eval"]["episodes"] == default["eval"]["episodes"]  # merged, not replaced
     quick = load_config("ppo", "paper-example", quick=True)
     assert quick["n_timesteps"] == 4096 and quick["hyperparams"]["n_steps"] == 128
-    assert quick["hyperparams"]["gamma"] == default["hyperparams"]["gamma"]  # merged, not replaced
+    assert quick["hyperparams"]["gamma"] == recipe["hyperparams"]["gamma"]  # merged, not replaced
 
 
 def test_config_file_then_preset(tmp_path):

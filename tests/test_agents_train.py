@@ -331,6 +331,11 @@ def test_evaluate_prints_the_compare_table_on_paired_seeds(ppo_run, tmp_path, ca
     ratio = np.exp(np.mean(np.log(learned.final_epsilon) - np.log(g.final_epsilon)))
     assert float(rows["ppo"]["ratio_to_gaussian"]) == pytest.approx(ratio, rel=1e-12)
     assert int(rows["ppo"]["horizon"]) == 64
+    oracle = rollout(OptimalDesignAttacker(params), cfg, episodes=6, seed=7, record=False)
+    to_oracle = np.exp(np.mean(np.log(learned.final_epsilon) - np.log(oracle.final_epsilon)))
+    margin = [line for line in text.out.splitlines() if line.startswith("plant2, delay 0, N = 64: ppo / optimal-cl: ")]
+    assert margin and margin[0].split(": ")[2].startswith(f"{to_oracle:.3f} [") and "6 episodes resolve +-" in margin[0]
+    assert (out / "summary.md").read_text().count("* plant2, delay 0, N = 64: ppo") == 4
     assert (
         cli.main(
             ["evaluate", str(ppo_run), "--episodes", "2", "--points", "1", "--deterministic", "--out", str(out), "--no-progress"]

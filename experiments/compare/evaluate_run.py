@@ -16,12 +16,19 @@ nearly rank deficient, so ``--deterministic`` is allowed but warned about. ``--s
 the run on other presets or plant files too (same observation layout needed). Outputs (CSV, PNG,
 ``summary.md``) go to ``RUN_DIR/evaluation`` unless ``--out`` is given; a new evaluation
 replaces the files of the previous one there.
+
+The margin it can resolve (:mod:`agents.resolution`): after the table, one line per learned
+attacker and reference (the oracle, the Gaussian attack, ``gamma_opt(N)``) with the ratio at
+the horizon, its 95 % interval, the half-width the episodes resolve and, when the interval
+contains 1, a warning with the episodes that would resolve the margin (and those for
+``--resolve``, +-5 % by default); also appended to ``summary.md``.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -34,16 +41,55 @@ from encctl_gym.errors import ConfigError
 
 from .attackers import system_config
 from .cli import names, positive, write_outputs
-from .protocol import compute
+from .protocol import GAUSSIAN_NAME, compute
+from .records import Result
 from .report import comparison_table, design_efficiencies
 from .settings import Setting, make_setting, parse_delays, system_entry
 
-__all__ = ["BASELINES", "EPISODES", "run_settings", "system_config", "add_arguments", "run"]
+__all__ = ["BASELINES", "EPISODES", "RESOLVE", "run_settings", "resolution_lines", "system_config", "add_arguments", "run"]
 
 #: The registered attackers a run is evaluated against.
 BASELINES = ("gaussian", "colored", "optimal")
 #: Default episodes per attacker and attack length.
 EPISODES = 100
+#: Default target half-width of ``--resolve`` (a fraction).
+RESOLVE = 0.05
+
+
+def resolution_lines(result: Result, learned: Sequence[str], *, target: float = RESOLVE) -> list[str]:
+    """What the episodes resolve (module docstring): for every setting and learned attacker, its
+    paired ratio to the oracle (geometric mean with a t interval, and the median with a bootstrap
+    interval), to the Gaussian attack, and ``E[eps] / gamma_opt(N)`` (the median where the mean
+    is not reliable), each by :func:`agents.resolution.resolution_line`."""
+    from encctl_gym.agents.resolution import median_resolution, paired_resolution, reference_resolution, resolution_line
+
+    from encctl_gym.ident.tails import error_tail_exponent
+
+    out = []
+    for s in result.settings:
+        curves = {c.attacker: c for c in result.curves[s.key]}
+        oracle = next((c for c in curves.values() if c.oracle), None)
+        gauss = curves.get(GAUSSIAN_NAME)
+        p = s.params
+        for name in learned:
+            c = curves.get(name)
+            if c is None or c.final.size < 2:
+                continue
+            N = int(c.N[-1])
+            where = f"{s.system}, delay {s.delay}, N = {N}: {name}"
+            if oracle is not None:
+                out.append(
+                    resolution_line(f"{where} / {oracle.attacker}", paired_resolution(c.final, oracle.final), target=target)
+                )
+                out.append(
+                    resolution_line(f"{where} / {oracle.attacker}", median_resolution(c.final, oracle.final), target=target)
+                )
+            if gauss is not None:
+                out.append(resolution_line(f"{where} / {gauss.attacker}", paired_resolution(c.final, gauss.final), target=target))
+            rule = error_tail_exponent(p.n, p.m, N) if N > p.n + p.m else None
+            res = reference_resolution(c.final, float(s.design.gamma(N)), tail_exponent=rule)
+            out.append(resolution_line(f"{where} E[eps] / gamma_opt(N)", res, target=target))
+    return out
 
 
 def run_settings(
@@ -115,6 +161,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--elgamal-episodes", type=int, default=0, help="episodes of each attacker through real ElGamal ciphertexts (default 0)"
     )
+    parser.add_argument(
+        "--resolve",
+        type=float,
+        default=100 * RESOLVE,
+        metavar="PCT",
+        help=f"half-width in per cent whose episodes the margin lines estimate (default {100 * RESOLVE:g})",
+    )
     parser.add_argument("--out", default=None, help="output directory (default RUN_DIR/evaluation)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
@@ -125,6 +178,8 @@ def run(args: argparse.Namespace) -> int:
     episodes = positive("episodes", args.episodes) or EPISODES
     positive("points", args.points)
     positive("elgamal-episodes", args.elgamal_episodes, 0)
+    if not (args.resolve > 0 and args.resolve < 1000):  # also refuses nan
+        raise ConfigError(f"--resolve must be a percentage in (0, 1000), got {args.resolve!r}")
     if args.full_budget and args.samples is not None:
         raise ConfigError("give --samples or --full-budget, not both")
     length = None if args.full_budget else (positive("samples", args.samples, 2) or resolve_params(info.env).horizon)
@@ -141,8 +196,9 @@ def run(args: argparse.Namespace) -> int:
     info.model_path(which)  # a readable archive, checked before the work
     out = check_output_dir(Path(args.out) if args.out else info.path / "evaluation")
 
+    label = info.algo + ("-blind" if info.observation == "blind" else "")
+
     def learned(setting: Setting) -> list[Attacker]:
-        label = info.algo + ("-blind" if info.observation == "blind" else "")
         return [
             load_attacker(
                 info.path,
@@ -185,6 +241,16 @@ def run(args: argparse.Namespace) -> int:
     print(comparison_table(result))
     print()
     print(design_efficiencies(result))
+    lines = resolution_lines(result, [label], target=args.resolve / 100)
+    if lines:
+        print()
+        print("\n".join(lines))
+        with (out / "summary.md").open("a") as fh:
+            fh.write(
+                "\nWhat the episodes resolve (95 % intervals; `agents.resolution`):\n\n"
+                + "\n".join(f"* {x}" for x in lines)
+                + "\n"
+            )
     print(
         f"\n{episodes} episodes per attacker and attack length on environment seeds {args.seed}, {args.seed + 1}, ...; "
         f"{'deterministic' if args.deterministic else 'stochastic'} policy ({args.which} model)."
