@@ -1,4 +1,4 @@
-"""agents.resolution: ratios with intervals and the episodes a margin needs, on synthetic samples
+"""encctl_gym.agents.resolution: ratios with intervals and the episodes a margin needs, on synthetic samples
 whose answers are known by construction."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ import math
 
 import numpy as np
 import pytest
-
 from encctl_gym.agents.resolution import median_resolution, paired_resolution, reference_resolution, resolution_line
+
 from encctl_gym.errors import ParameterError
 
 #: t_{0.975} with 99 and 399 degrees of freedom (statistical tables).

@@ -39,15 +39,15 @@ def check_progress(progress: Any) -> ProgressCallback | None:
 class PhaseBars:
     """One tqdm bar per phase (a new phase closes the previous bar, which stays on screen).
 
+    Use as ``progress=`` of :meth:`~.base.Breaker.precompute`; :meth:`close` the last bar at the
+    end (also when the work stopped with an exception).
+
     Parameters
     ----------
     file : text stream, optional
         Where the bars go (default ``sys.stderr``).
     prefix : str
         Put before every phase name (``"index-calculus "``).
-
-    Use as ``progress=`` of :meth:`~.base.Breaker.precompute`; :meth:`close` the last bar at the
-    end (also when the work stopped with an exception).
     """
 
     def __init__(self, file: TextIO | None = None, prefix: str = "") -> None:
