@@ -1,0 +1,175 @@
+"""The attacker-defender game (encctl_gym.multiagent): PettingZoo's API, bit-for-bit agreement
+with the single environment, the levers, the rewards and what the defender may see."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+pytest.importorskip("pettingzoo")
+
+from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
+
+import encctl_gym  # noqa: E402,F401
+from agents.evaluate import budget_config, env_config  # noqa: E402
+from encctl_gym.errors import ParameterError  # noqa: E402
+from encctl_gym.loop.backend import lqr_gain  # noqa: E402
+from encctl_gym.loop.defenses import audit_tolerance  # noqa: E402
+from encctl_gym.multiagent import EncryptedControlGame, GameRules  # noqa: E402
+
+N = 40
+NONE = np.array([-1.0, -1.0], dtype=np.float32)  # no audit, no noise
+AUDIT = np.array([1.0, -1.0], dtype=np.float32)
+
+
+def _cfg(**kw):
+    return budget_config(env_config({"preset": "paper-example", **kw}), N)
+
+
+def _inputs(m, seed=3):
+    return np.random.default_rng(seed).uniform(-0.5, 0.5, (N, m)).astype(np.float32)
+
+
+def test_the_game_passes_pettingzoos_api_and_seed_tests():
+    cfg = _cfg()
+    parallel_api_test(EncryptedControlGame(cfg), num_cycles=200)
+    parallel_seed_test(lambda: EncryptedControlGame(cfg), num_cycles=200)
+
+
+@pytest.mark.parametrize("noise", [None, 0.5])
+def test_a_fixed_defender_reproduces_the_single_environment_bit_for_bit(noise):
+    cfg = _cfg()
+    game = EncryptedControlGame(cfg)
+    m, s2 = game.params.m, game.params.sigma_u2
+    single_cfg = cfg if noise is None else {**cfg, "defender": {"name": "noise", "sigma_d2": s2 * noise}}
+    env = gym.make("encctl_gym/EncryptedLTIAttack-v0", config=single_cfg)
+    d = NONE if noise is None else np.array([-1.0, noise], dtype=np.float32)
+    o1, i1 = env.reset(seed=11)
+    o2, i2 = game.reset(seed=11)
+    assert np.array_equal(o1, o2["attacker"]) and i1 == i2["attacker"]
+    for a in _inputs(m):
+        o1, r1, te1, tr1, i1 = env.step(a)
+        o2, r2, te2, tr2, i2 = game.step({"attacker": np.r_[a, 1.0].astype(np.float32), "defender": d})
+        assert np.array_equal(o1, o2["attacker"])
+        assert r1 == r2["attacker"] and r2["defender"] == -r1 - i2["defender"]["cost"]
+        assert i1 == i2["attacker"] and (te1, tr1) == (te2["attacker"], tr2["attacker"])
+        if te1 or tr1:
+            break
+    assert te1 and not game.agents
+
+
+def test_an_audit_catches_an_injected_input_and_never_a_passed_through_one():
+    rules = {"detection_penalty": 2.5, "audit_cost": 0.0}
+    game = EncryptedControlGame(_cfg(), rules)
+    m = game.params.m
+    game.reset(seed=0)
+    passing = np.r_[np.full(m, 0.3), -1.0].astype(np.float32)
+    steps = 0
+    while game.agents:
+        _, rew, term, trunc, info = game.step({"attacker": passing, "defender": AUDIT})
+        steps += 1
+        assert not info["attacker"]["detected"]
+    assert steps == N and info["defender"]["audits"] == N - 1  # N samples, N actions; no input to audit at the first step
+    # the recorded inputs are the controller's: within the encoding's error of Phi x
+    X, U = game.episode.delivered_data()
+    Phi = -lqr_gain(game.params.A, game.params.B)
+    tol = audit_tolerance(Phi, X[0, :-1], game.params.delta, game.levers.max_shift)
+    assert np.all(np.abs(U[0] - X[0, :-1] @ Phi.T) <= tol)
+    assert info["attacker"]["input_energy"] == 0.0
+    # an injected input is caught by the first audit (step 1 audits the input of step 0)
+    game.reset(seed=0)
+    inject = np.r_[np.full(m, 0.3), 1.0].astype(np.float32)
+    game.step({"attacker": inject, "defender": NONE})
+    _, rew, term, trunc, info = game.step({"attacker": inject, "defender": AUDIT})
+    assert term["attacker"] and term["defender"] and info["attacker"]["detected"] and not game.agents
+    assert rew["attacker"] == pytest.approx(-rew["defender"] - 2.5)
+
+
+def test_the_audit_budget_and_the_costs_are_the_hand_count():
+    rules = GameRules(audit_budget=3, audit_cost=0.25, noise_weight=0.5)
+    game = EncryptedControlGame(_cfg(), rules)
+    m = game.params.m
+    game.reset(seed=2)
+    passing = np.r_[np.zeros(m), -1.0].astype(np.float32)
+    costs = []
+    for k in range(10):
+        noise = 0.5 if k == 4 else -1.0
+        _, rew, _, _, info = game.step({"attacker": passing, "defender": np.array([1.0, noise], dtype=np.float32)})
+        costs.append(info["defender"]["cost"])
+        assert rew["defender"] == -rew["attacker"] - costs[-1]
+    assert info["defender"]["audits"] == 3
+    unit = game.levers.unit_noise_price
+    # step 0 has no input to audit; steps 1-3 use the budget; step 4 adds noise, its audit is past the budget
+    want = [0.0, 0.25, 0.25, 0.25, 0.5 * unit * 0.5 * game.params.sigma_u2] + [0.0] * 5
+    assert costs == pytest.approx(want)
+
+
+def test_the_zero_sum_rules_make_the_rewards_sum_to_zero():
+    game = EncryptedControlGame(_cfg(), {"zero_sum": True, "audit_cost": 0.1})
+    m = game.params.m
+    game.reset(seed=4)
+    rng = np.random.default_rng(0)
+    while game.agents:
+        a = np.r_[rng.uniform(-1, 1, m), rng.choice([-1.0, 1.0])].astype(np.float32)
+        d = np.array([rng.choice([-1.0, 1.0]) * (rng.random() < 0.2), rng.uniform(-1, 1)], dtype=np.float32)
+        _, rew, _, _, _ = game.step({"attacker": a, "defender": d})
+        assert rew["attacker"] + rew["defender"] == 0.0
+
+
+def test_the_defender_sees_only_the_plant_side():
+    """Attackers differing only in what they decipher and estimate (delay, estimator, reward)
+    leave the defender's observation unchanged bit for bit; the attacker's changes."""
+    runs = []
+    for kw in ({}, {"decipher_delay": 5, "estimator": "forgetting", "reward": "logdet"}):
+        game = EncryptedControlGame(_cfg(**kw))
+        m, n = game.params.m, game.params.n
+        obs, _ = game.reset(seed=9)
+        seen, theirs = [obs["defender"]], [obs["attacker"]]
+        for a in _inputs(m, seed=5)[:20]:
+            obs, *_ = game.step({"attacker": np.r_[a, 1.0], "defender": np.array([-1.0, 0.2], dtype=np.float32)})
+            seen.append(obs["defender"])
+            theirs.append(obs["attacker"])
+            x = game.episode.state.x[0]
+            assert np.array_equal(obs["defender"][:n], x.astype(np.float32))  # the plant's own state
+        runs.append((np.array(seen), np.array(theirs)))
+    assert np.array_equal(runs[0][0], runs[1][0])
+    assert not np.array_equal(runs[0][1], runs[1][1])
+
+
+@pytest.mark.parametrize(
+    "make, text",
+    [
+        (lambda: EncryptedControlGame(_cfg(), {"audit_bugdet": 3}), "audit_bugdet"),
+        (lambda: EncryptedControlGame(_cfg(), {"audit_cost": -1}), "audit_cost"),
+        (lambda: EncryptedControlGame({**_cfg(), "defender": "audit"}), "defender"),
+    ],
+)
+def test_bad_game_settings_are_refused_naming_them(make, text):
+    with pytest.raises(ParameterError, match=text):
+        make()
+
+
+def test_bad_actions_are_refused_naming_them():
+    game = EncryptedControlGame(_cfg())
+    m = game.params.m
+    with pytest.raises(ParameterError, match="reset"):
+        game.step({"attacker": np.zeros(m + 1), "defender": NONE})
+    game.reset(seed=0)
+    with pytest.raises(ParameterError, match="both agents"):
+        game.step({"attacker": np.zeros(m + 1)})
+    with pytest.raises(ParameterError, match="attacker's action must have shape"):
+        game.step({"attacker": np.zeros(m), "defender": NONE})
+    with pytest.raises(ParameterError, match="defender's action must"):
+        game.step({"attacker": np.zeros(m + 1), "defender": np.array([0.0, 2.0])})
+    with pytest.raises(ParameterError, match="unknown agent"):
+        game.action_space("server")
+
+
+def test_a_missing_pettingzoo_is_one_line_naming_the_extra():
+    code = "import sys; sys.modules['pettingzoo'] = None\ntry:\n import encctl_gym.multiagent\nexcept ImportError as e:\n print(type(e).__name__, e)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
+    assert out.startswith("OptionalDependencyError") and "encctl-gym[multiagent]" in out and "\n" not in out
