@@ -14,6 +14,7 @@ of :class:`~encctl_gym.multiagent.game.EncryptedControlGame` (its observation an
   ``period`` (timed), and passes the controller's input through otherwise. A sparse or timed
   attacker scales its input by ``1 / sqrt(fraction injected)``, so it spends the same input energy
   as one that injects at every step (the energy budget allows it);
+* :class:`PassThrough`: never injects (closed-loop data only: it cannot be caught);
 * :class:`LearnedPlayer`: a stable-baselines3 model (PPO, the package's ARS) with the
   observation normalisation it was trained with;
 * :class:`Population`: one player of a list, drawn per episode (the opponents met so far, for
@@ -48,6 +49,7 @@ __all__ = [
     "DetectorAudit",
     "ConstantNoise",
     "ScheduledAttacker",
+    "PassThrough",
     "LearnedPlayer",
     "Population",
     "FrozenOpponent",
@@ -196,6 +198,27 @@ class ScheduledAttacker:
             inject = self.q == 1.0 or self.rng.random() < self.q
         self.k += 1
         return np.r_[u, 1.0 if inject else -1.0].astype(np.float32)
+
+
+class PassThrough:
+    """Never injects: every period runs the encrypted controller (closed-loop data only).
+
+    Parameters
+    ----------
+    m : int
+        The plant's number of inputs.
+    """
+
+    name = "pass-through"
+
+    def __init__(self, m: int) -> None:
+        self.action = np.r_[np.zeros(check_int("m", m, minimum=1)), -1.0].astype(np.float32)
+
+    def reset(self, seed: int | None = None) -> None:
+        pass
+
+    def act(self, obs: np.ndarray) -> np.ndarray:
+        return self.action.copy()
 
 
 class LearnedPlayer:
