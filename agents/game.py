@@ -359,7 +359,9 @@ def play(
         defender.reset(int(d_seed))
         ra = rd = cost = 0.0
         while game.agents:
-            obs, rew, _, _, info = game.step({"attacker": attacker.act(obs["attacker"]), "defender": defender.act(obs["defender"])})
+            obs, rew, _, _, info = game.step(
+                {"attacker": attacker.act(obs["attacker"]), "defender": defender.act(obs["defender"])}
+            )
             ra += rew["attacker"]
             rd += rew["defender"]
             cost += info["defender"]["cost"]

@@ -153,12 +153,16 @@ def alternate(
     attackers, defenders, curves = [attacker], [defender], []
     for r in range(1, rounds + 1):
         opp = Population(attackers) if len(attackers) > 1 else attackers[0]
-        d, c = train_side("defender", opp, config, rules, algo=algo, steps=steps, seed=seed + 2 * r, label=f"defender r{r} {algo}")
+        d, c = train_side(
+            "defender", opp, config, rules, algo=algo, steps=steps, seed=seed + 2 * r, label=f"defender r{r} {algo}"
+        )
         defenders.append(d)
         curves.append(c)
         learned = defenders[1:]
         opp = Population(learned) if len(learned) > 1 else learned[0]
-        a, c = train_side("attacker", opp, config, rules, algo=algo, steps=steps, seed=seed + 2 * r + 1, label=f"attacker r{r} {algo}")
+        a, c = train_side(
+            "attacker", opp, config, rules, algo=algo, steps=steps, seed=seed + 2 * r + 1, label=f"attacker r{r} {algo}"
+        )
         attackers.append(a)
         curves.append(c)
     return Alternation(attackers, defenders, curves)

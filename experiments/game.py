@@ -50,10 +50,10 @@ from agents.game import (
     play,
 )
 from agents.game_training import Curve, alternate, train_side
+from encctl_gym._validation import check_int
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.multiagent import GameRules
 from encctl_gym.plotting import legend_below, save_figure
-from encctl_gym._validation import check_int
 from experiments.common import _checked, ensure_out_dir, script_main
 from experiments.compare.statistics import Z95
 from experiments.identification_strategies import replicate_interval
@@ -152,11 +152,23 @@ def run(args: argparse.Namespace) -> int:
     params = resolve_params(config)
     rules = GameRules()
     defenders, attackers = static_players(params)
-    alt = alternate(attackers[0], defenders[0], config, rules, rounds=args.rounds, steps=args.steps, algo=args.algo, seed=args.seed)
+    alt = alternate(
+        attackers[0], defenders[0], config, rules, rounds=args.rounds, steps=args.steps, algo=args.algo, seed=args.seed
+    )
     learned_defender, learned_attacker = alt.defenders[-1], alt.attackers[-1]
-    learned_defender.name, learned_attacker.name = f"learned ({args.algo}, r{args.rounds})", f"learned ({args.algo}, r{args.rounds})"
+    learned_defender.name, learned_attacker.name = (
+        f"learned ({args.algo}, r{args.rounds})",
+        f"learned ({args.algo}, r{args.rounds})",
+    )
     exploiter, exploit_curve = train_side(
-        "attacker", learned_defender, config, rules, algo=args.algo, steps=args.steps, seed=args.seed + 1000, label=f"exploiter {args.algo}"
+        "attacker",
+        learned_defender,
+        config,
+        rules,
+        algo=args.algo,
+        steps=args.steps,
+        seed=args.seed + 1000,
+        label=f"exploiter {args.algo}",
     )
     exploiter.name = "exploiter"
     curves = [*alt.curves, exploit_curve]
@@ -173,7 +185,10 @@ def run(args: argparse.Namespace) -> int:
     # exploitability: the exploiter against the learned defender, over the best static attacker
     statics = [a.name for a in attackers]
     best = max(statics, key=lambda name: outcomes[(learned_defender.name, name)].attacker_return.mean())
-    gain = outcomes[(learned_defender.name, exploiter.name)].attacker_return - outcomes[(learned_defender.name, best)].attacker_return
+    gain = (
+        outcomes[(learned_defender.name, exploiter.name)].attacker_return
+        - outcomes[(learned_defender.name, best)].attacker_return
+    )
     g, glo, ghi = replicate_interval(gain)
     rows, cols = [d.name for d in rows_d], [a.name for a in cols_a]
     r = rules

@@ -106,12 +106,13 @@ class EncryptedControlGame(ParallelEnv):
         self.episode = EpisodeCore(p, self._loop, self.design, schedule=schedule, defender=self.levers)
         self.possible_agents = list(AGENTS)
         self.agents: list[str] = []
-        inf = np.float32(np.inf)
+        low, high = p.observation_bounds()
+        x_hi, inf = high[: p.n], np.inf  # states within the encoder's range; decoded inputs and the statistic unbounded
         self._observation_spaces = {
-            "attacker": spaces.Box(*p.observation_bounds(), dtype=np.float32),
+            "attacker": spaces.Box(low, high, dtype=np.float32),
             "defender": spaces.Box(
-                np.r_[np.full(p.n + p.m, -inf), 0.0, 0.0, 0.0].astype(np.float32),
-                np.r_[np.full(p.n + p.m, inf), inf, 1.0, 1.0].astype(np.float32),
+                np.r_[-x_hi, np.full(p.m, -inf), 0.0, 0.0, 0.0].astype(np.float32),
+                np.r_[x_hi, np.full(p.m, inf), inf, 1.0, 1.0].astype(np.float32),
                 dtype=np.float32,
             ),
         }
