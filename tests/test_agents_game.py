@@ -123,3 +123,22 @@ def test_a_short_best_response_trains_and_plays(algo):
     assert len(curve.returns) > 0 and np.all(np.diff(curve.timesteps) > 0)
     out = play(ScheduledAttacker(GaussianAttacker(P)), player, CFG, episodes=2)
     assert np.all(np.isfinite(out.defender_return))
+
+
+def test_the_rllib_game_without_ray_names_the_extra(monkeypatch):
+    import sys
+
+    from agents import rllib_game
+    from encctl_gym.errors import EncctlError
+
+    monkeypatch.setitem(sys.modules, "ray", None)
+    with pytest.raises(EncctlError, match=r"pip install 'encctl-gym\[ray\]'"):
+        rllib_game.game_ppo_config(CFG)
+
+
+def test_the_rllib_game_trains_both_sides_one_iteration():
+    pytest.importorskip("ray.rllib")
+    from agents.rllib_game import train_game
+
+    rows = train_game({**CFG, "rules": {"audit_cost": 0.02}}, iterations=1, train_batch_size=128, minibatch_size=64, num_epochs=1)
+    assert len(rows) == 1 and rows[0]["env_steps"] >= 128
