@@ -4,7 +4,8 @@ sides, learned policies, a single-agent view with the other side frozen, and pla
 A *player* is any object with ``name``, ``reset(seed)`` and ``act(obs) -> action`` for one side
 of :class:`~encctl_gym.multiagent.game.EncryptedControlGame` (its observation and action spaces):
 
-* defenders (the action is one entry per lever, ``[audit, noise]``, in [-1, 1]):
+* defenders (the action is one entry per lever of :data:`~encctl_gym.multiagent.levers.LEVERS`,
+  in [-1, 1], built by :func:`defender_action`):
   :class:`NoDefence`, :class:`RandomAudit` (audit with probability ``p`` per step),
   :class:`DetectorAudit` (audit when the chi-squared statistic it observes passes its threshold),
   :class:`ConstantNoise` (a fixed noise level);
@@ -38,12 +39,13 @@ import numpy as np
 
 from encctl_gym._validation import check_int, check_positive
 from encctl_gym.errors import ParameterError
-from encctl_gym.multiagent import AGENTS, EncryptedControlGame, GameRules
+from encctl_gym.multiagent import AGENTS, LEVERS, EncryptedControlGame, GameRules
 
 from .base import Attacker
 
 __all__ = [
     "Player",
+    "defender_action",
     "NoDefence",
     "RandomAudit",
     "DetectorAudit",
@@ -69,6 +71,15 @@ class Player(Protocol):
 
 
 # ---------------------------------------------------------------------- static defenders
+def defender_action(**levers: float) -> np.ndarray:
+    """A defender's action: the given levers' entries (by name of :data:`LEVERS`), -1 (off) for
+    every other lever."""
+    unknown = sorted(set(levers) - set(LEVERS))
+    if unknown:
+        raise ParameterError(f"unknown lever(s) {unknown}; the levers are {list(LEVERS)}")
+    return np.array([levers.get(name, -1.0) for name in LEVERS], dtype=np.float32)
+
+
 class NoDefence:
     """Never audits, adds no noise: the paper's defender."""
 
@@ -78,7 +89,7 @@ class NoDefence:
         pass
 
     def act(self, obs: np.ndarray) -> np.ndarray:
-        return np.array([-1.0, -1.0], dtype=np.float32)
+        return defender_action()
 
 
 class RandomAudit:
@@ -101,7 +112,7 @@ class RandomAudit:
         self.rng = np.random.default_rng(seed)
 
     def act(self, obs: np.ndarray) -> np.ndarray:
-        return np.array([1.0 if self.rng.random() < self.p else -1.0, -1.0], dtype=np.float32)
+        return defender_action(audit=1.0 if self.rng.random() < self.p else -1.0)
 
 
 class DetectorAudit:
@@ -123,7 +134,7 @@ class DetectorAudit:
         pass
 
     def act(self, obs: np.ndarray) -> np.ndarray:
-        return np.array([1.0 if obs[self.index] > 1.0 else -1.0, -1.0], dtype=np.float32)
+        return defender_action(audit=1.0 if obs[self.index] > 1.0 else -1.0)
 
 
 class ConstantNoise:
@@ -145,7 +156,7 @@ class ConstantNoise:
         pass
 
     def act(self, obs: np.ndarray) -> np.ndarray:
-        return np.array([-1.0, self.level], dtype=np.float32)
+        return defender_action(noise=self.level)
 
 
 # ---------------------------------------------------------------------- attackers

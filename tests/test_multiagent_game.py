@@ -16,14 +16,15 @@ from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
 
 import encctl_gym  # noqa: E402,F401
 from agents.evaluate import budget_config, env_config  # noqa: E402
+from agents.game import defender_action  # noqa: E402
 from encctl_gym.errors import ParameterError  # noqa: E402
 from encctl_gym.loop.backend import lqr_gain  # noqa: E402
 from encctl_gym.loop.defenses import audit_tolerance  # noqa: E402
 from encctl_gym.multiagent import EncryptedControlGame, GameRules  # noqa: E402
 
 N = 40
-NONE = np.array([-1.0, -1.0], dtype=np.float32)  # no audit, no noise
-AUDIT = np.array([1.0, -1.0], dtype=np.float32)
+NONE = defender_action()  # no audit, no noise
+AUDIT = defender_action(audit=1.0)
 
 
 def _cfg(**kw):
@@ -47,7 +48,7 @@ def test_a_fixed_defender_reproduces_the_single_environment_bit_for_bit(noise):
     m, s2 = game.params.m, game.params.sigma_u2
     single_cfg = cfg if noise is None else {**cfg, "defender": {"name": "noise", "sigma_d2": s2 * noise}}
     env = gym.make("encctl_gym/EncryptedLTIAttack-v0", config=single_cfg)
-    d = NONE if noise is None else np.array([-1.0, noise], dtype=np.float32)
+    d = NONE if noise is None else defender_action(noise=noise)
     o1, i1 = env.reset(seed=11)
     o2, i2 = game.reset(seed=11)
     assert np.array_equal(o1, o2["attacker"]) and i1 == i2["attacker"]
@@ -98,7 +99,7 @@ def test_the_audit_budget_and_the_costs_are_the_hand_count():
     costs = []
     for k in range(10):
         noise = 0.5 if k == 4 else -1.0
-        _, rew, _, _, info = game.step({"attacker": passing, "defender": np.array([1.0, noise], dtype=np.float32)})
+        _, rew, _, _, info = game.step({"attacker": passing, "defender": defender_action(audit=1.0, noise=noise)})
         costs.append(info["defender"]["cost"])
         assert rew["defender"] == -rew["attacker"] - costs[-1]
     assert info["defender"]["audits"] == 3
@@ -115,7 +116,7 @@ def test_the_zero_sum_rules_make_the_rewards_sum_to_zero():
     rng = np.random.default_rng(0)
     while game.agents:
         a = np.r_[rng.uniform(-1, 1, m), rng.choice([-1.0, 1.0])].astype(np.float32)
-        d = np.array([rng.choice([-1.0, 1.0]) * (rng.random() < 0.2), rng.uniform(-1, 1)], dtype=np.float32)
+        d = defender_action(audit=rng.choice([-1.0, 1.0]) * (rng.random() < 0.2), noise=rng.uniform(-1, 1))
         _, rew, _, _, _ = game.step({"attacker": a, "defender": d})
         assert rew["attacker"] + rew["defender"] == 0.0
 
@@ -130,7 +131,7 @@ def test_the_defender_sees_only_the_plant_side():
         obs, _ = game.reset(seed=9)
         seen, theirs = [obs["defender"]], [obs["attacker"]]
         for a in _inputs(m, seed=5)[:20]:
-            obs, *_ = game.step({"attacker": np.r_[a, 1.0], "defender": np.array([-1.0, 0.2], dtype=np.float32)})
+            obs, *_ = game.step({"attacker": np.r_[a, 1.0], "defender": defender_action(noise=0.2)})
             seen.append(obs["defender"])
             theirs.append(obs["attacker"])
             x = game.episode.state.x[0]
@@ -164,7 +165,7 @@ def test_bad_actions_are_refused_naming_them():
     with pytest.raises(ParameterError, match="attacker's action must have shape"):
         game.step({"attacker": np.zeros(m), "defender": NONE})
     with pytest.raises(ParameterError, match="defender's action must"):
-        game.step({"attacker": np.zeros(m + 1), "defender": np.array([0.0, 2.0])})
+        game.step({"attacker": np.zeros(m + 1), "defender": defender_action(noise=2.0)})
     with pytest.raises(ParameterError, match="unknown agent"):
         game.action_space("server")
 
