@@ -174,3 +174,18 @@ def test_a_missing_pettingzoo_is_one_line_naming_the_extra():
     code = "import sys; sys.modules['pettingzoo'] = None\ntry:\n import encctl_gym.multiagent\nexcept ImportError as e:\n print(type(e).__name__, e)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
     assert out.startswith("OptionalDependencyError") and "encctl-gym[multiagent]" in out and "\n" not in out
+
+
+def test_the_game_runs_on_real_ciphertexts_and_a_passed_input_is_the_controllers():
+    from agents.evaluate import elgamal_config
+
+    game = EncryptedControlGame(elgamal_config(env_config({"preset": "paper-example"}), 12, key_length=64))
+    m = game.params.m
+    game.reset(seed=1)
+    for k in range(11):
+        inject = 1.0 if k == 6 else -1.0
+        _, _, term, _, info = game.step({"attacker": np.r_[np.full(m, 0.1), inject], "defender": AUDIT})
+        assert info["attacker"]["detected"] == (k == 7)  # step 7 audits the input injected at step 6
+        if term["attacker"]:
+            break
+    assert k == 7 and info["defender"]["audits"] == 7
