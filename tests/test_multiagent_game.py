@@ -189,3 +189,22 @@ def test_the_game_runs_on_real_ciphertexts_and_a_passed_input_is_the_controllers
         if term["attacker"]:
             break
     assert k == 7 and info["defender"]["audits"] == 7
+
+
+def test_passed_through_steps_give_the_same_numbers_on_every_step_path():
+    """Injected and passed-through steps mixed: the ideal backend (its compiled steps) and real
+    ElGamal (the generic step) give the same trajectory bit for bit, as the single environment's do."""
+    from agents.evaluate import elgamal_config
+
+    cfg = elgamal_config(env_config({"preset": "paper-example"}), 16, key_length=64)
+    ideal = {k: v for k, v in cfg.items() if k != "crypto_seed"} | {"crypto": "ideal"}
+    runs = []
+    for c in (cfg, ideal):
+        game = EncryptedControlGame(c)
+        obs, _ = game.reset(seed=3)
+        seq = [obs["attacker"]]
+        for k, a in enumerate(_inputs(game.params.m)[:15]):
+            obs, rew, *_ = game.step({"attacker": np.r_[a, 1.0 if k % 3 else -1.0], "defender": defender_action(noise=0.1)})
+            seq.append(np.r_[obs["attacker"], obs["defender"], rew["attacker"]])
+        runs.append(np.concatenate(seq))
+    assert np.array_equal(runs[0], runs[1])
