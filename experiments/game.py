@@ -19,9 +19,9 @@ samples set by the deciphering budget, ideal backend, the default :class:`GameRu
   mean), one panel per side.
 
     python -m experiments.game [--N 128] [--episodes 30] [--steps 20000] [--rounds 2] [--algo ppo]
-        [--out docs/results/game] [--figure docs/figures/game_learning_curves.png]
+        [--out docs/results/game] [--figure docs/figures/game_learning_curves_ALGO.png]
 
-Writes ``game.md`` (the tables), ``game_cells.csv`` (one row per cell) and the figure.
+Writes ``game_ALGO.md`` (the tables), ``game_ALGO_cells.csv`` (one row per cell) and the figure.
 """
 
 from __future__ import annotations
@@ -64,6 +64,7 @@ METRICS = (
     ("detected", "detection rate"),
     ("cost", "the defender's cost"),
     ("attacker_return", "the attacker's return"),
+    ("defender_return", "the defender's return"),
 )
 
 
@@ -190,6 +191,8 @@ def run(args: argparse.Namespace) -> int:
         - outcomes[(learned_defender.name, best)].attacker_return
     )
     g, glo, ghi = replicate_interval(gain)
+    theta = np.hstack([params.A, params.B])
+    eps0 = float(np.sum(theta**2)) / (params.n * (params.n + params.m))  # Definition def:error of the estimate [A B] = 0
     rows, cols = [d.name for d in rows_d], [a.name for a in cols_a]
     r = rules
     header = [
@@ -201,13 +204,15 @@ def run(args: argparse.Namespace) -> int:
         f"Plant `{args.preset}`, attacks of N = {args.N} samples (deciphering budget), ideal backend; rules: audit_cost = {r.audit_cost}, "
         f"audit_budget = {r.audit_budget}, noise_max = sigma_u2 = {params.sigma_u2:g}, noise_weight = {r.noise_weight}, "
         f"detection_penalty = {r.detection_penalty}, chi-squared window {r.window} at false-alarm rate {r.false_alarm_rate}. "
-        f"{args.episodes} paired episodes per cell (episode e seeded {args.seed} + e in every cell). epsilon_0 = "
-        f"{outcomes[(rows[0], 'pass-through')].epsilon.max():.3g} is the error before any data (pass-through keeps close to it).",
+        f"{args.episodes} paired episodes per cell (episode e seeded {args.seed} + e in every cell). epsilon_0 = {eps0:.3g} is "
+        "the error before any data (of the estimate [A B] = 0): an attack detected within n + m samples ends there.",
         "",
         f"**Exploitability of the learned defender**: the exploiter (an attacker trained from scratch against it, {args.steps} steps) "
         f"returns {_fmt(outcomes[(learned_defender.name, exploiter.name)].attacker_return.mean())} against it; the best static attacker "
         f"({best}) returns {_fmt(outcomes[(learned_defender.name, best)].attacker_return.mean())}: a gain of {_fmt(g)} "
-        f"[{_fmt(glo)}, {_fmt(ghi)}] (paired, 95 %). Against no defence the exploiter returns "
+        f"[{_fmt(glo)}, {_fmt(ghi)}] (paired, 95 %), so the best attacker found against it returns "
+        f"{_fmt(max(outcomes[(learned_defender.name, exploiter.name)].attacker_return.mean(), outcomes[(learned_defender.name, best)].attacker_return.mean()))}. "
+        "Against no defence the exploiter returns "
         f"{_fmt(outcomes[(rows[0], exploiter.name)].attacker_return.mean())} and the Gaussian attacker "
         f"{_fmt(outcomes[(rows[0], cols[0])].attacker_return.mean())}.",
     ]
@@ -215,14 +220,15 @@ def run(args: argparse.Namespace) -> int:
     text = "\n".join(header) + "\n\n" + "\n\n".join(body) + "\n"
     print(text)
     out = ensure_out_dir(args.out)
-    (out / "game.md").write_text(text)
-    with open(out / "game_cells.csv", "w", newline="") as fh:
+    md, cells_csv = out / f"game_{args.algo}.md", out / f"game_{args.algo}_cells.csv"
+    md.write_text(text)
+    with open(cells_csv, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["defender", "attacker"] + [f"{k}_{s}" for k, _ in METRICS for s in ("mean", "low", "high")])
         for (dn, an), c in cells.items():
             w.writerow([dn, an] + [f"{v:.6g}" for k, _ in METRICS for v in c[k]])
-    fig = plot_curves(curves, args.figure)
-    print(f"wrote {out / 'game.md'}, {out / 'game_cells.csv'} and {fig}")
+    fig = plot_curves(curves, args.figure or f"docs/figures/game_learning_curves_{args.algo}.png")
+    print(f"wrote {md}, {cells_csv} and {fig}")
     return 0
 
 
@@ -238,7 +244,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--algo", choices=("ppo", "ars"), default="ppo")
     parser.add_argument("--seed", type=_checked(lambda t: check_int("seed", int(t), minimum=0), "seed"), default=0)
     parser.add_argument("--out", default="docs/results/game")
-    parser.add_argument("--figure", default="docs/figures/game_learning_curves.png")
+    parser.add_argument("--figure", default=None, help="default: docs/figures/game_learning_curves_ALGO.png")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
