@@ -142,3 +142,23 @@ def test_the_rllib_game_trains_both_sides_one_iteration():
 
     rows = train_game({**CFG, "rules": {"audit_cost": 0.02}}, iterations=1, train_batch_size=128, minibatch_size=64, num_epochs=1)
     assert len(rows) == 1 and rows[0]["env_steps"] >= 128
+
+
+@pytest.mark.slow
+def test_the_game_experiment_writes_its_tables_and_curves(tmp_path):
+    from experiments import game as experiment
+
+    fig = tmp_path / "curves.png"
+    args = ["--N", "32", "--episodes", "2", "--steps", "256", "--rounds", "1", "--algo", "ars", "--out", str(tmp_path)]
+    assert experiment.main([*args, "--figure", str(fig)]) == 0
+    text = (tmp_path / "game_ars.md").read_text()
+    assert "Exploitability" in text and "| chi2 |" in text and fig.exists()
+    assert len((tmp_path / "game_ars_cells.csv").read_text().splitlines()) == 1 + 7 * 8
+
+
+def test_the_game_experiment_refuses_a_bad_option_in_one_line(capsys):
+    from experiments import game as experiment
+
+    with pytest.raises(SystemExit) as exc:
+        experiment.main(["--N", "4"])
+    assert exc.value.code == 2 and "N" in capsys.readouterr().err
