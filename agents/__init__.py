@@ -34,4 +34,4 @@ def __getattr__(name: str):  # lazy: stable-baselines3 and torch only when asked
         from . import sb3
 
         return getattr(sb3, name)
-    raise AttributeError(f"module 'agents' has no attribute {name!r}")
+    raise AttributeError(f"module 'encctl_gym.agents' has no attribute {name!r}")

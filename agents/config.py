@@ -46,14 +46,13 @@ aliases (nested aliases can expand a small file into gigabytes) and nested at mo
 from __future__ import annotations
 
 import copy
-import numbers
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from encctl_gym._validation import format_value
+from encctl_gym._validation import check_int, format_value, read_bounded
 from encctl_gym.envs.config import completion_preset, resolve_params
 from encctl_gym.envs.config import default_config as env_default_config
 from encctl_gym.errors import ConfigError, EncctlError, ParameterError
@@ -131,10 +130,9 @@ def read_yaml(path: str | Path) -> dict[str, Any]:
     p = Path(path)
     if not p.is_file():
         raise ConfigError(f"config file {str(p)!r} does not exist")
-    if p.stat().st_size > MAX_CONFIG_BYTES:
-        raise ConfigError(f"config file {str(p)!r} is larger than {MAX_CONFIG_BYTES} bytes")
+    raw = read_bounded("config file", p, MAX_CONFIG_BYTES, "MAX_CONFIG_BYTES", error=ConfigError)
     try:
-        text = p.read_text()
+        text = raw.decode("utf-8")
         _check_yaml_tokens(text, f"config file {str(p)!r}")
         data = yaml.safe_load(text)
     except ConfigError:
@@ -302,13 +300,7 @@ def _int(minimum: int, optional: bool = False, maximum: int | None = None) -> Ch
     def check(name: str, v: Any) -> Any:
         if v is None and optional:
             return v
-        if isinstance(v, bool) or not isinstance(v, numbers.Integral):
-            raise ConfigError(f"{name} must be an integer{' or null' if optional else ''}, got {format_value(v)}")
-        if int(v) < minimum:
-            raise ConfigError(f"{name} must be >= {minimum}, got {format_value(v)}")
-        if maximum is not None and int(v) > maximum:
-            raise ConfigError(f"{name} must be <= {maximum}, got {format_value(v)}")
-        return int(v)
+        return check_int(name, v, minimum, maximum, error=ConfigError)  # the package's one integer rule
 
     return check
 

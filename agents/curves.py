@@ -288,11 +288,11 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m agents.curves RUN_DIR ... --out FILE``: several runs' learning curves in one figure."""
+    """``python -m encctl_gym.agents.curves RUN_DIR ... --out FILE``: several runs' learning curves in one figure."""
     import argparse
     import sys
 
-    parser = argparse.ArgumentParser(prog="python -m agents.curves", description=main.__doc__)
+    parser = argparse.ArgumentParser(prog="python -m encctl_gym.agents.curves", description=main.__doc__)
     parser.add_argument("runs", nargs="+", metavar="RUN_DIR", help="training run directories (or learning_curve.npz files)")
     parser.add_argument("--out", required=True, help="output PNG")
     parser.add_argument("--title", default=None, help="figure title")
@@ -300,7 +300,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         path = plot_learning_curves(args.runs, args.out, title=args.title)
     except ConfigError as exc:
-        print(f"python -m agents.curves: error: {exc}", file=sys.stderr)
+        print(f"python -m encctl_gym.agents.curves: error: {exc}", file=sys.stderr)
         return 2
     print(f"wrote {path}")
     return 0

@@ -13,5 +13,5 @@ train() { /usr/bin/time -f "%e s wall" $PY -m encctl_gym.cli train --algo "$1" -
 ( train ppo paper-example; train ppo fig1-c; train ppo fig1-g ) &
 ( train sac paper-example; train recurrent_ppo paper-example ) &
 wait
-$PY -m agents.curves "$OUT"/train/*_s0 --out "$OUT/learning_curves.png" > "$OUT/logs/curves.log" 2>&1
+$PY -m encctl_gym.agents.curves "$OUT"/train/*_s0 --out "$OUT/learning_curves.png" > "$OUT/logs/curves.log" 2>&1
 /usr/bin/time -f "%e s wall" $PY -m encctl_gym.cli compare --seed 0 --episodes 50 --runs "$OUT/train" --out "$OUT/compare" > "$OUT/logs/compare.log" 2>&1

@@ -9,7 +9,7 @@ of :class:`~encctl_gym.multiagent.game.EncryptedControlGame` (its observation an
   :class:`NoDefence`, :class:`RandomAudit` (audit with probability ``p`` per step),
   :class:`DetectorAudit` (audit when the chi-squared statistic it observes passes its threshold),
   :class:`ConstantNoise` (a fixed noise level);
-* attackers: :class:`ScheduledAttacker` turns any attacker of :mod:`agents` (Gaussian, AR(1),
+* attackers: :class:`ScheduledAttacker` turns any attacker of :mod:`encctl_gym.agents` (Gaussian, AR(1),
   the optimal design, a learned one) into a game player that injects on a schedule: at every
   step, at random steps with probability ``q`` (sparse), or in bursts of ``duty`` steps every
   ``period`` (timed), and passes the controller's input through otherwise. A sparse or timed
@@ -19,10 +19,10 @@ of :class:`~encctl_gym.multiagent.game.EncryptedControlGame` (its observation an
 * :class:`LearnedPlayer`: a stable-baselines3 model (PPO, the package's ARS) with the
   observation normalisation it was trained with;
 * :class:`Population`: one player of a list, drawn per episode (the opponents met so far, for
-  the fictitious-play rounds of :mod:`agents.game_training`).
+  the fictitious-play rounds of :mod:`encctl_gym.agents.game_training`).
 
 :class:`FrozenOpponent` is the game as a single-agent Gymnasium environment for one side, the
-other side's player frozen inside it, so stable-baselines3 PPO and :class:`~agents.ars.PairedARS`
+other side's player frozen inside it, so stable-baselines3 PPO and :class:`~encctl_gym.agents.ars.PairedARS`
 train one side. :func:`play` plays paired episodes (episode ``e`` seeded ``seed + e`` for every
 pair of players) and returns per-episode outcomes.
 """
@@ -161,7 +161,7 @@ class ConstantNoise:
 
 # ---------------------------------------------------------------------- attackers
 class ScheduledAttacker:
-    """An attacker of :mod:`agents` as a game player that injects on a schedule (module docstring).
+    """An attacker of :mod:`encctl_gym.agents` as a game player that injects on a schedule (module docstring).
 
     Parameters
     ----------
@@ -238,7 +238,7 @@ class LearnedPlayer:
     Parameters
     ----------
     model : stable_baselines3 BaseAlgorithm
-        PPO, :class:`~agents.ars.PairedARS`, ...
+        PPO, :class:`~encctl_gym.agents.ars.PairedARS`, ...
     vecnorm : VecNormalize, optional
         The observation normalisation it was trained with (its statistics are used, not updated).
     name : str
@@ -290,7 +290,7 @@ class FrozenOpponent(gym.Env):
     Observation, action and reward are the game's for ``side``; ``info`` is that side's info of
     the game with the other side's under ``"opponent"``. The frozen player is reset with a seed
     drawn from this environment's generator, so a seeded reset replays the opponent too (paired
-    episodes for :class:`~agents.ars.PairedARS`).
+    episodes for :class:`~encctl_gym.agents.ars.PairedARS`).
 
     Parameters
     ----------

@@ -2,13 +2,13 @@
 
 :func:`train_side` trains the attacker or the defender of
 :class:`~encctl_gym.multiagent.game.EncryptedControlGame` with stable-baselines3's PPO or the
-package's :class:`~agents.ars.PairedARS` on :class:`~agents.game.FrozenOpponent` (the other
+package's :class:`~encctl_gym.agents.ars.PairedARS` on :class:`~encctl_gym.agents.game.FrozenOpponent` (the other
 side's player frozen into a single-agent environment), from scratch, and returns the learned
 player with its learning curve (the return of every training episode, from ``Monitor``).
 
 :func:`alternate` runs rounds of best responses, fictitious-play style: round ``r`` trains a
 defender against the attackers met so far (the starting attacker and the learned ones, one drawn
-per episode, :class:`~agents.game.Population`), then an attacker against the defenders learned
+per episode, :class:`~encctl_gym.agents.game.Population`), then an attacker against the defenders learned
 so far. The exploitability of a learned defender is what an attacker trained from scratch
 against it alone gains over the static attackers (``experiments/game.py``).
 

@@ -11,7 +11,7 @@ configuration), exactly as the single environment defines them.
 connects to a cluster (``address="auto"`` for a running one; ``None`` starts a local Ray
 instance), trains for some iterations and returns one summary per iteration. For example::
 
-    from agents.rllib import train_ppo
+    from encctl_gym.agents.rllib import train_ppo
     rows = train_ppo({"preset": "paper-example", "gamma_opt": False}, iterations=50,
                      address="auto", num_env_runners=32)
 
@@ -39,7 +39,7 @@ def _require_rllib() -> Any:
         from ray.rllib.algorithms.ppo import PPOConfig  # noqa: F401
     except ModuleNotFoundError as exc:
         raise EncctlError(
-            f"agents.rllib needs Ray RLlib (module {exc.name!r} is missing); install the extra: pip install 'encctl-gym[ray]'"
+            f"encctl_gym.agents.rllib needs Ray RLlib (module {exc.name!r} is missing); install the extra: pip install 'encctl-gym[ray]'"
         ) from exc
     return ray
 

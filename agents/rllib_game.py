@@ -7,7 +7,7 @@ a creator (:func:`make_game`) under :data:`GAME_NAME`, and :func:`game_ppo_confi
 ``PPOConfig`` with one policy per agent (``"attacker"`` and ``"defender"``, each agent mapped to
 its own), so both sides learn at once, each from its own reward. For example::
 
-    from agents.rllib_game import train_game
+    from encctl_gym.agents.rllib_game import train_game
     rows = train_game({"preset": "paper-example", "gamma_opt": False, "max_samples": 128},
                       iterations=50, address="auto", num_env_runners=32)
 

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from encctl_gym._validation import format_value
+from encctl_gym._validation import format_value, read_bounded
 from encctl_gym.errors import ConfigError
 
 __all__ = [
@@ -168,11 +168,9 @@ def read_run(run_dir: str | Path) -> RunInfo:
         raise ConfigError(f"the run directory {str(path)!r} does not exist{hint}")
     if not meta_path.is_file():
         raise ConfigError(f"{str(path)!r} is not a training run (no {RUN_FILE})")
-    size = meta_path.stat().st_size
-    if size > MAX_RUN_FILE_BYTES:
-        raise ConfigError(f"{meta_path} has {size} bytes; a {RUN_FILE} has at most {MAX_RUN_FILE_BYTES}")
+    raw = read_bounded("the run file", meta_path, MAX_RUN_FILE_BYTES, "MAX_RUN_FILE_BYTES", error=ConfigError)
     try:
-        meta = json.loads(meta_path.read_text())
+        meta = json.loads(raw.decode("utf-8"))
     except (OSError, ValueError, RecursionError) as exc:  # ValueError: bad JSON, bad UTF-8, an integer of over 4300 digits
         what = (
             "nests too deeply"

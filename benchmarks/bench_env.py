@@ -10,8 +10,9 @@ Prints:
    on one thread (``helper_thread=False``), and with ``parallel=True``;
 3. the ElGamal backend's time per step at 712 bits against the crypto floor: the time of one
    ``gmpy2.powmod`` with a full-size exponent at that size, measured in the same run;
-4. the steps per second with each estimator other than least squares (``estimator`` key:
-   updated column by column, off the compiled path), single and vector, against least squares.
+4. the steps per second with each estimator other than least squares (``estimator`` key: on
+   their compiled moment path, :class:`encctl_gym.ident.compiled.MomentKernels`, not fused),
+   single and vector, against least squares (target: >= 0.1x single).
 
 Usage: ``python benchmarks/bench_env.py [--quick] [--record]`` (``--record`` writes
 ``benchmarks/results/bench_env.json`` for the README table, :mod:`benchmarks.record`).

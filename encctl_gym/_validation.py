@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import ConfigError, ParameterError, ShapeError, UnstableSystemError
+from .errors import ConfigError, EncctlError, ParameterError, ResourceLimitError, ShapeError, UnstableSystemError
 
 __all__ = [
     "one_line",
@@ -32,6 +32,7 @@ __all__ = [
     "check_nonnegative",
     "check_real",
     "check_int",
+    "MAX_EXACT_FLOAT_INT",
     "check_bool",
     "parse_number",
     "as_finite_array",
@@ -39,6 +40,7 @@ __all__ = [
     "spectral_radius",
     "check_schur_stable",
     "check_regular_file",
+    "read_bounded",
     "FLOAT_MAX",
 ]
 
@@ -163,19 +165,54 @@ def check_nonnegative(name: str, value: Any) -> float:
     return v
 
 
-def check_int(name: str, value: Any, minimum: int | None = None, maximum: int | None = None) -> int:
-    """Return ``value`` as an int, raising :class:`ParameterError` for non-integers or values
-    outside ``[minimum, maximum]`` (integral floats such as ``3.0`` are accepted)."""
-    if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)):
-        if isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer():
+#: Largest float that :func:`check_int` takes as an integer: every integer up to 2^53 is exact in
+#: float64, and no float beyond it says which integer it means (``2.0**64 + 1 == 2.0**64``).
+MAX_EXACT_FLOAT_INT = 2**53
+
+
+def check_int(
+    name: str, value: Any, minimum: int | None = None, maximum: int | None = None, *, error: type[EncctlError] = ParameterError
+) -> int:
+    """``value`` as an int, the package's one integer check.
+
+    The rule: an exact integer is accepted (``int``, a NumPy integer, a ``gmpy2.mpz``: every
+    :class:`numbers.Integral`), and so is a float that is an integer of at most
+    :data:`MAX_EXACT_FLOAT_INT` in magnitude (``3.0``, a YAML ``1e6``: exactly the integer
+    written); a bool, a fractional or larger float, a string (see
+    :func:`encctl_gym.crypto.group.parse_group_integer` for the hex strings of group files) and
+    everything else is refused.
+
+    Parameters
+    ----------
+    name : str
+        The value's name, for the message.
+    value : object
+        The value.
+    minimum, maximum : int, optional
+        Bounds (inclusive).
+    error : type of EncctlError, default ParameterError
+        The subclass raised (e.g. :class:`~encctl_gym.errors.GroupError` for group parameters).
+
+    Raises
+    ------
+    ParameterError
+        (or ``error``) naming the value, for a value the rule refuses or one outside the bounds.
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        if (
+            isinstance(value, (float, np.floating))
+            and math.isfinite(value)
+            and float(value).is_integer()
+            and abs(float(value)) <= MAX_EXACT_FLOAT_INT
+        ):
             value = int(value)
         else:
-            raise ParameterError(f"{name} must be an integer, got {format_value(value)}")
+            raise error(f"{name} must be an integer, got {format_value(value)}")
     v = int(value)
     if minimum is not None and v < minimum:
-        raise ParameterError(f"{name} must be >= {minimum}, got {format_value(v)}")
+        raise error(f"{name} must be >= {minimum}, got {format_value(v)}")
     if maximum is not None and v > maximum:
-        raise ParameterError(f"{name} must be <= {maximum}, got {format_value(v)}")
+        raise error(f"{name} must be <= {maximum}, got {format_value(v)}")
     return v
 
 
@@ -208,13 +245,23 @@ def parse_number(name: str, text: Any) -> float:
     return v
 
 
-def as_finite_array(name: str, value: Any, ndim: int | None = None) -> np.ndarray:
+def as_finite_array(
+    name: str,
+    value: Any,
+    ndim: int | None = None,
+    *,
+    allow_empty: bool = False,
+    overflow_error: type[EncctlError] = ParameterError,
+) -> np.ndarray:
     """Convert ``value`` to a float64 array with finite real entries (and ``ndim`` dimensions if
-    given).
+    given): the package's one real-array check.
 
     Complex, boolean and string data are refused (never truncated to the real part or read as
     0/1), as are bytes (NumPy would read ``bytearray(b"1")`` as the number 49) and integers
-    beyond the float64 range.
+    beyond the float64 range (``overflow_error``, default :class:`ParameterError`; the encoder
+    raises :class:`~encctl_gym.errors.EncodingOverflowError`). Exact integers of any type
+    (``int``, ``gmpy2.mpz``) within the range are read as floats. An empty array is refused
+    unless ``allow_empty``.
     """
     if isinstance(value, (str, bytes, bytearray, memoryview)):
         raise ParameterError(f"{name} must be a numeric array, got {format_value(value)}")
@@ -238,12 +285,12 @@ def as_finite_array(name: str, value: Any, ndim: int | None = None) -> np.ndarra
     try:
         arr = np.asarray(raw, dtype=np.float64)
     except OverflowError as exc:
-        raise ParameterError(f"{name} must have entries within the float64 range, got {format_value(value)}") from exc
+        raise overflow_error(f"{name} must have entries within the float64 range, got {format_value(value)}") from exc
     except (TypeError, ValueError) as exc:
         raise ParameterError(f"{name} must be a numeric array, got {format_value(value)}") from exc
     if ndim is not None and arr.ndim != ndim:
         raise ShapeError(f"{name} must have {ndim} dimension(s), got shape {arr.shape}")
-    if arr.size == 0:
+    if arr.size == 0 and not allow_empty:
         raise ShapeError(f"{name} must not be empty, got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise ParameterError(f"{name} must have finite entries, got {format_value(arr)}")
@@ -298,3 +345,46 @@ def check_regular_file(what: str, path: Any) -> str:
         raise ConfigError(f"{what} {name!r} is a directory, not a file")
     kind = next((label for test, label in _FILE_KINDS if test(mode)), "a special file")
     raise ConfigError(f"{what} {name!r} is not a regular file: it is {kind}")
+
+
+def read_bounded(what: str, path: Any, limit: int, limit_name: str, *, error: type[EncctlError] = ResourceLimitError) -> bytes:
+    """The bytes of the file ``path``, the package's one bounded file read: a file of more than
+    ``limit`` bytes is refused before it is read, and at most ``limit + 1`` bytes are ever read
+    (a file that grows meanwhile cannot make it read more).
+
+    Parameters
+    ----------
+    what : str
+        What the file is, for messages (``"system file"``, ``"config file"``, ...).
+    path : str or os.PathLike
+        The file (callers check first that it is a regular file where a FIFO could block).
+    limit : int
+        Most bytes accepted.
+    limit_name : str
+        The constant that holds ``limit``, named in the message.
+    error : type of EncctlError, default ResourceLimitError
+        Raised for a file over the limit.
+
+    Raises
+    ------
+    ConfigError
+        If the file cannot be opened or read.
+    ResourceLimitError
+        (or ``error``) for a file of more than ``limit`` bytes; the message gives both sizes.
+    """
+    name = os.fspath(path)
+
+    def too_large(size: int) -> EncctlError:
+        return error(f"{what} {name!r} has {size} bytes, more than {limit_name} = {limit}")
+
+    try:
+        with open(name, "rb") as f:
+            size = os.fstat(f.fileno()).st_size
+            if size > limit:
+                raise too_large(size)
+            raw = f.read(limit + 1)
+    except OSError as exc:
+        raise ConfigError(f"cannot read {what} {name!r}: {exc.strerror or exc}") from None
+    if len(raw) > limit:
+        raise too_large(len(raw))
+    return raw

@@ -22,18 +22,21 @@ from .errors import EncctlError
 # name -> (module, one-line help)
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "design": (
-        "encctl_gym.security.design_cli",
+        "encctl_gym.design_command",
         "optimal security parameter and key length for a plant (Theorem thm:opt_sec, eq:opt_key)",
     ),
-    "reproduce": ("experiments.reproduce", "reproduce the paper's figures and design example (writes PNG and CSV)"),
-    "train": ("agents.train", "train a learned attacker with stable-baselines3 (needs the [rl] extra)"),
-    "compare": ("experiments.compare.cli", "the headline experiment: every attacker against gamma(N) and gamma_opt(N)"),
+    "reproduce": ("encctl_gym.experiments.reproduce", "reproduce the paper's figures and design example (writes PNG and CSV)"),
+    "train": ("encctl_gym.agents.train", "train a learned attacker with stable-baselines3 (needs the [rl] extra)"),
+    "compare": (
+        "encctl_gym.experiments.compare.cli",
+        "the headline experiment: every attacker against gamma(N) and gamma_opt(N)",
+    ),
     "tune": (
-        "agents.tune",
+        "encctl_gym.agents.tune",
         "hyperparameter search for a learned attacker with Optuna, written as a tuned config (needs the [rl] and [optuna] extras)",
     ),
     "evaluate": (
-        "experiments.compare.evaluate_run",
+        "encctl_gym.experiments.compare.evaluate_run",
         "a training run against the Gaussian, AR(1) and oracle attackers on paired seeds (needs the [rl] extra)",
     ),
     "crack": (

@@ -33,6 +33,7 @@ float64: booleans, strings, NaN, infinities, complex data and integers beyond th
 from __future__ import annotations
 
 import functools
+import io
 import json
 import math
 import numbers
@@ -52,6 +53,7 @@ from ._validation import (
     check_regular_file,
     check_system,
     format_value,
+    read_bounded,
 )
 from .errors import ConfigError, ParameterError, ResourceLimitError
 from .presets import DESIGN_FIELDS, SystemPreset, design_defaults
@@ -204,9 +206,9 @@ def _load_yaml(path: Path, text: str) -> Any:
         loader.dispose()
 
 
-def _load_npz(path: Path) -> dict[str, Any]:
+def _load_npz(path: Path, raw: bytes) -> dict[str, Any]:
     try:
-        with zipfile.ZipFile(path) as zf:
+        with zipfile.ZipFile(io.BytesIO(raw)) as zf:
             infos = zf.infolist()
     except (zipfile.BadZipFile, OSError) as exc:
         raise _fail(path, f"not a readable NPZ archive ({format_value(str(exc))})") from None
@@ -218,7 +220,7 @@ def _load_npz(path: Path) -> dict[str, Any]:
             f"system file {str(path)!r}: its arrays take {total} bytes uncompressed; the limit is {MAX_FILE_BYTES}"
         )
     try:
-        with np.load(path, allow_pickle=False) as z:
+        with np.load(io.BytesIO(raw), allow_pickle=False) as z:
             return {k: z[k] for k in z.files}
     except ValueError as exc:
         raise _fail(path, f"cannot load its arrays without pickles ({format_value(str(exc))})") from None
@@ -233,13 +235,11 @@ def _decode(path: Path) -> Any:
     suffix = path.suffix.lower()
     if suffix not in SUFFIXES:
         raise ConfigError(f"system file {str(path)!r} must end in .json, .yaml, .yml or .npz")
-    size = path.stat().st_size
-    if size > MAX_FILE_BYTES:
-        raise ResourceLimitError(f"system file {str(path)!r} has {size} bytes; the limit is {MAX_FILE_BYTES}")
+    raw = read_bounded("system file", path, MAX_FILE_BYTES, "MAX_FILE_BYTES")
     if suffix == ".npz":
-        return _load_npz(path)
+        return _load_npz(path, raw)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = raw.decode("utf-8")
         if suffix == ".json":
             return json.loads(text, object_pairs_hook=lambda pairs: _json_object(path, pairs))
         return _load_yaml(path, text)

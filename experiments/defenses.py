@@ -9,21 +9,33 @@ Figure 1 (c) (``fig1-c``):
 * **Audits**: the rate ``p* = 1 - delta^(1/N*)`` that stops an attacker injecting at every step
   before ``N*`` with probability ``1 - delta``, for delta in {1e-2, 1e-3, 1e-6}.
 
+* **Group rotation** (``--rotation``): the design example's ``k*`` when the group rotates every
+  ``K`` in {1, 10, 100, N*} steps (precomputation model: one precomputation per group, and the
+  paper model, which rotation leaves unchanged), with a fresh group of ``k*`` bits generated and
+  timed; and the same periods measured through real ElGamal at 64 bits with the index-calculus
+  breaker, which redoes its precomputation on every new group (counted and timed), with the
+  plant side's cost (encryptions and bytes re-provisioned, group generation, waiting for the pool).
 * **Measured in the environment** (``--measure``): each defender policy of
-  :mod:`encctl_gym.loop.defenses` (none; audits at three rates; the chi-squared detector; input
-  noise at two levels) against the Gaussian, AR(1) and optimal-design attackers through the
-  environment (ideal backend, the system's own budget ``tau_c``): the detection rate, the samples
-  collected before the attack ends, the median final error over ``gamma_c``, and the wall time
-  per step against the undefended loop (a ratio measured in the same run).
+  :mod:`encctl_gym.loop.defenses` (none; audits at three rates; the chi-squared and CUSUM
+  detectors; input noise at two levels) against the Gaussian, AR(1) and optimal-design attackers
+  through the environment (ideal backend, the system's own budget ``tau_c``): the detection rate
+  (Wilson 95 % interval), the detection delay and the samples collected before the attack ends,
+  the final error over ``gamma_c`` (medians and quartiles), the defender's own wall time per step
+  (its ``act``, timed), and the whole step's time against the undefended loop's.
+* **Detection delay against input energy** (``--delays``): the chi-squared and CUSUM detectors
+  against every attacker at attack powers ``sigma_u2 / sigma_w2`` in :data:`ENERGY_RATIOS`
+  (``defenses_detection.md`` and the figure ``defenses_detection.png``).
 
-    python -m experiments.defenses [--measure] [--episodes 20] [--out results/defenses]
+    python -m encctl_gym.experiments.defenses [--measure] [--delays] [--rotation] [--episodes 20] [--out results/defenses] [--figures figures]
 
-Prints the tables and writes them as ``defenses_analytic.md`` (and ``defenses_measured.md``).
+Prints the tables and writes them as ``defenses_analytic.md`` (and ``defenses_measured.md``,
+``defenses_rotation.md``).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from pathlib import Path
@@ -108,9 +120,102 @@ MEASURED_DEFENDERS: tuple[tuple[str, Any], ...] = (
     ("audit p = 5e-4", {"name": "audit", "rate": 5e-4}),
     ("audit p = 1e-3", {"name": "audit", "rate": 1e-3}),
     ("chi2, W = 10, 1e-4 per step", {"name": "chi2", "window": 10, "false_alarm_rate": 1e-4}),
+    ("cusum, c = 2, 1e-4 per step", {"name": "cusum", "false_alarm_rate": 1e-4, "variance_ratio": 2.0}),
     ("noise sigma_d2 = sigma_w2", "noise-w"),
     ("noise sigma_d2 = 10 sigma_w2", "noise-10w"),
 )
+
+#: The detectors of the detection-delay sweep (label, ``defender`` value).
+DETECTORS: tuple[tuple[str, dict[str, Any]], ...] = (
+    ("chi2", {"name": "chi2", "window": 10, "false_alarm_rate": 1e-4}),
+    ("cusum", {"name": "cusum", "false_alarm_rate": 1e-4, "variance_ratio": 2.0}),
+)
+
+
+def _defender_spec(spec: Any, p: Any) -> Any:
+    if spec == "noise-w":
+        return {"name": "noise", "sigma_d2": p.sigma_w2}
+    if spec == "noise-10w":
+        return {"name": "noise", "sigma_d2": 10 * p.sigma_w2}
+    return spec
+
+
+def _attackers(env: Any) -> dict[str, Any]:
+    from encctl_gym.agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker
+
+    params = env.unwrapped.params
+    return {
+        "gaussian": GaussianAttacker(params),
+        "ar1": ColoredGaussianAttacker(params),
+        "optimal": OptimalDesignAttacker.from_env(env.unwrapped),
+    }
+
+
+class _TimedPolicy:
+    """The defender of an environment with its ``act`` timed (the defender's own cost per step)."""
+
+    def __init__(self, core: Any) -> None:
+        self.policy, self.seconds, self.calls = core.defender, 0.0, 0
+        core.defender = self
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.policy, name)
+
+    def act(self, view: Any) -> Any:
+        t0 = time.perf_counter()
+        try:
+            return self.policy.act(view)
+        finally:
+            self.seconds += time.perf_counter() - t0
+            self.calls += 1
+
+
+def _episodes(env: Any, att: Any, episodes: int, seed: int) -> tuple[list[dict[str, Any]], float, float]:
+    """``episodes`` attacks; per episode ``detected``, ``samples``, ``epsilon``, ``energy``; the
+    wall time per step and the defender's own time per step (its ``act``), both after one untimed
+    step, so compiled kernels are loaded before the clock runs."""
+    obs, _ = env.reset(seed=seed)
+    att.reset(seed=0)
+    env.step(att.act(obs[None])[0])
+    timer = _TimedPolicy(env.unwrapped.episode)
+    out, steps, t0 = [], 0, time.perf_counter()
+    for e in range(episodes):
+        obs, info = env.reset(seed=seed + e)
+        att.reset(seed=np.random.SeedSequence([seed, e]))
+        while True:
+            obs, _, term, trunc, info = env.step(att.act(obs[None])[0])
+            steps += 1
+            if term or trunc:
+                break
+        out.append(
+            {
+                "detected": bool(info["detected"]),
+                "samples": int(info["samples_collected"]),
+                "epsilon": float(info["epsilon"]),
+                "power": float(info["average_power"]),
+            }
+        )
+    wall = (time.perf_counter() - t0) / steps
+    env.unwrapped.episode.defender = timer.policy
+    return out, wall, timer.seconds / steps
+
+
+def wilson_interval(successes: int, trials: int, z: float = 1.96) -> tuple[float, float]:
+    """The Wilson score interval of a binomial proportion (95 % by default)."""
+    if trials == 0:
+        return (0.0, 1.0)
+    ph = successes / trials
+    den = 1 + z * z / trials
+    mid = (ph + z * z / (2 * trials)) / den
+    half = z * np.sqrt(ph * (1 - ph) / trials + z * z / (4 * trials * trials)) / den
+    return (float(max(0.0, mid - half)), float(min(1.0, mid + half)))
+
+
+def _quartiles(values: list[float]) -> tuple[float, float, float]:
+    if not values:
+        return (math.nan, math.nan, math.nan)
+    q = np.quantile(values, [0.25, 0.5, 0.75])
+    return float(q[0]), float(q[1]), float(q[2])
 
 
 def measure(system: str, episodes: int, seed: int) -> list[dict[str, Any]]:
@@ -118,106 +223,378 @@ def measure(system: str, episodes: int, seed: int) -> list[dict[str, Any]]:
     import gymnasium as gym
 
     import encctl_gym  # noqa: F401  (registers the environment)
-    from agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker
 
     p = get_preset(system)
     rows: list[dict[str, Any]] = []
     base_time: dict[str, float] = {}
     for label, spec in MEASURED_DEFENDERS:
-        if spec == "noise-w":
-            spec = {"name": "noise", "sigma_d2": p.sigma_w2}
-        elif spec == "noise-10w":
-            spec = {"name": "noise", "sigma_d2": 10 * p.sigma_w2}
-        env = gym.make("encctl_gym/EncryptedLTIAttack-v0", config={"preset": system, "decipher_delay": 0, "defender": spec})
+        config = {"preset": system, "decipher_delay": 0, "defender": _defender_spec(spec, p)}
+        env = gym.make("encctl_gym/EncryptedLTIAttack-v0", config=config)
         params = env.unwrapped.params  # type: ignore[attr-defined]
-        attackers = {
-            "gaussian": GaussianAttacker(params),
-            "ar1": ColoredGaussianAttacker(params),
-            "optimal": OptimalDesignAttacker.from_env(env.unwrapped),
-        }
-        for name, att in attackers.items():
-            detected, samples, finals = [], [], []
-            obs, _ = env.reset(seed=seed)  # one untimed step: compiled kernels are loaded before the clock runs
-            att.reset(seed=0)
-            env.step(att.act(obs[None])[0])
-            steps, t0 = 0, time.perf_counter()
-            for e in range(episodes):
-                obs, info = env.reset(seed=seed + e)
-                att.reset(seed=np.random.SeedSequence([seed, e]))
-                while True:
-                    obs, _, term, trunc, info = env.step(att.act(obs[None])[0])
-                    steps += 1
-                    if term or trunc:
-                        break
-                detected.append(bool(info["detected"]))
-                samples.append(int(info["samples_collected"]))
-                finals.append(float(info["epsilon"]))
-            per_step = (time.perf_counter() - t0) / steps
+        for name, att in _attackers(env).items():
+            eps, per_step, defender_step = _episodes(env, att, episodes, seed)
             if label == "none":
                 base_time[name] = per_step
+            hits = sum(e["detected"] for e in eps)
+            delays = [float(e["samples"]) for e in eps if e["detected"]]
             rows.append(
                 {
                     "system": system,
                     "defender": label,
                     "attacker": name,
                     "episodes": episodes,
-                    "detection_rate": float(np.mean(detected)),
-                    "samples_median": float(np.median(samples)),
-                    "error_over_gamma_c": float(np.median(finals)) / p.gamma_c,
+                    "detection_rate": hits / episodes,
+                    "detection_interval": wilson_interval(hits, episodes),
+                    "samples": _quartiles([float(e["samples"]) for e in eps]),
+                    "samples_median": float(np.median([e["samples"] for e in eps])),
+                    "delay": _quartiles(delays),
+                    "error_over_gamma_c": _quartiles([e["epsilon"] / p.gamma_c for e in eps]),
                     "horizon": params.horizon,
+                    "seconds_per_step": per_step,
+                    "defender_seconds_per_step": defender_step,
                     "time_ratio": per_step / base_time[name],
                 }
             )
     return rows
 
 
+def _iqr(q: tuple[float, float, float], fmt: str = ".3g") -> str:
+    if not np.isfinite(q[1]):
+        return "-"
+    return f"{q[1]:{fmt}} [{q[0]:{fmt}}, {q[2]:{fmt}}]"
+
+
 def format_measured(rows: list[dict[str, Any]]) -> str:
     """The measured table as markdown."""
     out = [
-        "| system | defender | attacker | detected | samples collected (median) | final error / gamma_c (median) | time per step / undefended |",
-        "|---|---|---|---|---|---|---|",
+        "| system | defender | attacker | detected [95 % CI] | detection delay, median [IQR] | samples collected, median [IQR] "
+        "| final E[eps] / gamma_c, median [IQR] | defender's own time per step (us) | time per step / undefended |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
+        lo, hi = r["detection_interval"]
         out.append(
-            f"| {r['system']} | {r['defender']} | {r['attacker']} | {r['detection_rate']:.0%} | "
-            f"{r['samples_median']:.0f} of {r['horizon']} | {r['error_over_gamma_c']:.3g} | {r['time_ratio']:.2f} |"
+            f"| {r['system']} | {r['defender']} | {r['attacker']} | {r['detection_rate']:.0%} [{lo:.0%}, {hi:.0%}] | "
+            f"{_iqr(r['delay'], '.0f')} | {_iqr(r['samples'], '.0f')} of {r['horizon']} | {_iqr(r['error_over_gamma_c'])} | "
+            f"{1e6 * r['defender_seconds_per_step']:.1f} | {r['time_ratio']:.2f} |"
         )
     return "\n".join(out)
 
 
+#: Attack powers of the detection-delay sweep, in units of the system's sigma_w2.
+ENERGY_RATIOS: tuple[float, ...] = (1e-3, 1e-2, 0.1, 1.0, 10.0, 100.0)
+
+
+def detection_delays(
+    system: str, episodes: int, seed: int, *, ratios: tuple[float, ...] = ENERGY_RATIOS, max_samples: int = 2000
+) -> list[dict[str, Any]]:
+    """Detection delay of the chi-squared and CUSUM detectors against the attacker's input power:
+    every attacker at ``sigma_u2 = ratio sigma_w2`` for each ratio, attacks of at most
+    ``max_samples`` steps (an attack not detected by then counts as undetected, its delay censored;
+    the key length is the preset's design at its own power, so the horizon does not move with the
+    power)."""
+    import gymnasium as gym
+
+    import encctl_gym  # noqa: F401  (registers the environment)
+    from encctl_gym.envs.config import resolve_params
+
+    p = get_preset(system)
+    key_length = resolve_params({"preset": system}).key_length  # the design's key at the preset's power, held fixed
+    rows: list[dict[str, Any]] = []
+    for det_label, spec in DETECTORS:
+        for ratio in ratios:
+            su2 = ratio * p.sigma_w2
+            config = {
+                "preset": system,
+                "decipher_delay": 0,
+                "defender": spec,
+                "sigma_u2": su2,
+                "key_length": key_length,
+                "max_samples": max_samples,
+            }
+            env = gym.make("encctl_gym/EncryptedLTIAttack-v0", config=config)
+            for name, att in _attackers(env).items():
+                eps, _, _ = _episodes(env, att, episodes, seed)
+                hits = sum(e["detected"] for e in eps)
+                rows.append(
+                    {
+                        "system": system,
+                        "detector": det_label,
+                        "attacker": name,
+                        "sigma_u2": su2,
+                        "power_ratio": ratio,
+                        "average_power": float(np.mean([e["power"] for e in eps])),
+                        "episodes": episodes,
+                        "detection_rate": hits / episodes,
+                        "detection_interval": wilson_interval(hits, episodes),
+                        "delay": _quartiles([float(e["samples"]) for e in eps if e["detected"]]),
+                        "max_samples": max_samples,
+                    }
+                )
+    return rows
+
+
+def format_delays(rows: list[dict[str, Any]]) -> str:
+    """The detection-delay table as markdown."""
+    out = [
+        "| system | detector | attacker | sigma_u2 / sigma_w2 | measured power per channel | detected [95 % CI] "
+        "| detection delay (steps), median [IQR] |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lo, hi = r["detection_interval"]
+        out.append(
+            f"| {r['system']} | {r['detector']} | {r['attacker']} | {r['power_ratio']:g} | {r['average_power']:.3g} | "
+            f"{r['detection_rate']:.0%} [{lo:.0%}, {hi:.0%}] | {_iqr(r['delay'], '.0f')} |"
+        )
+    return "\n".join(out)
+
+
+#: Rotation periods of the rotation rows (``None``: ``K = N*``, one group for the whole attack).
+ROTATION_PERIODS: tuple[int | None, ...] = (1, 10, 100, None)
+
+
+def rotation_rows(samples: int = 200, seed: int = 0, breaker: str = "index-calculus") -> dict[str, list[dict[str, Any]]]:
+    """Group rotation on the design example: the key length it needs, and the loop measured.
+
+    ``design``: per ``K`` of :data:`ROTATION_PERIODS`, ``k*`` under the precomputation model
+    charged per group (:func:`~encctl_gym.security.rotation.rotated_minimum_key_length`) and under
+    the paper model, the plant side's cost per step amortised over ``K`` (``n m / K`` encryptions,
+    their bytes, and the generation of one ``k*``-bit group, by the package's time model and
+    measured once here).
+
+    ``measured``: one episode of ``samples`` samples per ``K`` through real ElGamal at 64 bits
+    with ``breaker`` and the Gaussian attacker (``crypto_seed = seed``): the groups met, the
+    breaker's precomputations (counted on its cost records) and their seconds, the seconds per key,
+    and what the plant side spent.
+    """
+    import time as _time
+
+    import gymnasium as gym
+    from encctl_gym.agents import GaussianAttacker
+
+    import encctl_gym  # noqa: F401  (registers the environment)
+    from encctl_gym.crypto.group import estimate_generation_seconds, generate_safe_prime_group
+    from encctl_gym.loop.provisioning import provisioning_bytes
+    from encctl_gym.security.cost_models import PaperModel, PrecomputationModel
+    from encctl_gym.security.key_length import defense_budget
+    from encctl_gym.security.rotation import rotated_minimum_key_length
+
+    p = get_preset("paper-example")
+    N_star = int(noise_defense_design(p.plant(), p.threat(), sigma_d2=0.0).N_star)
+    budget = defense_budget(p.tau_c, p.upsilon)
+    n, m = p.A.shape[0], p.B.shape[1]
+    design: list[dict[str, Any]] = []
+    for K in ROTATION_PERIODS:
+        every = N_star if K is None else K
+        k_pre = rotated_minimum_key_length(PrecomputationModel(), N_star, every, budget)
+        k_paper = rotated_minimum_key_length(PaperModel(), N_star, every, budget)
+        t0 = _time.perf_counter()
+        group = generate_safe_prime_group(k_pre, rng=seed + every)
+        generated = _time.perf_counter() - t0
+        design.append(
+            {
+                "K": every,
+                "label": f"N* = {N_star}" if K is None else str(K),
+                "k_star_precomputation": k_pre,
+                "k_star_paper": k_paper,
+                "encryptions_per_step": n * m / every,
+                "bytes_per_step": provisioning_bytes(group, n * m) / every,
+                "generation_model_seconds": estimate_generation_seconds(k_pre),
+                "generation_seconds": generated,
+            }
+        )
+    measured: list[dict[str, Any]] = []
+    for K in ROTATION_PERIODS:
+        every = N_star if K is None else K
+        config = {
+            "preset": "paper-example",
+            "crypto": "elgamal",
+            "key_length": 64,
+            "breaker": breaker,
+            "deciphering_model": "precomputation",
+            "max_samples": samples,
+            "rotate_group_every": every,
+            "crypto_seed": seed,
+            "gamma_opt": False,
+        }
+        env = gym.make("encctl_gym/EncryptedLTIAttack-v0", config=config)
+        att = GaussianAttacker(env.unwrapped.params)  # type: ignore[attr-defined]
+        obs, info = env.reset(seed=seed)
+        att.reset(seed=seed)
+        steps, t0 = 0, _time.perf_counter()
+        while True:
+            obs, _, term, trunc, info = env.step(att.act(obs[None])[0])
+            steps += 1
+            if term or trunc:
+                break
+        wall = _time.perf_counter() - t0
+        loop = env.unwrapped.episode.loop  # type: ignore[attr-defined]
+        costs = list(loop.decipherer.costs)
+        pre = [c.seconds for method, c in costs if method == "precomputation"]
+        keys = [c.seconds for method, c in costs if method != "precomputation"]
+        measured.append(
+            {
+                "K": every,
+                "label": f"N* = {N_star}" if K is None else str(K),
+                "samples": int(info["samples_collected"]),
+                "groups": int(info["groups"]),
+                "groups_expected": -(-int(info["samples_collected"]) // every),
+                "precomputations": int(info["breaker_precomputations"]),
+                "precomputation_seconds": float(sum(pre)),
+                "seconds_per_key": float(np.mean(keys)) if keys else float("nan"),
+                "breaker_seconds": float(loop.deciphering_seconds),
+                "encryptions": int(info["provisioning_encryptions"]),
+                "bytes": int(info["provisioning_bytes"]),
+                "generation_seconds": float(info["group_generation_seconds"]),
+                "generation_model_seconds": float(info["group_generation_model_seconds"]),
+                "wait_seconds": float(info["group_wait_seconds"]),
+                "seconds_per_step": wall / steps,
+                "error_over_gamma_c": float(info["epsilon"]) / p.gamma_c,
+            }
+        )
+        env.close()
+    return {"design": design, "measured": measured}
+
+
+def format_rotation(rows: dict[str, list[dict[str, Any]]]) -> str:
+    """Both rotation tables as markdown."""
+    out = [
+        "| K | k* (precomputation model, per group) | k* (paper model) | encryptions per step | bytes per step "
+        "| group generation at k* bits: model / measured (s) |",
+        "|---|---|---|---|---|---|",
+    ]
+    for r in rows["design"]:
+        out.append(
+            f"| {r['label']} | {r['k_star_precomputation']} | {r['k_star_paper']} | {r['encryptions_per_step']:.4g} | "
+            f"{r['bytes_per_step']:.4g} | {r['generation_model_seconds']:.3g} / {r['generation_seconds']:.3g} |"
+        )
+    out += [
+        "",
+        "| K | samples | groups (ceil(N/K)) | breaker precomputations | precomputation s (total) | s per key "
+        "| breaker s (total) | encryptions re-provisioned | bytes | generation s: measured / model | waited s | s per step |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows["measured"]:
+        out.append(
+            f"| {r['label']} | {r['samples']} | {r['groups']} ({r['groups_expected']}) | {r['precomputations']} | "
+            f"{r['precomputation_seconds']:.3g} | {r['seconds_per_key']:.2g} | {r['breaker_seconds']:.3g} | "
+            f"{r['encryptions']} | {r['bytes']} | {r['generation_seconds']:.3g} / {r['generation_model_seconds']:.3g} | "
+            f"{r['wait_seconds']:.2g} | {r['seconds_per_step']:.3g} |"
+        )
+    return "\n".join(out)
+
+
+def plot_delays(rows: list[dict[str, Any]], path: Path) -> Path:
+    """Median detection delay (IQR bars) against the attack power, one panel per system; a
+    detector that misses some attacks is drawn with open markers."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from encctl_gym.plotting import legend_below, save_figure
+
+    systems = list(dict.fromkeys(r["system"] for r in rows))
+    fig, axes = plt.subplots(1, len(systems), figsize=(6.2 * len(systems), 4.4), squeeze=False)
+    styles = {"chi2": "-", "cusum": "--"}
+    markers = {"gaussian": "o", "ar1": "s", "optimal": "^"}
+    for ax, system in zip(axes[0], systems):
+        for det in styles:
+            for att in markers:
+                sel = [r for r in rows if r["system"] == system and r["detector"] == det and r["attacker"] == att]
+                sel = [r for r in sel if np.isfinite(r["delay"][1])]
+                if not sel:
+                    continue
+                x = np.array([r["power_ratio"] for r in sel])
+                med = np.array([r["delay"][1] for r in sel])
+                err = np.array([[r["delay"][1] - r["delay"][0] for r in sel], [r["delay"][2] - r["delay"][1] for r in sel]])
+                line = ax.errorbar(x, med, yerr=err, ls=styles[det], marker=markers[att], ms=5, capsize=2, label=f"{det}, {att}")
+                missed = [i for i, r in enumerate(sel) if r["detection_rate"] < 1]
+                if missed:
+                    ax.plot(x[missed], med[missed], ls="none", marker=markers[att], ms=10, mfc="none", color=line[0].get_color())
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("attack power sigma_u2 / sigma_w2")
+        ax.set_ylabel("detection delay (steps)")
+        ax.set_title(system)
+        ax.grid(True, which="major", alpha=0.3)
+    bottom = legend_below(fig, axes[0], ncol=3)
+    fig.suptitle("Detection delay vs attack power (open markers: not every attack detected)", fontsize=9)
+    fig.tight_layout(rect=(0, bottom, 1, 1))
+    return save_figure(fig, path)
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m experiments.defenses", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m encctl_gym.experiments.defenses", description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("results/defenses"))
     parser.add_argument(
         "--measure", action="store_true", help="also measure every defender against every attacker in the environment"
     )
+    parser.add_argument(
+        "--delays", action="store_true", help="also measure the detectors' delay against the attack power (table and figure)"
+    )
+    parser.add_argument("--figures", type=Path, default=Path("figures"), help="directory of the detection-delay figure")
     parser.add_argument("--episodes", type=int, default=20, help="episodes per defender and attacker (default 20)")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--rotation", action="store_true", help="also the group-rotation tables (real ElGamal and a breaker at 64 bits)"
+    )
+    parser.add_argument("--rotation-samples", type=int, default=200, help="samples per rotation episode (default 200)")
     args = parser.parse_args(argv)
     if args.episodes < 1:
         print(f"defenses: --episodes must be >= 1, got {args.episodes}", file=sys.stderr)
+        return 2
+    if args.rotation_samples < 9:
+        print(f"defenses: --rotation-samples must be >= 9 (n + m + 1), got {args.rotation_samples}", file=sys.stderr)
         return 2
     try:
         noise = noise_rows()
         text = format_tables(noise, audit_rows(noise))
         measured = [r for system in SYSTEMS for r in measure(system, args.episodes, args.seed)] if args.measure else []
+        rotation = rotation_rows(args.rotation_samples, args.seed) if args.rotation else None
+        delays = [r for system in SYSTEMS for r in detection_delays(system, args.episodes, args.seed)] if args.delays else []
     except EncctlError as exc:
         print(f"defenses: {exc}", file=sys.stderr)
         return 2
     print(text)
     args.out.mkdir(parents=True, exist_ok=True)
     path = args.out / "defenses_analytic.md"
-    path.write_text("# The defender's levers in closed form\n\nCommand: `python -m experiments.defenses`\n\n" + text + "\n")
+    path.write_text(
+        "# The defender's levers in closed form\n\nCommand: `python -m encctl_gym.experiments.defenses`\n\n" + text + "\n"
+    )
     print(f"  wrote {path}")
     if measured:
         table = format_measured(measured)
         print(table)
         path = args.out / "defenses_measured.md"
         path.write_text(
-            f"# The defences measured in the environment\n\nCommand: `python -m experiments.defenses --measure --episodes {args.episodes}`"
+            f"# The defences measured in the environment\n\nCommand: `python -m encctl_gym.experiments.defenses --measure --episodes {args.episodes}`"
             f" (seed {args.seed}; decipher_delay = 0, ideal backend, each system's own tau_c)\n\n" + table + "\n"
         )
         print(f"  wrote {path}")
+    if rotation is not None:
+        table = format_rotation(rotation)
+        print(table)
+        path = args.out / "defenses_rotation.md"
+        path.write_text(
+            "# Group rotation on the design example\n\nCommand: `python -m encctl_gym.experiments.defenses --rotation "
+            f"--rotation-samples {args.rotation_samples}` (seed {args.seed}; the design: uncorrected GNFS, budget "
+            "Upsilon tau_c of paper-example; measured: real ElGamal at 64 bits, index-calculus breaker, Gaussian "
+            "attacker, one episode per K)\n\n" + table + "\n"
+        )
+        print(f"  wrote {path}")
+    if delays:
+        table = format_delays(delays)
+        print(table)
+        path = args.out / "defenses_detection.md"
+        path.write_text(
+            f"# Detection delay against the attack power\n\nCommand: `python -m encctl_gym.experiments.defenses --delays --episodes {args.episodes}`"
+            f" (seed {args.seed}; decipher_delay = 0, ideal backend, attacks of at most 2000 steps)\n\n" + table + "\n"
+        )
+        print(f"  wrote {path}")
+        args.figures.mkdir(parents=True, exist_ok=True)
+        print(f"  wrote {plot_delays(delays, args.figures / 'defenses_detection.png')}")
     return 0
 
 

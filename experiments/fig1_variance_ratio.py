@@ -25,8 +25,9 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 
+from encctl_gym.experiments.common import FULL, GridConfig, Table, figure_entry_points, figure_table, panel_figure, preset_spec
+
 from encctl_gym.sim.montecarlo import AttackSpec
-from experiments.common import FULL, GridConfig, Table, figure_entry_points, figure_table, panel_figure, preset_spec
 
 __all__ = ["PANELS", "panel_systems", "compute", "plot", "add_arguments", "run", "main"]
 

@@ -3,7 +3,7 @@
 On the game of :mod:`encctl_gym.multiagent` (preset ``paper-example``, an attack of ``N``
 samples set by the deciphering budget, ideal backend, the default :class:`GameRules`):
 
-* **Learning** (:func:`agents.game_training.alternate`): ``--rounds`` rounds of best responses
+* **Learning** (:func:`encctl_gym.agents.game_training.alternate`): ``--rounds`` rounds of best responses
   with ``--algo`` (PPO or the package's ARS), ``--steps`` steps each, from the Gaussian attacker
   and no defence; then an attacker trained from scratch against the last learned defender alone
   (the *exploiter*).
@@ -18,7 +18,7 @@ samples set by the deciphering budget, ideal backend, the default :class:`GameRu
 * **Learning curves** of every best response (the return of each training episode, a running
   mean), one panel per side.
 
-    python -m experiments.game [--N 128] [--episodes 30] [--steps 20000] [--rounds 2] [--algo ppo]
+    python -m encctl_gym.experiments.game [--N 128] [--episodes 30] [--steps 20000] [--rounds 2] [--algo ppo]
         [--out docs/results/game] [--figure docs/figures/game_learning_curves_ALGO.png]
 
 Writes ``game_ALGO.md`` (the tables), ``game_ALGO_cells.csv`` (one row per cell) and the figure.
@@ -35,10 +35,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-
-from agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker
-from agents.evaluate import budget_config, env_config
-from agents.game import (
+from encctl_gym.agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker
+from encctl_gym.agents.evaluate import budget_config, env_config
+from encctl_gym.agents.game import (
     ConstantNoise,
     DetectorAudit,
     NoDefence,
@@ -49,14 +48,15 @@ from agents.game import (
     ScheduledAttacker,
     play,
 )
-from agents.game_training import Curve, alternate, train_side
+from encctl_gym.agents.game_training import Curve, alternate, train_side
+from encctl_gym.experiments.common import _checked, ensure_out_dir, script_main
+from encctl_gym.experiments.compare.statistics import Z95
+from encctl_gym.experiments.identification_strategies import replicate_interval
+
 from encctl_gym._validation import check_int
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.multiagent import GameRules
 from encctl_gym.plotting import legend_below, save_figure
-from experiments.common import _checked, ensure_out_dir, script_main
-from experiments.compare.statistics import Z95
-from experiments.identification_strategies import replicate_interval
 
 METRICS = (
     ("epsilon", "the attacker's final error epsilon"),
@@ -198,7 +198,7 @@ def run(args: argparse.Namespace) -> int:
     header = [
         "# The attacker-defender game (recorded by experiments/game.py)",
         "",
-        f"Command: `python -m experiments.game --N {args.N} --episodes {args.episodes} --steps {args.steps} "
+        f"Command: `python -m encctl_gym.experiments.game --N {args.N} --episodes {args.episodes} --steps {args.steps} "
         f"--rounds {args.rounds} --algo {args.algo} --seed {args.seed}` ({t_train:.0f} s of training, {time.time() - t0:.0f} s in all).",
         "",
         f"Plant `{args.preset}`, attacks of N = {args.N} samples (deciphering budget), ideal backend; rules: audit_cost = {r.audit_cost}, "
@@ -248,7 +248,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    return script_main("experiments.game", __doc__, add_arguments, run, argv)
+    return script_main("encctl_gym.experiments.game", __doc__, add_arguments, run, argv)
 
 
 if __name__ == "__main__":

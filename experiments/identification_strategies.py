@@ -44,7 +44,7 @@ against N with bands, gamma(N) and gamma_opt(N); rows systems, columns attackers
 ``identification_strategies_ratio.png`` (each estimator's mean error over least squares') and
 ``summary.md`` (the tables and the finding in words).
 
-Usage: ``python -m experiments.identification_strategies [--quick] [--out DIR] [--seed S]
+Usage: ``python -m encctl_gym.experiments.identification_strategies [--quick] [--out DIR] [--seed S]
 [--episodes E] [--replicates R] [--systems a,b] [--estimators ls,bayes] [--runs DIR] [--max-samples N]``; also
 ``encctl-gym reproduce`` (step ``strategies``).
 """
@@ -66,11 +66,16 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import numpy as np
+from encctl_gym.agents import Attacker
+from encctl_gym.agents.baselines import ColoredGaussianAttacker, GaussianAttacker
+from encctl_gym.agents.evaluate import budget_config
+from encctl_gym.agents.runs import RunInfo, find_runs
+from encctl_gym.experiments.common import add_common_arguments, ensure_out_dir, entry_point
+from encctl_gym.experiments.compare.attackers import ATTACKERS, learned_players, left_out, make_attackers
+from encctl_gym.experiments.compare.settings import Setting, make_setting, system_entry
+from encctl_gym.experiments.compare.statistics import fit_rate
+from encctl_gym.experiments.compare.tables import bound_rows
 
-from agents import Attacker
-from agents.baselines import ColoredGaussianAttacker, GaussianAttacker
-from agents.evaluate import budget_config
-from agents.runs import RunInfo, find_runs
 from encctl_gym.errors import ParameterError
 from encctl_gym.ident.estimator import Estimator, estimate_errors
 from encctl_gym.ident.registry import estimator_names, make_estimator
@@ -78,11 +83,6 @@ from encctl_gym.ident.tails import ErrorSummary, error_tail_exponent, summarize_
 from encctl_gym.plotting import legend_below, save_figure
 from encctl_gym.security.design import minimum_key_length, optimal_security_parameter, sample_size_for_rate
 from encctl_gym.sim.montecarlo import log_grid
-from experiments.common import add_common_arguments, ensure_out_dir, entry_point
-from experiments.compare.attackers import ATTACKERS, learned_players, left_out, make_attackers
-from experiments.compare.settings import Setting, make_setting, system_entry
-from experiments.compare.statistics import fit_rate
-from experiments.compare.tables import bound_rows
 
 __all__ = [
     "DEFAULT_SYSTEMS",
@@ -846,7 +846,7 @@ def run(args: argparse.Namespace) -> int:
     plots = plot(result, out)
     cmd = (
         [
-            "python -m experiments.identification_strategies",
+            "python -m encctl_gym.experiments.identification_strategies",
             f"--seed {args.seed}",
             f"--episodes {episodes}",
             f"--replicates {getattr(args, 'replicates', 1) or 1}",

@@ -16,7 +16,7 @@ gives the ``N*`` at which it reaches that target and the ``k*`` (paper model, eq
 defender then needs, with intervals; an ``N*`` beyond the simulated grid is an extrapolation and
 is marked.
 
-    python -m experiments.output_identification [--runs 20] [--points 6] [--quick] [--out docs/results/output]
+    python -m encctl_gym.experiments.output_identification [--runs 20] [--points 6] [--quick] [--out docs/results/output]
 
 Writes ``output_identification.csv``, ``output_identification.md`` and
 ``output_identification.png``.
@@ -159,7 +159,7 @@ def write(rows: list[dict[str, Any]], out: Path) -> list[Path]:
             )
     md = out / "output_identification.md"
     md.write_text(
-        "# Identification from outputs\n\nCommand: `python -m experiments.output_identification`"
+        "# Identification from outputs\n\nCommand: `python -m encctl_gym.experiments.output_identification`"
         f" ({rows[0]['runs']} runs per case). Target: the state least-squares Markov error at the paper's N*.\n\n"
         + format_table(rows)
         + "\n"
@@ -205,7 +205,9 @@ def write(rows: list[dict[str, Any]], out: Path) -> list[Path]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m experiments.output_identification", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m encctl_gym.experiments.output_identification", description=__doc__.splitlines()[0]
+    )
     parser.add_argument("--runs", type=int, default=20, help="attacks per case and N (default 20)")
     parser.add_argument("--points", type=int, default=6, help="sample sizes on the log grid (default 6)")
     parser.add_argument("--seed", type=int, default=0)

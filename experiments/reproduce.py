@@ -1,7 +1,7 @@
 """Reproduce the paper's Figures 1 and 2, its design example and the measurements beyond it (PNG, CSV, tables).
 
 The ``reproduce`` subcommand of ``encctl-gym`` (``add_arguments`` / ``run``); also
-``python -m experiments.reproduce``. Runs :mod:`experiments.fig1_variance_ratio`
+``python -m encctl_gym.experiments.reproduce``. Runs :mod:`experiments.fig1_variance_ratio`
 (fig:variance_ratio), :mod:`experiments.fig2_gramian` (fig:gramian),
 :mod:`experiments.design_example` (Theorem thm:opt_sec, eq:opt_key) and
 :mod:`experiments.identification_strategies` (attackers times estimators against gamma(N)) and
@@ -20,17 +20,17 @@ from pathlib import Path
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from experiments.common import add_common_arguments, entry_point
+from encctl_gym.experiments.common import add_common_arguments, entry_point
 
 __all__ = ["STEPS", "add_arguments", "run", "main"]
 
 #: (name, module) in the order they run.
 STEPS = (
-    ("fig1", "experiments.fig1_variance_ratio"),
-    ("fig2", "experiments.fig2_gramian"),
-    ("design", "experiments.design_example"),
-    ("strategies", "experiments.identification_strategies"),
-    ("deciphering", "experiments.deciphering_time"),
+    ("fig1", "encctl_gym.experiments.fig1_variance_ratio"),
+    ("fig2", "encctl_gym.experiments.fig2_gramian"),
+    ("design", "encctl_gym.experiments.design_example"),
+    ("strategies", "encctl_gym.experiments.identification_strategies"),
+    ("deciphering", "encctl_gym.experiments.deciphering_time"),
 )
 
 

@@ -7,9 +7,7 @@ import math
 import gymnasium as gym
 import numpy as np
 import pytest
-
-import encctl_gym  # noqa: F401  (registers the environment)
-from agents import (
+from encctl_gym.agents import (
     Attacker,
     ColoredGaussianAttacker,
     GaussianAttacker,
@@ -18,7 +16,9 @@ from agents import (
     observation_indices,
     rollout,
 )
-from agents.evaluate import budget_config
+from encctl_gym.agents.evaluate import budget_config
+
+import encctl_gym  # noqa: F401  (registers the environment)
 from encctl_gym.envs import ENV_ID, EncryptedLTIAttackEnv
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.envs.layout import ObservationLayout
@@ -217,7 +217,7 @@ def test_rollout_covariance_is_the_delivered_regressors_gram_over_their_count():
 
 
 def test_design_efficiency_of_the_gaussian_attack_and_the_oracle():
-    from agents.evaluate import design_efficiency
+    from encctl_gym.agents.evaluate import design_efficiency
 
     cfg = budget_config({"preset": "paper-example", "gamma_opt": False}, 2048)
     p = resolve_params(cfg)
@@ -251,7 +251,7 @@ def test_the_design_noise_root_does_not_depend_on_the_eigenvector_basis():
     """The design example's V is a multiple of the identity up to the solver's last digits: any
     orthonormal basis diagonalises it, so an eigenvector factor U diag(sqrt(w)) (and the inputs
     of a seed) is set by rounding; the symmetric root is sqrt(c) I for every such perturbation."""
-    from agents.optimal import psd_sqrt
+    from encctl_gym.agents.optimal import psd_sqrt
 
     rng = np.random.default_rng(0)
     c, n = 8.5, 4

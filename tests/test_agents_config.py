@@ -12,10 +12,20 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from agents.config import CONFIG_DIR, DEFAULTS_DIR, apply_override, default_config, env_config, load_config, read_yaml, run_name
-from agents.hyperparams import check_value
-from agents.runs import find_runs, new_run_dir, read_run
-from agents.sb3 import ALGORITHMS, SB3VecEnv, algorithm_class, load_attacker
+from encctl_gym.agents.config import (
+    CONFIG_DIR,
+    DEFAULTS_DIR,
+    apply_override,
+    default_config,
+    env_config,
+    load_config,
+    read_yaml,
+    run_name,
+)
+from encctl_gym.agents.hyperparams import check_value
+from encctl_gym.agents.runs import find_runs, new_run_dir, read_run
+from encctl_gym.agents.sb3 import ALGORITHMS, SB3VecEnv, algorithm_class, load_attacker
+
 from encctl_gym import cli
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ConfigError, ResourceLimitError
@@ -108,7 +118,7 @@ def test_system_file_replaces_a_and_b(tmp_path):
 def test_a_plant_file_and_the_environments_config_are_completed_by_one_rule(tmp_path):
     """train --system and config={"A": A, "B": B} take the same missing values from the same
     preset; with preset None neither completes anything."""
-    from agents.config import plant_config
+    from encctl_gym.agents.config import plant_config
 
     A, B = [[0.5, 0.1], [0.0, 0.3]], [[1.0], [0.5]]
     f = tmp_path / "plant.json"
@@ -216,7 +226,7 @@ def test_billion_laughs_is_refused_before_expansion(tmp_path):
         read_yaml(f)
     big = tmp_path / "big.yaml"
     big.write_text("x: " + "1" * (1 << 20) + "\n")
-    with pytest.raises(ConfigError, match="larger than"):
+    with pytest.raises(ConfigError, match="more than MAX_CONFIG_BYTES"):
         read_yaml(big)
 
 
@@ -320,7 +330,7 @@ def _depth(v: object) -> int:
 
 
 def test_nesting_is_bounded_before_yaml_builds_anything(tmp_path):
-    from agents.config import MAX_CONFIG_DEPTH
+    from encctl_gym.agents.config import MAX_CONFIG_DEPTH
 
     ok = tmp_path / "ok.yaml"  # the top-level mapping is one level, the flow lists the others
     ok.write_text("x: " + "[" * (MAX_CONFIG_DEPTH - 1) + "]" * (MAX_CONFIG_DEPTH - 1) + "\n")
@@ -362,7 +372,7 @@ def test_integers_of_more_than_4300_digits_are_one_config_error(tmp_path):
     ],
 )
 def test_counts_and_seeds_have_an_upper_bound(key, largest):
-    from agents.config import SCHEMA
+    from encctl_gym.agents.config import SCHEMA
 
     rule = SCHEMA
     for part in key.split("."):
@@ -406,7 +416,7 @@ def test_the_final_elgamal_evaluation_is_checked_before_training():
 
 
 def test_integer_hyperparameters_stay_within_int64():
-    from agents.hyperparams import INT64_MAX
+    from encctl_gym.agents.hyperparams import INT64_MAX
 
     assert INT64_MAX == np.iinfo(np.int64).max
     assert check_value("hyperparams.batch_size", INT64_MAX, int) == INT64_MAX
@@ -417,7 +427,7 @@ def test_integer_hyperparameters_stay_within_int64():
 
 
 def test_network_bytes_by_hand():
-    from agents.hyperparams import network_bytes
+    from encctl_gym.agents.hyperparams import network_bytes
 
     # [64, 64] from 11 inputs to 2 outputs: (11 + 1) 64 + (64 + 1) 64 + (64 + 1) 2 = 5058 weights, actor and critic
     assert network_bytes([64, 64], 11, 2) == 32 * 2 * 5058
@@ -453,7 +463,7 @@ def test_huge_policy_networks_are_refused_before_pytorch_allocates(capsys, tmp_p
 
 
 def test_run_json_parse_failures_are_config_errors(tmp_path, monkeypatch):
-    import agents.runs as runs
+    import encctl_gym.agents.runs as runs
 
     d = _run_dir(tmp_path, '{"algo": "ppo", "observation": "full", "env": {}, "seed": ' + "9" * 5000 + "}")
     with pytest.raises(ConfigError, match="cannot read .*run.json.*4300") as exc:
@@ -464,12 +474,12 @@ def test_run_json_parse_failures_are_config_errors(tmp_path, monkeypatch):
         read_run(d)
     _run_dir(tmp_path, {"algo": "ppo", "observation": "full", "env": {}, "pad": "x" * 200})
     monkeypatch.setattr(runs, "MAX_RUN_FILE_BYTES", 100)
-    with pytest.raises(ConfigError, match=r"run.json has \d+ bytes; a run.json has at most 100"):
+    with pytest.raises(ConfigError, match=r"run.json' has \d+ bytes, more than MAX_RUN_FILE_BYTES = 100"):
         read_run(d)
 
 
 def test_model_archives_are_checked_without_unpickling(tmp_path):
-    from agents.runs import check_model_file
+    from encctl_gym.agents.runs import check_model_file
 
     p = tmp_path / "model.zip"
     p.write_bytes(b"PK\x03\x04" + b"\x00" * 40 + b"garbage")
@@ -485,7 +495,7 @@ def test_model_archives_are_checked_without_unpickling(tmp_path):
 
 
 def test_an_output_path_that_is_a_file_is_refused(tmp_path):
-    from agents.runs import check_output_dir
+    from encctl_gym.agents.runs import check_output_dir
 
     f = tmp_path / "afile"
     f.write_text("x")

@@ -1,4 +1,4 @@
-"""Players of the game (agents.game): the static baselines' schedules by hand count, the frozen
+"""Players of the game (encctl_gym.agents.game): the static baselines' schedules by hand count, the frozen
 opponent's single-agent view (Gymnasium's checker, replayed seeds) and paired play; one short
 real best response each with PPO and ARS (slow)."""
 
@@ -9,11 +9,9 @@ import pytest
 
 pytest.importorskip("pettingzoo")
 
-from gymnasium.utils.env_checker import check_env  # noqa: E402
-
-from agents import GaussianAttacker  # noqa: E402
-from agents.evaluate import budget_config, env_config  # noqa: E402
-from agents.game import (  # noqa: E402
+from encctl_gym.agents import GaussianAttacker  # noqa: E402
+from encctl_gym.agents.evaluate import budget_config, env_config  # noqa: E402
+from encctl_gym.agents.game import (  # noqa: E402
     ConstantNoise,
     DetectorAudit,
     FrozenOpponent,
@@ -24,6 +22,8 @@ from agents.game import (  # noqa: E402
     ScheduledAttacker,
     play,
 )
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+
 from encctl_gym.envs.config import resolve_params  # noqa: E402
 from encctl_gym.errors import ParameterError  # noqa: E402
 
@@ -117,7 +117,7 @@ def test_play_pairs_the_episodes_and_counts_what_it_reports():
 @pytest.mark.slow
 @pytest.mark.parametrize("algo", ["ppo", "ars"])
 def test_a_short_best_response_trains_and_plays(algo):
-    from agents.game_training import train_side
+    from encctl_gym.agents.game_training import train_side
 
     player, curve = train_side("defender", ScheduledAttacker(GaussianAttacker(P)), CFG, algo=algo, steps=1024, seed=0)
     assert len(curve.returns) > 0 and np.all(np.diff(curve.timesteps) > 0)
@@ -128,7 +128,8 @@ def test_a_short_best_response_trains_and_plays(algo):
 def test_the_rllib_game_without_ray_names_the_extra(monkeypatch):
     import sys
 
-    from agents import rllib_game
+    from encctl_gym.agents import rllib_game
+
     from encctl_gym.errors import EncctlError
 
     monkeypatch.setitem(sys.modules, "ray", None)
@@ -138,7 +139,7 @@ def test_the_rllib_game_without_ray_names_the_extra(monkeypatch):
 
 def test_the_rllib_game_trains_both_sides_one_iteration():
     pytest.importorskip("ray.rllib")
-    from agents.rllib_game import train_game
+    from encctl_gym.agents.rllib_game import train_game
 
     rows = train_game({**CFG, "rules": {"audit_cost": 0.02}}, iterations=1, train_batch_size=128, minibatch_size=64, num_epochs=1)
     assert len(rows) == 1 and rows[0]["env_steps"] >= 128
@@ -146,7 +147,7 @@ def test_the_rllib_game_trains_both_sides_one_iteration():
 
 @pytest.mark.slow
 def test_the_game_experiment_writes_its_tables_and_curves(tmp_path):
-    from experiments import game as experiment
+    from encctl_gym.experiments import game as experiment
 
     fig = tmp_path / "curves.png"
     args = ["--N", "32", "--episodes", "2", "--steps", "256", "--rounds", "1", "--algo", "ars", "--out", str(tmp_path)]
@@ -157,7 +158,7 @@ def test_the_game_experiment_writes_its_tables_and_curves(tmp_path):
 
 
 def test_the_game_experiment_refuses_a_bad_option_in_one_line(capsys):
-    from experiments import game as experiment
+    from encctl_gym.experiments import game as experiment
 
     with pytest.raises(SystemExit) as exc:
         experiment.main(["--N", "4"])

@@ -10,7 +10,8 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from agents.runs import read_run
+from encctl_gym.agents.runs import read_run
+
 from encctl_gym import cli
 from encctl_gym.errors import ConfigError
 
@@ -39,8 +40,9 @@ def test_a_missing_run_directory_says_so_and_names_its_quick_sibling(tmp_path, c
 
 
 def test_train_system_reports_the_systems_defense_period_and_the_shortened_training_one(tmp_path):
-    from agents.config import env_config, load_config
-    from agents.train import system_summary
+    from encctl_gym.agents.config import env_config, load_config
+    from encctl_gym.agents.train import system_summary
+
     from encctl_gym.envs.config import resolve_params
     from encctl_gym.presets import get_preset
 
@@ -59,8 +61,8 @@ def test_train_system_reports_the_systems_defense_period_and_the_shortened_train
 @pytest.fixture(scope="module")
 def ars_run(tmp_path_factory):
     """A tiny ARS run on ``small``: its config sets input_history 0, the environment default is 2."""
-    from agents.config import apply_override, load_config
-    from agents.train import train
+    from encctl_gym.agents.config import apply_override, load_config
+    from encctl_gym.agents.train import train
 
     cfg = load_config("ars", "small", quick=True)
     for item in ("n_timesteps=512", "eval.freq=256", "eval.episodes=2"):
@@ -70,9 +72,9 @@ def ars_run(tmp_path_factory):
 
 
 def test_compare_plays_a_run_in_the_environment_it_was_trained_in(ars_run, tmp_path, capsys):
-    from experiments.compare.attackers import learned_players, run_setting
-    from experiments.compare.protocol import compute
-    from experiments.compare.settings import make_setting
+    from encctl_gym.experiments.compare.attackers import learned_players, run_setting
+    from encctl_gym.experiments.compare.protocol import compute
+    from encctl_gym.experiments.compare.settings import make_setting
 
     run = read_run(ars_run)
     setting = make_setting("small", 0, 24)
@@ -123,8 +125,8 @@ def test_compare_plays_a_run_in_the_environment_it_was_trained_in(ars_run, tmp_p
 
 
 def test_identification_strategies_and_evaluate_play_a_run_in_its_environment(ars_run, tmp_path):
-    import experiments.identification_strategies as strat
-    from experiments.compare.evaluate_run import run_settings
+    import encctl_gym.experiments.identification_strategies as strat
+    from encctl_gym.experiments.compare.evaluate_run import run_settings
 
     run = read_run(ars_run)
     res = strat.compute(("small",), estimators=("ls",), episodes=2, cap=16, points=2, runs=[run])
@@ -136,9 +138,9 @@ def test_identification_strategies_and_evaluate_play_a_run_in_its_environment(ar
 def test_compare_says_which_runs_it_leaves_out_and_why(ars_run, tmp_path, capsys):
     import shutil
 
-    from agents.runs import find_runs
-    from experiments.compare.attackers import left_out, run_setting
-    from experiments.compare.settings import make_setting
+    from encctl_gym.agents.runs import find_runs
+    from encctl_gym.experiments.compare.attackers import left_out, run_setting
+    from encctl_gym.experiments.compare.settings import make_setting
 
     run = read_run(ars_run)
     skipped: list = []
@@ -188,7 +190,8 @@ def test_compare_says_which_runs_it_leaves_out_and_why(ars_run, tmp_path, capsys
 
 
 def test_a_refusal_to_play_names_the_run(ars_run):
-    from agents.sb3 import load_attacker
+    from encctl_gym.agents.sb3 import load_attacker
+
     from encctl_gym.envs.config import resolve_params
 
     with pytest.raises(ConfigError, match="input_history = 0 in training, 2 here") as exc:
@@ -198,8 +201,9 @@ def test_a_refusal_to_play_names_the_run(ars_run):
 
 # ------------------------------------------------------------------ plant files wherever a system is taken
 def test_every_command_that_takes_a_system_takes_a_plant_file(ars_run, tmp_path, capsys):
+    from encctl_gym.experiments.compare.settings import system_entry
+
     from encctl_gym.presets import get_preset
-    from experiments.compare.settings import system_entry
 
     small = get_preset("small")
     plant = tmp_path / "myplant.json"

@@ -10,16 +10,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from encctl_gym.agents import GaussianAttacker, OptimalDesignAttacker, rollout
+from encctl_gym.agents.evaluate import budget_config
+from encctl_gym.experiments import compare as cmp
+from encctl_gym.experiments.compare.cli import QUICK_EPISODES
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from agents import GaussianAttacker, OptimalDesignAttacker, rollout
-from agents.evaluate import budget_config
 from encctl_gym import cli
 from encctl_gym.errors import ConfigError
 from encctl_gym.security.design import optimal_security_parameter, sample_size_for_rate
-from experiments import compare as cmp
-from experiments.compare.cli import QUICK_EPISODES
 
 
 # ------------------------------------------------------------------ statistics
@@ -127,7 +127,7 @@ def test_oracle_beats_gaussian_where_the_theory_says_so():
 # ------------------------------------------------------------------ end to end
 def _fake_run(root: Path, algo: str, observation: str) -> Path:
     """A training run directory holding an untrained model (the format of agents.train)."""
-    from agents.sb3 import SB3VecEnv, algorithm_class
+    from encctl_gym.agents.sb3 import SB3VecEnv, algorithm_class
 
     env_cfg = {"preset": "paper-example", "decipher_delay": 0, "gamma_opt": False, "max_samples": 64}
     venv = SB3VecEnv(env_cfg, 2, observation)
@@ -287,7 +287,7 @@ def test_length_grid_has_at_most_the_horizon_points():
 
 
 def test_record_bytes_by_hand():
-    from experiments.compare.protocol import record_bytes
+    from encctl_gym.experiments.compare.protocol import record_bytes
 
     s0 = cmp.make_setting("small", 0, cap=20)  # delivered states: one running record of 20 steps too
     s_end = cmp.make_setting("small", "end", cap=20)
@@ -305,8 +305,7 @@ def test_the_kernels_are_warmed_before_the_progress_bar_starts(monkeypatch):
     """The bar's rate, and so its ETA, must not include compile time: one short episode of every
     setting is played before the bar is made, and the results do not depend on it."""
     import tqdm
-
-    from experiments.compare import protocol
+    from encctl_gym.experiments.compare import protocol
 
     events: list[str] = []
     real_warm_up, real_tqdm = protocol.warm_up, tqdm.tqdm

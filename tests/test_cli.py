@@ -45,9 +45,9 @@ def test_a_multi_line_package_error_is_printed_on_one_line(monkeypatch, capsys) 
     def boom(args):  # type: ignore[no-untyped-def]
         raise ParameterError("A must be real, got array([[0.5+0.j, 0.1+0.j],\n [0. +0.j, 0.3+1.j]])")
 
-    import encctl_gym.security.design_cli as design_cli
+    import encctl_gym.design_command as design_command
 
-    monkeypatch.setattr(design_cli, "run", boom)  # the parser takes the subcommand's run when it is built
+    monkeypatch.setattr(design_command, "run", boom)  # the parser takes the subcommand's run when it is built
     assert cli.main(["design"]) == 2
     err = capsys.readouterr().err
     assert err == "encctl-gym design: error: A must be real, got array([[0.5+0.j, 0.1+0.j], [0. +0.j, 0.3+1.j]])\n"

@@ -10,6 +10,7 @@ import random
 import mpmath
 import numpy as np
 import pytest
+from encctl_gym.experiments import deciphering_time, reproduce
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -19,7 +20,6 @@ from encctl_gym.cryptanalysis.index_calculus import choose_bound, cost_model, re
 from encctl_gym.cryptanalysis.linalg import solve_mod_prime
 from encctl_gym.cryptanalysis.smoothness import FactorBase, dickman_rho, primes_up_to, rational_reconstruction
 from encctl_gym.errors import ParameterError
-from experiments import deciphering_time, reproduce
 
 
 # ----------------------------------------------------------------------------- crack
@@ -116,7 +116,7 @@ def test_deciphering_time_csv_round_trip_and_plot(quick_rows: list, tmp_path) ->
 
 
 def test_deciphering_time_is_a_reproduce_step() -> None:
-    assert ("deciphering", "experiments.deciphering_time") in reproduce.STEPS
+    assert ("deciphering", "encctl_gym.experiments.deciphering_time") in reproduce.STEPS
 
 
 def test_full_plan_covers_the_sizes_of_the_issue() -> None:

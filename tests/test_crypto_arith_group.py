@@ -123,8 +123,10 @@ def test_as_random_source_and_bad_bounds():
         RandomSource().below(3)
 
 
-# Non-integers that gmpy2 would refuse with a bare TypeError (or, for 2.5, that would lose digits).
-NON_INTEGERS = [2.5, 3.0, "7", None, [7], True, 2 + 0j, np.float64(3.0)]
+# Non-integers that gmpy2 would refuse with a bare TypeError (or, for 2.5 and 2.0**64, that would
+# lose digits). By the package's one integer rule (_validation.check_int) an integral float up to
+# 2^53, such as 3.0, is exactly its integer and accepted (tests/test_validation_integers.py).
+NON_INTEGERS = [2.5, 2.0**64, np.float64(2.0**60), "7", None, [7], True, 2 + 0j]
 
 
 @pytest.mark.parametrize("bad", NON_INTEGERS, ids=repr)
@@ -203,7 +205,7 @@ def test_between_checks_its_bounds():
         with pytest.raises(ParameterError, match=r"high must be an integer.*got " + re.escape(format_value(bad))):
             src.between(1, bad)
     with pytest.raises(ParameterError, match="low must be an integer"):
-        src.between(1.0, 5)
+        src.between(1.5, 5)  # 1.0 is exactly 1 (the one integer rule); 1.5 is no integer
     assert all(10 <= seeded_random(4).between(np.int64(10), gmpy2.mpz(12)) < 12 for _ in range(5))
     # the same draws whatever integer type the bounds have
     assert seeded_random(5).between(np.int32(7), 10**30) == seeded_random(5).between(7, 10**30)
@@ -340,7 +342,7 @@ def test_group_files_that_cannot_be_read_are_config_errors(tmp_path):
     with big.open("wb") as f:  # sparse: larger than the bound on paper only
         f.seek(MAX_GROUP_FILE_BYTES)
         f.write(b" ")
-    with pytest.raises(ConfigError, match=rf"larger than MAX_GROUP_FILE_BYTES = {MAX_GROUP_FILE_BYTES}"):
+    with pytest.raises(ConfigError, match=rf"more than MAX_GROUP_FILE_BYTES = {MAX_GROUP_FILE_BYTES}"):
         GroupParams.load(big)
     # a file of exactly the bound is read (and then refused for its content only)
     with big.open("r+b") as f:

@@ -1,6 +1,6 @@
 """Tests of the encrypted linear controller of eq:ec (crypto.controller and its parties:
 crypto.quantized, crypto.servers, crypto.plant_side, crypto.schemes) and of the forging of
-injected inputs (attacks.forgery)."""
+injected inputs (attacks.forgery, through each scheme's ``forge`` of loop.scheme)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from encctl_gym.attacks.forgery import forge, forge_injection, forge_injection_token, injection_value
+from encctl_gym.attacks.forgery import forge_injection, forge_injection_token, injection_value
 from encctl_gym.crypto.arith import PowmodCounter, RandomSource, seeded_random
 from encctl_gym.crypto.controller import EncryptedLinearController
 from encctl_gym.crypto.dyn_elgamal import UpdateToken, recover_next_secret_key
@@ -26,6 +26,7 @@ from encctl_gym.crypto.quantized import QuantizedLinearController
 from encctl_gym.crypto.schemes import SCHEMES
 from encctl_gym.crypto.servers import ControllerServer, StaticControllerServer
 from encctl_gym.errors import CiphertextError, EncodingOverflowError, KeyMismatchError, ParameterError
+from encctl_gym.loop.scheme import SCHEMES as LOOP_SCHEMES
 
 G64, G128 = shipped_group(64), shipped_group(128)
 PHI = np.array([[0.5, -1.2, 0.3, 0.0], [1.0, 2.0, -3.0, 0.25], [0.1, 0.2, 0.3, 0.4], [-1.0, -1.0, -1.0, -1.0]])
@@ -374,7 +375,7 @@ def test_every_scheme_pairs_its_plant_and_server_and_forgery():
         for t in range(3):
             assert np.array_equal(ctrl.step(_x(t)), ctrl.reference(_x(t)))
         assert (ctrl.pk == pk0) == (name == "static") and (ctrl.t == 0) == (name == "static")
-        forged = forge(name, ctrl.pk0, ctrl.pk, a, ctrl.encoder, 4, seeded_random(2))
+        forged = LOOP_SCHEMES.build(name).forge(ctrl.plant, a, ctrl.encoder, 4, seeded_random(2))
         assert np.array_equal(ctrl.step(_x(5), inject=forged), injection_value(a, ctrl.encoder, 4))
     static = EncryptedLinearController(PHI, G128, 2.0**12, 10.0, scheme="static", rng=3)
     assert type(static.server) is StaticControllerServer and isinstance(static.plant, StaticPlant)
@@ -390,7 +391,7 @@ def test_per_entry_forgery_hides_the_input_and_decodes_the_same(scheme):
     p = G128.p
     last = (lambda c: c.c3) if scheme == "modified" else (lambda c: c.c2)
     for per_entry in (False, True):
-        out = forge(scheme, ctrl.pk0, ctrl.pk, a, ctrl.encoder, 4, seeded_random(7), per_entry=per_entry)
+        out = LOOP_SCHEMES.build(scheme, per_entry=per_entry).forge(ctrl.plant, a, ctrl.encoder, 4, seeded_random(7))
         masks = {last(c) for row in out for c in row[1:]}  # entries that encrypt the known 1
         read = [last(row[0]) * pow(last(row[1]), -1, p) % p for row in out]
         truth = [w % p for w in (ctrl.encoder.encode_signed(float(ai)) * ctrl.encoder.encode_signed(1.0) for ai in a)]

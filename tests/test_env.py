@@ -443,7 +443,7 @@ def test_helper_thread_gives_the_same_numbers_through_refreshes_and_early_resets
     """The helper thread (noise drawn ahead, Gram catch-up) changes where work runs, not the
     numbers: a vector env with it matches single envs without it, step for step, through noise
     chunks, Gram hand-overs, exact refreshes, the episode end and resets in mid-episode."""
-    from encctl_gym.envs.episode import EpisodeSchedule
+    from encctl_gym.envs.schedule import EpisodeSchedule
 
     schedule = EpisodeSchedule(chunk=16, gram_batch=4, refresh=40)  # many chunk, hand-over and refresh boundaries
     K, cfg = 4, {**SMALL, "scheme": "static", "max_samples": 150}
@@ -769,3 +769,24 @@ def test_bad_vector_flags_are_refused_before_a_helper_thread_starts():
         with pytest.raises(ParameterError, match="must be a bool"):
             EncryptedLTIAttackVectorEnv(num_envs=2, config=SMALL, **kw)
     assert threading.active_count() == before
+
+
+@pytest.mark.parametrize("how", ["deepcopy", "pickle"])
+def test_a_copied_env_rewards_and_identifies_on_as_the_original(how):
+    """The copy's Gram views G and C stay views of its own [G | C] (a deep copy of a numpy view is
+    an array of its own, which the kernels would no longer update: the copy's reward was 0 and its
+    epsilon frozen from the copy on)."""
+    import copy
+    import pickle
+
+    env = gym.make(ENV_ID, config={"preset": "paper-example", "decipher_delay": 0, "max_samples": 30})
+    env.reset(seed=0)
+    a = np.full(env.action_space.shape, 0.3, dtype=np.float32)
+    for _ in range(4):
+        env.step(a)
+    twin = copy.deepcopy(env) if how == "deepcopy" else pickle.loads(pickle.dumps(env))
+    for _ in range(20):
+        _, r1, *_, i1 = env.step(a)
+        _, r2, *_, i2 = twin.step(a)
+        assert r1 == r2 and i1["epsilon"] == i2["epsilon"]
+    assert r1 != 0.0

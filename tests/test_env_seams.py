@@ -12,7 +12,7 @@ import pytest
 
 import encctl_gym  # noqa: F401  (registers the environment)
 from encctl_gym.envs import ENV_ID
-from encctl_gym.envs.episode import EpisodeSchedule
+from encctl_gym.envs.schedule import EpisodeSchedule
 from encctl_gym.envs.steps import CompiledIdealStep, FusedStep, GenericStep
 from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
 from encctl_gym.errors import ParameterError

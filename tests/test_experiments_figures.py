@@ -8,11 +8,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from encctl_gym.experiments import design_example, fig1_variance_ratio, fig2_gramian, reproduce
+from encctl_gym.experiments.common import COLUMNS, QUICK, GridConfig, Table, read_csv
 
 from encctl_gym import cli
 from encctl_gym.security.complexity import input_upper_bound
-from experiments import design_example, fig1_variance_ratio, fig2_gramian, reproduce
-from experiments.common import COLUMNS, QUICK, GridConfig, Table, read_csv
 
 REPO = Path(__file__).resolve().parents[1]
 # Reduced grid: 50 runs as in the paper, N up to 2000 (the claims are about the 1/N regime).
@@ -183,9 +183,9 @@ def test_cli_bad_option_is_a_one_line_error_before_any_work(
 
 
 def test_reproduce_module_and_script_entry_points(tmp_path: Path) -> None:
-    # `python -m experiments.reproduce` and `python experiments/<script>.py` both work.
+    # `python -m encctl_gym.experiments.reproduce` and `python experiments/<script>.py` both work.
     r = subprocess.run(
-        [sys.executable, "-m", "experiments.reproduce", "--only", "design", "--out", str(tmp_path)],
+        [sys.executable, "-m", "encctl_gym.experiments.reproduce", "--only", "design", "--out", str(tmp_path)],
         cwd=REPO,
         capture_output=True,
         text=True,

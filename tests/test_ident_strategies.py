@@ -7,11 +7,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from encctl_gym.experiments import identification_strategies as strat
+from encctl_gym.experiments import reproduce
+from encctl_gym.experiments.compare.settings import make_setting
 
 from encctl_gym.errors import ParameterError
-from experiments import identification_strategies as strat
-from experiments import reproduce
-from experiments.compare.settings import make_setting
 
 
 def test_table_sizes_and_grid_reach_n_star_of_the_design_example() -> None:
@@ -52,7 +52,7 @@ def test_quick_run_end_to_end(tmp_path: Path) -> None:
     assert len(sec) == 16
     md = strat.summary_markdown(res, command="cmd", plots=pngs)
     assert "| gaussian | ls |" in md and "paper gamma (eq:sic2)" in md and "Findings:" in md
-    assert ("strategies", "experiments.identification_strategies") in reproduce.STEPS
+    assert ("strategies", "encctl_gym.experiments.identification_strategies") in reproduce.STEPS
 
 
 def test_security_rows_refuse_to_extrapolate_a_curve_that_does_not_fall_like_one_over_n() -> None:
@@ -84,7 +84,7 @@ def test_a_learned_attacker_from_a_run_directory_joins(tmp_path: Path) -> None:
     pytest.importorskip("stable_baselines3")
     import json
 
-    from agents.sb3 import SB3VecEnv, algorithm_class
+    from encctl_gym.agents.sb3 import SB3VecEnv, algorithm_class
 
     env_cfg = {"preset": "small", "decipher_delay": 0, "gamma_opt": False, "max_samples": 32}
     model = algorithm_class("ppo")("MlpPolicy", SB3VecEnv(env_cfg, 2, "full"), n_steps=8, batch_size=16, seed=0, device="cpu")

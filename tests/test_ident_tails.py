@@ -114,11 +114,11 @@ def test_engine_summaries_use_the_rule() -> None:
 
 
 def test_compare_row_reports_the_median_where_the_mean_does_not_exist() -> None:
-    from agents.evaluate import Rollout
-    from experiments.compare.protocol import Curve
-    from experiments.compare.report import _error_cell
-    from experiments.compare.settings import make_setting
-    from experiments.compare.tables import security_row
+    from encctl_gym.agents.evaluate import Rollout
+    from encctl_gym.experiments.compare.protocol import Curve
+    from encctl_gym.experiments.compare.report import _error_cell
+    from encctl_gym.experiments.compare.settings import make_setting
+    from encctl_gym.experiments.compare.tables import security_row
 
     s = make_setting("small", 0, None, length=40)
     rng = np.random.default_rng(2)

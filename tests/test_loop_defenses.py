@@ -84,6 +84,8 @@ def test_audits_stop_an_injecting_attacker_after_a_geometric_number_of_steps():
 def test_the_chi2_detector_stops_a_large_injection_and_noise_changes_the_trajectory():
     steps, info = run({"name": "chi2", "window": 5, "false_alarm_rate": 1e-6}, 0, action=np.ones(2, dtype=np.float32))
     assert info["detected"]
+    steps, info = run({"name": "cusum", "false_alarm_rate": 1e-6}, 0, action=np.ones(2, dtype=np.float32))
+    assert info["detected"]
     no_noise = run({"name": "noise", "sigma_d2": 0.0}, 3)[1]
     fixed = run("fixed", 3)[1]
     assert no_noise["epsilon"] == fixed["epsilon"]  # sigma_d2 = 0 is the fixed defender, bit for bit
@@ -99,6 +101,8 @@ def test_the_chi2_detector_stops_a_large_injection_and_noise_changes_the_traject
         ({"name": "nope"}, "unknown defender 'nope'"),
         ({"name": "noise", "sigma_d2": -1.0}, "sigma_d2"),
         ({"name": "chi2", "false_alarm_rate": 1.0}, "false_alarm_rate must lie in \\(0, 1\\)"),
+        ({"name": "cusum", "false_alarm_rate": 0.0}, "false_alarm_rate must be > 0"),
+        ({"name": "cusum", "variance_ratio": 1.0}, "variance_ratio must be > 1"),
     ],
 )
 def test_bad_defender_options_are_refused(spec, match):
@@ -107,7 +111,7 @@ def test_bad_defender_options_are_refused(spec, match):
 
 
 def test_the_measured_defence_table_on_a_small_plant():
-    from experiments.defenses import MEASURED_DEFENDERS, format_measured, measure
+    from encctl_gym.experiments.defenses import MEASURED_DEFENDERS, format_measured, measure
 
     rows = measure("small", episodes=1, seed=0)
     assert len(rows) == 3 * len(MEASURED_DEFENDERS)
@@ -118,3 +122,15 @@ def test_the_measured_defence_table_on_a_small_plant():
     assert all(r["detection_rate"] == 1.0 for r in rows if r["defender"].startswith("chi2"))  # every step injects
     assert all(r["samples_median"] <= r["horizon"] for r in rows)
     assert format_measured(rows).count("\n") == len(rows) + 1
+
+
+@pytest.mark.slow
+def test_the_detection_delay_sweep_and_its_figure_on_a_small_plant(tmp_path):
+    from encctl_gym.experiments.defenses import DETECTORS, detection_delays, format_delays, plot_delays
+
+    rows = detection_delays("small", episodes=1, seed=0, ratios=(1e-3, 100.0), max_samples=300)
+    assert len(rows) == len(DETECTORS) * 2 * 3
+    loud = [r for r in rows if r["power_ratio"] == 100.0]
+    assert all(r["detection_rate"] == 1.0 and r["delay"][1] <= 300 for r in loud)
+    assert format_delays(rows).count("\n") == len(rows) + 1
+    assert plot_delays(rows, tmp_path / "delays.png").stat().st_size > 0

@@ -77,3 +77,56 @@ def test_refusals():
         ChiSquaredDetector(A_CL, np.eye(3), window=3, false_alarm_rate=0.01)
     with pytest.raises(ParameterError, match="window"):
         ChiSquaredDetector(A_CL, np.eye(2), window=0, false_alarm_rate=0.01)
+
+
+def _binomial_interval(trials: int, p: float, tail: float = 1e-6) -> tuple[int, int]:
+    from scipy.stats import binom
+
+    return int(binom.ppf(tail / 2, trials, p)), int(binom.isf(tail / 2, trials, p))
+
+
+def test_the_cusum_false_alarm_rate_per_step_meets_its_target():
+    """Restarted after each alarm, the CUSUM's run length to a false alarm is close to geometric
+    with mean 1/alpha, so its alarm count over K T steps is close to binomial(K T, alpha): the
+    count must fall in that distribution's central 1 - 1e-6 interval."""
+    from encctl_gym.loop.detection import CusumDetector
+
+    alpha, K, T = 1e-3, 200, 5000
+    det = CusumDetector(A_CL, SW * np.eye(2), false_alarm_rate=alpha, num_loops=K)
+    count = int(run(det, T, np.random.default_rng(4)).sum())
+    lo, hi = _binomial_interval(K * T, alpha)
+    assert lo <= count <= hi, (lo, count, hi)
+
+
+def test_the_cusum_detects_an_inflated_innovation_within_its_run_length():
+    """An attack that inflates the innovation covariance by r: the mean delay over K loops is
+    the Markov chain's run length under r Sigma, within four standard errors of the mean."""
+    from encctl_gym.loop.detection import CusumDetector
+    from encctl_gym.security.defenses import cusum_run_length
+
+    K, r = 2000, 4.0
+    det = CusumDetector(A_CL, SW * np.eye(2), false_alarm_rate=1e-4, variance_ratio=2.0, num_loops=K)
+    expected = cusum_run_length(2, 2.0, det.threshold, actual_ratio=r)
+    rng = np.random.default_rng(5)
+    x = np.zeros((K, 2))
+    delay = np.zeros(K)
+    for t in range(1, 2000):
+        x_next = x @ A_CL.T + rng.normal(scale=math.sqrt(r * SW), size=(K, 2))
+        alarms = det.update(x, x_next)
+        delay[(delay == 0) & alarms] = t
+        x = x_next
+        if (delay > 0).all():
+            break
+    assert (delay > 0).all()
+    assert abs(delay.mean() - expected) < 4 * delay.std() / math.sqrt(K), (delay.mean(), expected)
+
+
+def test_the_cusum_stops_a_real_injection():
+    """An attacker that replaces Phi x by N(0, 3^2) inputs is caught in every loop."""
+    from encctl_gym.loop.detection import CusumDetector
+
+    K = 500
+    det = CusumDetector(A_CL, SW * np.eye(2), false_alarm_rate=1e-4, num_loops=K)
+    rng = np.random.default_rng(6)
+    alarms = run(det, 300, rng, injection=lambda t, x: rng.normal(scale=3.0, size=(K, 1)))
+    assert alarms.any(axis=0).all()

@@ -12,11 +12,11 @@ import pytest
 
 pytest.importorskip("pettingzoo")
 
+from encctl_gym.agents.evaluate import budget_config, env_config  # noqa: E402
+from encctl_gym.agents.game import defender_action  # noqa: E402
 from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
 
 import encctl_gym  # noqa: E402,F401
-from agents.evaluate import budget_config, env_config  # noqa: E402
-from agents.game import defender_action  # noqa: E402
 from encctl_gym.errors import ParameterError  # noqa: E402
 from encctl_gym.loop.backend import lqr_gain  # noqa: E402
 from encctl_gym.loop.defenses import audit_tolerance  # noqa: E402
@@ -147,6 +147,7 @@ def test_the_defender_sees_only_the_plant_side():
         (lambda: EncryptedControlGame(_cfg(), {"audit_bugdet": 3}), "audit_bugdet"),
         (lambda: EncryptedControlGame(_cfg(), {"audit_cost": -1}), "audit_cost"),
         (lambda: EncryptedControlGame({**_cfg(), "defender": "audit"}), "defender"),
+        (lambda: EncryptedControlGame({**_cfg(), "rotate_group_every": 8}), "rotate_group_every"),
     ],
 )
 def test_bad_game_settings_are_refused_naming_them(make, text):
@@ -177,7 +178,7 @@ def test_a_missing_pettingzoo_is_one_line_naming_the_extra():
 
 
 def test_the_game_runs_on_real_ciphertexts_and_a_passed_input_is_the_controllers():
-    from agents.evaluate import elgamal_config
+    from encctl_gym.agents.evaluate import elgamal_config
 
     game = EncryptedControlGame(elgamal_config(env_config({"preset": "paper-example"}), 12, key_length=64))
     m = game.params.m
@@ -194,7 +195,7 @@ def test_the_game_runs_on_real_ciphertexts_and_a_passed_input_is_the_controllers
 def test_passed_through_steps_give_the_same_numbers_on_every_step_path():
     """Injected and passed-through steps mixed: the ideal backend (its compiled steps) and real
     ElGamal (the generic step) give the same trajectory bit for bit, as the single environment's do."""
-    from agents.evaluate import elgamal_config
+    from encctl_gym.agents.evaluate import elgamal_config
 
     cfg = elgamal_config(env_config({"preset": "paper-example"}), 16, key_length=64)
     ideal = {k: v for k, v in cfg.items() if k != "crypto_seed"} | {"crypto": "ideal"}

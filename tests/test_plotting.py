@@ -70,7 +70,7 @@ def test_save_figure_warns_for_what_it_cannot_mend(tmp_path):
 
 
 def test_a_learning_curve_that_stays_above_the_cut_is_still_drawn(tmp_path):
-    from agents.curves import LearningCurve, plot_learning_curves
+    from encctl_gym.agents.curves import LearningCurve, plot_learning_curves
 
     E, K = 4, 3
     curve = LearningCurve(

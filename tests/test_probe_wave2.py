@@ -4,6 +4,9 @@ unbounded allocation or a silent wrong number."""
 
 from __future__ import annotations
 
+from typing import Any
+
+import numpy as np
 import pytest
 
 from encctl_gym.envs.config import resolve_params
@@ -197,31 +200,47 @@ def test_a_bayes_prior_whose_error_overflows_is_refused() -> None:
     assert make_estimator({"name": "bayes", "prior_mean": np.full((2, 4), 1e100)}).prior_mean.max() == 1e100
 
 
-def test_an_estimation_error_that_overflows_ends_the_episode_loudly() -> None:
+def _bayes_episode(path: str) -> tuple[Any, Any]:
+    """An environment with Bayes on the column-by-column path (``generic``) or on its compiled
+    form (``compiled``), and a function that makes every estimate's error that of ``theta``."""
     import gymnasium as gym
     import numpy as np
 
-    from encctl_gym.errors import SolverError
+    from encctl_gym.ident.bayes import BayesianLeastSquares
     from encctl_gym.registration import ENV_ID
 
-    env = gym.make(ENV_ID, config={"preset": "small", "estimator": {"name": "bayes"}, "max_samples": 12, "gamma_opt": False})
+    est: Any = "bayes"
+    if path == "generic":
+        est = type("ColumnByColumnBayes", (BayesianLeastSquares,), {"online_kernels": None})()
+    env = gym.make(ENV_ID, config={"preset": "small", "estimator": est, "max_samples": 12, "gamma_opt": False})
+    core = env.unwrapped.episode
+
+    def force(value: float) -> None:
+        if path == "generic":
+            core.estimator.error = lambda A, B: np.full(1, value)
+        else:
+            core.kernels.estimator.online_solve = lambda M, columns, n, m: np.full((1, n, n + m), value)
+
+    return env, force
+
+
+@pytest.mark.parametrize("path", ["generic", "compiled"])
+def test_an_estimation_error_that_overflows_ends_the_episode_loudly(path: str) -> None:
+    from encctl_gym.errors import SolverError
+
+    env, force = _bayes_episode(path)
     env.reset(seed=0)
-    est = env.unwrapped.episode.estimator
-    est.error = lambda A, B: np.full(1, np.inf)  # an estimate too far from the plant to measure
+    force(np.inf if path == "generic" else 1e200)  # an estimate too far from the plant to measure
     with pytest.raises(SolverError, match=r"error overflowed float64 \(epsilon = inf\)"):
         for _ in range(12):
             env.step(env.action_space.sample())
 
 
-def test_an_estimator_without_an_estimate_yet_keeps_the_previous_error() -> None:
-    import gymnasium as gym
-    import numpy as np
-
-    from encctl_gym.registration import ENV_ID
-
-    env = gym.make(ENV_ID, config={"preset": "small", "estimator": {"name": "bayes"}, "max_samples": 12, "gamma_opt": False})
+@pytest.mark.parametrize("path", ["generic", "compiled"])
+def test_an_estimator_without_an_estimate_yet_keeps_the_previous_error(path: str) -> None:
+    env, force = _bayes_episode(path)
     _, info0 = env.reset(seed=0)
-    env.unwrapped.episode.estimator.error = lambda A, B: np.full(1, np.nan)  # NaN: no estimate for this copy
+    force(np.nan)  # NaN: no estimate for this copy
     for _ in range(3):
         _, _, _, _, info = env.step(env.action_space.sample())
     assert info["epsilon"] == info0["epsilon"]
@@ -235,7 +254,7 @@ def test_the_episode_memory_estimate_covers_the_measured_peak_within_ten_percent
     import gymnasium as gym
     import numpy as np
 
-    from encctl_gym.envs.episode import episode_bytes
+    from encctl_gym.envs.schedule import episode_bytes
     from encctl_gym.registration import ENV_ID
 
     cfg = {"gamma_opt": False, "max_samples": 2000}
@@ -261,7 +280,7 @@ def test_the_episode_memory_estimate_covers_the_measured_peak_within_ten_percent
 
 
 def test_the_memory_refusal_states_the_margin() -> None:
-    from encctl_gym.envs.episode import check_episode_memory
+    from encctl_gym.envs.schedule import check_episode_memory
 
     with pytest.raises(ResourceLimitError, match="5 % margin"):
         check_episode_memory(resolve_params({"gamma_opt": False}), 10_000, memory_limit=2**30)

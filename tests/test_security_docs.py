@@ -8,8 +8,7 @@ import re
 from pathlib import Path
 
 import pytest
-
-from experiments import design_example
+from encctl_gym.experiments import design_example
 
 ROOT = Path(__file__).resolve().parents[1]
 LABEL = re.compile(r"\b(?:eq|def|thm|ex|prop|fig):[A-Za-z_0-9]+")

@@ -258,7 +258,7 @@ def test_plant_file_bounds(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> N
 
     path = _write(tmp_path, "p.json", {"A": [[0.5]], "B": [[1.0]]})
     monkeypatch.setattr(pf, "MAX_FILE_BYTES", 10)
-    with pytest.raises(ResourceLimitError, match="bytes; the limit is 10"):
+    with pytest.raises(ResourceLimitError, match="bytes, more than MAX_FILE_BYTES = 10"):
         load_plant_file(path)
     monkeypatch.undo()
     recursive = tmp_path / "r.yaml"

@@ -25,9 +25,12 @@ from scratch.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 from ..errors import ParameterError
+
+if TYPE_CHECKING:
+    from ..loop.scheme import EncryptionScheme
 
 __all__ = ["Decipherer", "KeyOracle", "KeyBreaking", "make_decipherer", "DEFAULT_BREAKER_TIME_LIMIT"]
 
@@ -51,8 +54,8 @@ class Decipherer(Protocol):
     def start_episode(self) -> None:
         """A new episode: fresh keys, nothing recovered yet, ``seconds = 0``."""
 
-    def secret(self, pk: Any) -> int:
-        """The exponent ``s_t`` of the period's public key ``pk`` (``pk.h = g^{s_t}``)."""
+    def secret(self, pk: Any) -> Any:
+        """The secret of the period's public key ``pk`` (ElGamal: the exponent ``s_t``, ``pk.h = g^{s_t}``)."""
 
     def observe_token(self, token: Any) -> None:
         """An update token the adversary sees (the token scheme's controller server)."""
@@ -64,7 +67,8 @@ class KeyOracle:
     Parameters
     ----------
     read_key : callable
-        Returns the plant's current :class:`~encctl_gym.crypto.elgamal.SecretKey`.
+        Returns the plant's secret of the period (the scheme's ``oracle_secret``: for ElGamal
+        the exponent ``s_t``).
     """
 
     def __init__(self, read_key: Callable[[], Any]) -> None:
@@ -74,8 +78,8 @@ class KeyOracle:
     def start_episode(self) -> None:
         self.seconds = 0.0
 
-    def secret(self, pk: Any) -> int:
-        return int(self._read_key().s)
+    def secret(self, pk: Any) -> Any:
+        return self._read_key()
 
     def observe_token(self, token: Any) -> None:
         return None
@@ -90,9 +94,13 @@ class KeyBreaking:
         A name of :data:`encctl_gym.cryptanalysis.BREAKERS`.
     group : GroupParams
         The loop's group (every key is in it).
-    scheme, adversary : str
-        The key scheme and the adversary (``scheme="token"`` with ``adversary="server"``: the
-        breaker is wrapped in the token chain, which breaks one key and derives the others).
+    scheme : EncryptionScheme
+        The loop's scheme (:class:`encctl_gym.loop.scheme.EncryptionScheme`): its
+        ``breaker_for(breaker, adversary, rng)`` wraps the breaker as the adversary uses it (the
+        token scheme against a malicious server: the token chain, which breaks one key and
+        derives the others).
+    adversary : str
+        The adversary (``"eavesdropper"`` or ``"server"``).
     time_limit : float
         Seconds allowed for the precomputation and for each key. A breaker whose expected
         first-key time exceeds it is refused here; a break that overruns it raises
@@ -114,16 +122,14 @@ class KeyBreaking:
         breaker: str,
         group: Any,
         *,
-        scheme: str,
+        scheme: EncryptionScheme,
         adversary: str,
         time_limit: float = DEFAULT_BREAKER_TIME_LIMIT,
         rng: Any = None,
     ) -> None:
         from ..cryptanalysis import TokenChain, get_breaker
 
-        b = get_breaker(breaker, rng=rng)
-        if scheme == "token" and adversary == "server" and not isinstance(b, TokenChain):
-            b = TokenChain(b, rng=rng)
+        b = scheme.breaker_for(get_breaker(breaker, rng=rng), adversary, rng)
         b.check_time(
             group,
             time_limit,
@@ -186,19 +192,26 @@ class KeyBreaking:
             self._state.add_tokens([token])
 
 
-def make_decipherer(params: Any, group: Any, read_key: Callable[[], Any], rng: Any = None) -> Decipherer:
-    """The decipherer of an environment's parameters: :class:`KeyBreaking` with
-    ``params.breaker``, else the :class:`KeyOracle` over ``read_key``."""
-    name = getattr(params, "breaker", None)
-    if name is None:
+def make_decipherer(
+    breaker: str | None,
+    group: Any,
+    read_key: Callable[[], Any],
+    *,
+    scheme: EncryptionScheme,
+    adversary: str,
+    time_limit: float = DEFAULT_BREAKER_TIME_LIMIT,
+    rng: Any = None,
+) -> Decipherer:
+    """The decipherer of a loop: :class:`KeyBreaking` with a ``breaker`` name, else the
+    :class:`KeyOracle` over ``read_key`` (the scheme's ``oracle_secret`` of the plant).
+
+    Raises
+    ------
+    ParameterError
+        For a breaker that is not a name.
+    """
+    if breaker is None:
         return KeyOracle(read_key)
-    if not isinstance(name, str):
-        raise ParameterError(f"breaker must be a breaker name, got {name!r}")
-    return KeyBreaking(
-        name,
-        group,
-        scheme=params.scheme,
-        adversary=params.adversary,
-        time_limit=getattr(params, "breaker_time_limit", DEFAULT_BREAKER_TIME_LIMIT),
-        rng=rng,
-    )
+    if not isinstance(breaker, str):
+        raise ParameterError(f"breaker must be a breaker name, got {breaker!r}")
+    return KeyBreaking(breaker, group, scheme=scheme, adversary=adversary, time_limit=time_limit, rng=rng)

@@ -26,10 +26,9 @@ from ..crypto.checks import check_instance, check_same_group
 from ..crypto.elgamal import Ciphertext, PublicKey, encrypt_member
 from ..crypto.encoding import Encoder
 from ..crypto.modified import ModifiedCiphertext
-from ..crypto.schemes import get_scheme
 from ..errors import EncodingOverflowError, KeyMismatchError, ParameterError
 
-__all__ = ["injection_integers", "injection_value", "forge_injection", "forge_injection_token", "forge"]
+__all__ = ["injection_integers", "injection_value", "forge_injection", "forge_injection_token"]
 
 CtMatrix = list[list[Ciphertext]]
 ModMatrix = list[list[ModifiedCiphertext]]
@@ -195,23 +194,3 @@ def forge_injection_token(
     r = src.between(1, grp.q)  # one r for the matrix (see forge_injection)
     c1, mask = int(arith.powmod(grp.g, r, p)), arith.powmod(pk_t.h, r, p)
     return [[Ciphertext(grp, c1, int(arith.mulmod(m, mask, p)), pk_t.t) for m in row] for row in plain]
-
-
-def forge(
-    scheme: str,
-    pk_0: PublicKey,
-    pk_t: PublicKey,
-    a: Any,
-    encoder: Encoder,
-    n_cols: int,
-    rng: RngLike = None,
-    *,
-    per_entry: bool = False,
-) -> list[list[Any]]:
-    """The forged output for the plant of ``scheme`` (:data:`encctl_gym.crypto.schemes.SCHEMES`):
-    :func:`forge_injection` for the modified scheme, :func:`forge_injection_token` for the token and
-    static schemes (whose plants decrypt ``Dec(sk_t, .)``)."""
-    get_scheme(scheme)
-    if scheme == "modified":
-        return forge_injection(pk_0, pk_t, a, encoder, n_cols, rng, per_entry=per_entry)
-    return forge_injection_token(pk_t, a, encoder, n_cols, rng, per_entry=per_entry)

@@ -89,18 +89,16 @@ MAX_PRIMALITY_REPS = 1000
 
 
 def check_integer(name: str, value: Any) -> int:
-    """``value`` if it is an exact integer (``int``, ``gmpy2.mpz`` or a NumPy integer), else a
-    :class:`ParameterError` naming it.
+    """``value`` as an integer for the big-integer arithmetic, by the package's one rule
+    (:func:`encctl_gym._validation.check_int`: exact integers, and integral floats up to 2^53;
+    no bool, no string), else a :class:`ParameterError` naming it.
 
-    Booleans, floats (even integral ones: ``2.0**64`` is not exact), strings and everything
-    else are refused: big-integer arithmetic on a float would silently lose digits, and gmpy2
-    would raise a bare ``TypeError``. NumPy integers are returned as Python ints.
+    An ``int`` or a ``gmpy2.mpz`` is returned as it is (the fast path of every exponentiation);
+    anything else accepted is returned as a Python int.
     """
     if type(value) is int or type(value) is _MPZ:  # fast path (hot in every exponentiation)
         return value
-    if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)):
-        raise ParameterError(f"{name} must be an integer (int or gmpy2.mpz), got {format_value(value)}")
-    return int(value)
+    return check_int(name, value)
 
 
 def _check_modulus(name: str, mod: Any) -> int:

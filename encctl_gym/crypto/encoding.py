@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_int, check_positive, format_value
+from .._validation import as_finite_array, check_int, check_positive, format_value
 from ..errors import EncodingOverflowError, ParameterError, PlaintextError
 from . import arith
 from .arith import format_int as fmt
@@ -130,7 +130,7 @@ def nearest_member(group: GroupParams, v: int, max_shift: int) -> tuple[int, int
         If no member of G lies within ``max_shift`` of ``v``.
     """
     if type(v) is not int:
-        v = _as_int("v", v)
+        v = check_int("v", v)
     if type(max_shift) is not int or max_shift < 0:
         max_shift = check_int("max_shift", max_shift, 0)
     p = _check_group(group).p
@@ -150,7 +150,7 @@ def encode_int(group: GroupParams, v: int, max_shift: int | None = None) -> int:
     ``w`` is :func:`nearest_member` of ``v`` (Definition def:ec); raises
     :class:`EncodingOverflowError` if ``|w| > (p - 1)/2`` (it would not decode back).
     """
-    v = _as_int("v", v)
+    v = check_int("v", v)
     _check_group(group).verify()
     ms = default_max_shift(group) if max_shift is None else check_int("max_shift", max_shift, 0)
     w, _ = nearest_member(group, v, ms)
@@ -166,7 +166,7 @@ def lift(group: GroupParams, m: int) -> int:
     non-integer ``m`` or ``group`` raises :class:`ParameterError`.
     """
     if type(m) is not int:
-        m = _as_int("m", m)
+        m = check_int("m", m)
     half = _check_group(group).half
     return m - group.p if m > half else m
 
@@ -179,7 +179,7 @@ def decode_int(group: GroupParams, m: int) -> int:
     PlaintextError
         If ``m`` is not an integer in [0, p).
     """
-    m = _as_int("m", m, PlaintextError)
+    m = check_int("m", m, error=PlaintextError)
     if not 0 <= m < _check_group(group).p:
         raise PlaintextError(f"plaintext m = {fmt(m)} is outside [0, p) for p = {fmt(group.p)}")
     return lift(group, m)
@@ -234,19 +234,11 @@ def decode_scaled(w: int, delta_ratio: tuple[int, int], power: int = 1) -> float
     power = _check_power(power)
     num, den = _check_delta_ratio(delta_ratio)
     if type(w) is not int:
-        w = _as_int("w", w)
+        w = check_int("w", w)
     try:
         return (w * den**power) / num**power
     except OverflowError as exc:
         raise EncodingOverflowError(f"decoded value {fmt(w)} / Delta^{power} does not fit in a float") from exc
-
-
-def _as_int(name: str, value: Any, err: type = ParameterError) -> int:
-    if isinstance(value, bool):
-        raise err(f"{name} must be an integer, got {format_value(value)}")
-    if isinstance(value, (numbers.Integral, np.integer)) or type(value).__name__ == "mpz":
-        return int(value)
-    raise err(f"{name} must be an integer, got {format_value(value)}")
 
 
 def _check_group(group: Any) -> GroupParams:
@@ -265,37 +257,6 @@ def _as_finite(name: str, x: Any) -> float:
     if not math.isfinite(xf):
         raise ParameterError(f"{name} must be finite, got {format_value(x)}")
     return xf
-
-
-def _as_finite_array(name: str, x: Any) -> np.ndarray:
-    """``x`` as a float64 array of finite real numbers (no complex, boolean or text entries)."""
-    try:
-        arr = x if isinstance(x, np.ndarray) else np.asarray(x)
-    except (TypeError, ValueError) as exc:  # e.g. a ragged nested list
-        raise ParameterError(f"{name} must be a numeric (real) array, got {format_value(x)}: {exc}") from None
-    kind = arr.dtype.kind
-    if kind == "O":  # e.g. a list mixing Python ints and floats, or gmpy2 numbers
-        flat = arr.ravel().tolist()
-        for v in flat:
-            real = isinstance(v, (numbers.Real, np.floating, np.integer)) or type(v).__name__ == "mpz"
-            if isinstance(v, bool) or not real:
-                raise ParameterError(f"{name} must contain real numbers, got {format_value(v)}")
-        try:
-            arr = np.asarray([float(v) for v in flat], dtype=np.float64).reshape(arr.shape)
-        except OverflowError as exc:
-            raise EncodingOverflowError(f"{name} has an entry too large for a float: {exc}") from None
-    elif kind == "c":
-        bad = arr.ravel()[np.flatnonzero(arr.ravel().imag != 0)[:1]]
-        shown = bad[0] if bad.size else arr.ravel()[0]
-        raise ParameterError(f"{name} must be real, got a complex array (e.g. {shown!r}); its imaginary part would be lost")
-    elif kind not in "iuf":
-        raise ParameterError(f"{name} must be a numeric (real) array, got dtype {arr.dtype}: {format_value(x)}")
-    else:
-        arr = arr.astype(np.float64, copy=False)
-    if not np.all(np.isfinite(arr)):
-        bad_v = float(arr[~np.isfinite(arr)].flat[0])
-        raise ParameterError(f"{name} must be finite, got {bad_v!r}")
-    return arr
 
 
 class Encoder:
@@ -405,7 +366,7 @@ class Encoder:
 
     def decode_signed(self, w: int, power: int = 1) -> float:
         """Decode an already lifted signed integer (e.g. a row sum of lifted products)."""
-        return decode_scaled(_as_int("w", w), self.delta_ratio, power)
+        return decode_scaled(check_int("w", w), self.delta_ratio, power)
 
     def error_bound(self, shift: int | None = None) -> float:
         """Round-trip bound ``(1/2 + s)/Delta`` (default ``s = max_shift``).
@@ -438,7 +399,7 @@ class Encoder:
     # ------------------------------------------------------------------ arrays
     def quantize_array(self, x: Any) -> np.ndarray:
         """Vectorised :meth:`quantize`: an object array of Python ints of the shape of ``x``."""
-        arr = _as_finite_array("x", x)
+        arr = as_finite_array("x", x, allow_empty=True, overflow_error=EncodingOverflowError)
         if self.x_bound is not None and arr.size and np.max(np.abs(arr)) > self.x_bound:
             bad = float(arr.flat[int(np.argmax(np.abs(arr)))])
             raise EncodingOverflowError(f"x = {bad!r} is outside the declared input range |x| <= {self.x_bound!r}")

@@ -13,9 +13,11 @@ scheme          plant party          server                     keys
 ``static``      :class:`StaticPlant` :class:`StaticControllerServer` one fixed key pair
 ==============  ===================  =========================  ==============================
 
-A new scheme is a row of :data:`SCHEMES`; the encrypted controller, the environment's ElGamal
-backend and the forging of injected inputs (:mod:`encctl_gym.attacks.forgery`) all pick their
-parts from it.
+These are the ElGamal variants' parties: the encrypted controller
+(:class:`~encctl_gym.crypto.controller.EncryptedLinearController`) pairs them here, and the
+loop's scheme seam (:class:`encctl_gym.loop.scheme.EncryptionScheme`, the ElGamal variants in
+:mod:`encctl_gym.loop.elgamal_scheme`) takes them from here; a new scheme is a class of that
+seam and a row of :data:`encctl_gym.loop.scheme.SCHEMES`.
 """
 
 from __future__ import annotations

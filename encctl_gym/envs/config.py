@@ -11,6 +11,7 @@ import math
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -20,29 +21,28 @@ from ..errors import BudgetError, ConfigError, ParameterError
 from ..ident.registry import make_estimator
 from ..loop import BACKENDS as _LOOP_BACKENDS
 from ..loop.defender import make_defender
+from ..loop.scheme import SCHEMES, make_scheme
+from ..loop.spec import LoopSpec
+from ..plant import Plant
 from ..presets import get_preset
 from ..security.complexity import sic_from_traces
 from ..security.cost_models import (
     DECIPHERING_MODELS,
     GENERIC_MIN_KEY_LENGTH,
     GUILLEVIC_CORRECTION,
+    CostModel,
     KeyBreakCost,
     PaperModel,
     check_gnfs_correction,
     check_security_parameter,
     deciphering_model,
 )
-from ..security.deciphering import (
-    ADVERSARIES,
-    SCHEMES,
-    independent_keys,
-    max_affordable_samples,
-    per_sample_cost,
-    sample_deciphering_time,
-)
+from ..security.deciphering import ADVERSARIES, independent_keys, max_affordable_samples, per_sample_cost, sample_deciphering_time
 from ..security.design import design_from_traces
 from ..security.exact import decimal_fraction
 from ..security.gramians import controllability_gramian, noise_gramian
+from ..security.rotation import check_rotation_period, rotated_affordable_samples, rotated_deciphering_time
+from ..security.threat import ThreatModel
 from ..units import parse_duration
 from .layout import ObservationLayout
 from .rewards import REWARDS as _REWARD_CLASSES
@@ -68,7 +68,8 @@ def default_config() -> dict[str, Any]:
     ``sigma_w2``                  process noise variance (preset's if ``None``)
     ``sigma_x2``                  variance of x_0 (preset's if ``None``; the paper uses 1)
     ``sigma_u2``                  attacker's average input power per channel (energy budget)
-    ``scheme``                    ``"modified"`` (the paper's), ``"token"``, ``"static"``
+    ``scheme``                    ``"modified"`` (the paper's), ``"token"``, ``"static"``, or any
+                                  row of :data:`encctl_gym.loop.scheme.SCHEMES`
     ``adversary``                 ``"eavesdropper"`` or ``"server"``
     ``security_parameter``        lambda in bits; ``None``: from ``key_length``, else lambda* of
                                   Theorem thm:opt_sec for the preset's design parameters
@@ -127,6 +128,11 @@ def default_config() -> dict[str, Any]:
     ``defender``                  the plant side's policy (:mod:`encctl_gym.loop.defender`): a
                                   name of ``DEFENDERS`` (``"fixed"``: the paper's fixed defender)
                                   or an object implementing ``DefenderPolicy``
+    ``rotate_group_every``        ``None`` (one group) or ``K >= 1``: every K attack steps the
+                                  plant side moves to a fresh safe-prime group of the same size
+                                  and re-provisions the server (:mod:`encctl_gym.loop.rotation`);
+                                  the attacker pays each group's precomputation
+                                  (:mod:`encctl_gym.security.rotation`)
     ============================  ==============================================================
     """
     return {
@@ -162,12 +168,21 @@ def default_config() -> dict[str, Any]:
         "gamma_opt": True,
         "crypto_seed": None,
         "defender": "fixed",
+        "rotate_group_every": None,
     }
 
 
 @dataclass(frozen=True)
 class AttackParams:
-    """Resolved, validated parameters of one environment (shared by the vector environment)."""
+    """Resolved, validated parameters of one environment (shared by the vector environment).
+
+    The fields are flat; the value objects they compose are :attr:`plant` (the
+    :class:`~encctl_gym.plant.Plant` ``(A, B)``), :attr:`threat` (the
+    :class:`~encctl_gym.security.threat.ThreatModel`: variances, gamma_c, tau_c, Upsilon, the
+    adversary and the cost model) and :attr:`loop` (the :class:`~encctl_gym.loop.spec.LoopSpec`:
+    backend, scheme, key length, Delta, breaker, defender), each built once from the checked
+    fields.
+    """
 
     A: np.ndarray
     B: np.ndarray
@@ -210,6 +225,44 @@ class AttackParams:
     sources: dict[str, str] = field(default_factory=dict)  # where A, B, the variances and design values came from
     defender: Any = "fixed"  # the defender policy specification (a name or a policy object), checked
     horizon_capped: bool = False  # no max_samples and a budget beyond MAX_DEFAULT_HORIZON: N is that cap
+    rotate_group_every: int | None = None  # K: a fresh group every K attack steps (None: one group)
+    cost_model: CostModel | None = None  # the built deciphering model (its GNFS correction); None: the named one's defaults
+
+    @cached_property
+    def plant(self) -> Plant:
+        """The plant ``(A, B)`` of eq:system as a value object."""
+        return Plant(self.A, self.B)
+
+    @cached_property
+    def threat(self) -> ThreatModel:
+        """The adversary and the defender's tolerances (Definition def:security)."""
+        return ThreatModel(
+            tau_c=self.tau_c,
+            upsilon=self.upsilon,
+            sigma_u2=self.sigma_u2,
+            sigma_w2=self.sigma_w2,
+            sigma_x2=self.sigma_x2,
+            gamma_c=self.gamma_c,
+            adversary=self.adversary,
+            cost_model=self.cost_model if self.cost_model is not None else self.deciphering_model,
+        )
+
+    @cached_property
+    def loop(self) -> LoopSpec:
+        """The closed loop: backend, scheme, key length, Delta, breaker, defender."""
+        return LoopSpec(
+            crypto=self.crypto,
+            scheme=self.scheme,
+            key_length=self.key_length,
+            delta=self.delta,
+            x_bound=self.x_bound,
+            u_max=self.u_max,
+            breaker=self.breaker,
+            breaker_time_limit=self.breaker_time_limit,
+            crypto_seed=self.crypto_seed,
+            defender=self.defender,
+            rotate_group_every=self.rotate_group_every,
+        )
 
     def warn_if_capped(self) -> None:
         """Warn (once per environment, when it is made) that the attack length is the default cap
@@ -232,8 +285,14 @@ class AttackParams:
         return int(self.B.shape[1])
 
     def deciphering_time(self, N: Any) -> Any:
-        """tau(N) of the configured model (Definition def:sdt, :func:`sample_deciphering_time`), seconds."""
-        return sample_deciphering_time(N, self.cost, self.upsilon, scheme=self.scheme, adversary=self.adversary)
+        """tau(N) of the configured model (Definition def:sdt, :func:`sample_deciphering_time`), seconds;
+        with ``rotate_group_every`` the model charged per group
+        (:func:`~encctl_gym.security.rotation.rotated_deciphering_time`)."""
+        if self.rotate_group_every is not None:
+            return rotated_deciphering_time(
+                N, self.cost, self.upsilon, self.rotate_group_every, scheme=self.loop.encryption(), adversary=self.adversary
+            )
+        return sample_deciphering_time(N, self.cost, self.upsilon, scheme=self.loop.encryption(), adversary=self.adversary)
 
     @property
     def energy_budget(self) -> float:
@@ -396,7 +455,8 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     upsilon = check_positive("upsilon", raw["upsilon"])
     tau_c = parse_duration(raw["tau_c"], "tau_c")
     gamma_c = check_positive("gamma_c", raw["gamma_c"])
-    scheme = _choice("scheme", cfg["scheme"], SCHEMES)
+    scheme = _choice("scheme", cfg["scheme"], tuple(SCHEMES))
+    encryption = make_scheme(scheme)  # the scheme seam: what the adversary must break
     adversary = _choice("adversary", cfg["adversary"], ADVERSARIES)
     reward = _choice("reward", cfg["reward"], REWARDS)
     estimator = cfg["estimator"]
@@ -445,7 +505,14 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         key_length = paper.key_length_for_security_parameter(lam)  # eq:opt_key
         cost = paper.cost_of_security_parameter(lam) if model_name == "paper" else model.break_cost(key_length)
 
-    budget = max_affordable_samples(tau_c, cost, upsilon, scheme=scheme, adversary=adversary)
+    rotate_every = cfg["rotate_group_every"]
+    if rotate_every is not None:  # every group's keys are charged (security.rotation)
+        rotate_every = check_rotation_period(rotate_every)
+        budget: int | float = rotated_affordable_samples(
+            tau_c, cost, upsilon, rotate_every, scheme=encryption, adversary=adversary
+        )
+    else:
+        budget = max_affordable_samples(tau_c, cost, upsilon, scheme=encryption, adversary=adversary)
     max_samples = cfg["max_samples"]
     if max_samples is not None:
         max_samples = check_int("max_samples", max_samples, minimum=1)
@@ -524,7 +591,7 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         next_sample_cost=float(cost.next / decimal_fraction("upsilon", upsilon)),
         budget_samples=budget,
         horizon=horizon,
-        independent_keys=independent_keys(scheme, adversary),
+        independent_keys=independent_keys(encryption, adversary),
         budget_limited=budget_limited,
         decipher_delay=delay_v,
         warmup_steps=warmup,
@@ -546,4 +613,6 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         sources=sources,
         defender=defender,
         horizon_capped=max_samples is None and horizon < budget,
+        rotate_group_every=rotate_every,
+        cost_model=model,
     )

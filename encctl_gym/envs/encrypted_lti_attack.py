@@ -10,9 +10,10 @@ from gymnasium import spaces
 
 from .._validation import format_value
 from ..errors import ParameterError
-from ..loop import LoopBackend, make_defender, make_loop
+from ..loop import LoopBackend, defender_for, make_loop
 from .config import AttackParams, default_config, resolve_params
-from .episode import EpisodeCore, EpisodeSchedule, attack_design_for, check_episode_memory
+from .episode import EpisodeCore, attack_design_for
+from .schedule import EpisodeSchedule, check_episode_memory
 
 __all__ = ["EncryptedLTIAttackEnv", "reset_options", "check_seed"]
 
@@ -166,6 +167,8 @@ class EncryptedLTIAttackEnv(gym.Env):
     | ``samples_collected``, ``samples_delivered`` | N paid for, N delivered                 |
     | ``deciphering_time``| seconds of attacker computation spent (Definition def:sdt)       |
     | ``input_energy``, ``average_power`` | energy spent, and per input channel and step     |
+    | ``detected``        | the defender stopped the attack (:mod:`encctl_gym.loop.defenses`) |
+    | ``groups``, ``group_rotations``, ... | with group rotation only (``rotate_group_every``): the groups used, the encryptions and bytes re-provisioned, the group generation and wait seconds, and with a breaker its precomputations (:func:`encctl_gym.loop.rotation.rotation_info`) |
 
     **Privileged**: ``epsilon``, ``gamma`` and ``gamma_opt`` are functions of the true plant
     ``(A, B)`` (``epsilon`` from the start: at reset it is ``||[A B]||_F^2 / (n (n + m))``,
@@ -197,7 +200,7 @@ class EncryptedLTIAttackEnv(gym.Env):
         self.render_mode = render_mode
         p = self.params
         check_episode_memory(p, 1, schedule)  # before anything is sized by the parameters
-        defender = make_defender(p.defender)
+        defender = defender_for(p)
         self._loop = make_loop(p, defender)  # refuses a loop it cannot build (the quantisation table) before the spaces are sized
         self.action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
         self.observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
@@ -236,3 +239,8 @@ class EncryptedLTIAttackEnv(gym.Env):
         from .render import render_error_curve
 
         return render_error_curve(self._core, self.params, self.design)
+
+    def close(self) -> None:
+        """Release the episode's resources (a rotating defender's group pool, see :meth:`EpisodeCore.close`)."""
+        self._core.close()
+        super().close()

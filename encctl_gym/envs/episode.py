@@ -41,103 +41,27 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from .._validation import as_finite_array, check_int, check_positive, format_value
+from .._validation import as_finite_array, check_int, format_value
 from ..errors import EncodingOverflowError, ParameterError, ShapeError
 from ..ident.compiled import OnlineKernels, ProvidesKernels
 from ..ident.registry import make_estimator
 from ..loop import LoopBackend
 from ..loop.defender import DefenderPolicy, DefenderStreams, PlantView, check_defender_action, make_defender
-from ..resources import check_memory
+from ..loop.provisioning import RotationRecord
+from ..loop.rotation import check_new_group, defender_for, move_loop, rotation_info
 from . import _kernels as kern
 from .config import AttackParams
 from .helper import HelperThread
 from .layout import ObservationLayout, info_dict
 from .rewards import REWARDS
+from .schedule import EpisodeSchedule, check_episode_memory
 from .steps import EpisodeArrays, KernelConstants, StepStrategy, choose_step
 
-__all__ = ["EpisodeCore", "EpisodeSchedule", "attack_design_for", "episode_bytes", "check_episode_memory"]
-
-
-@dataclass(frozen=True)
-class EpisodeSchedule:
-    """How the episode batches its work (the numbers do not depend on ``chunk`` or
-    ``gram_batch``; ``refresh`` and ``cond_limit`` set when the exact solve re-anchors the recursion).
-
-    Attributes
-    ----------
-    chunk : int
-        Noise is drawn from each copy's generator in chunks of this many periods.
-    refresh : int
-        Every copy's recursive least squares is re-anchored to the exact solve after this many columns.
-    cond_limit : float
-        A copy starts its recursion once the condition number of its scaled Gram matrix is below this.
-    gram_batch : int
-        With a helper thread, the Gram catch-up is handed over once it lags this many columns.
-    """
-
-    chunk: int = 256
-    refresh: int = 1024
-    cond_limit: float = 1e8
-    gram_batch: int = 64
-
-    def __post_init__(self) -> None:
-        check_int("chunk", self.chunk, minimum=1)
-        check_int("refresh", self.refresh, minimum=1)
-        check_positive("cond_limit", self.cond_limit)
-        check_int("gram_batch", self.gram_batch, minimum=1)
-
-
-def episode_bytes(params: AttackParams, num_envs: int, schedule: EpisodeSchedule | None = None) -> int:
-    """Bytes an episode of ``num_envs`` copies allocates (an estimate with a 5 % margin).
-
-    The data of the attack (states and inputs of the horizon), the running least squares, the
-    noise chunks, the per-copy generators and the tables over the sample size. Without the margin
-    this sum is within 0.5 % of the measured peak (growth of VmHWM over a warm process) of the
-    vector environment of the paper-example preset at 500, 2000 and 10000 copies (0.234, 0.934
-    and 4.667 GiB against 0.233, 0.937 and 4.689 GiB); the margin of 5 % covers that and the
-    allocator's slack, so work that fits is not refused (a margin of a half refused 10000 copies
-    under a 6 GiB address-space limit although they peak at 5.3 GiB).
-    """
-    sch = schedule if schedule is not None else EpisodeSchedule()
-    n, m, N, K = params.n, params.m, params.horizon, int(num_envs)
-    d, H = n + m, params.input_history
-    per_copy = (
-        N * d  # X, U
-        + 2 * d * (d + n)  # GC, Q
-        + 3 * d
-        + 2 * n
-        + 2  # scratch
-        + 3 * sch.chunk * n  # noise: drawn, in use, ahead
-        + H * m
-        + 4 * m
-        + 2 * n
-        + 8  # history, actions and buffers, energy, eps, reward
-        + (ObservationLayout.of(params).dim + 8 * 2) // 2  # observation (float32) and info per step
-    )
-    generators = 2048  # a numpy Generator with its bit generator, per copy
-    tables = 4 * (N + 1)
-    return 21 * (8 * (K * per_copy + tables) + K * generators) // 20  # integers: exact for any K
-
-
-def check_episode_memory(
-    params: AttackParams, num_envs: int, schedule: EpisodeSchedule | None = None, memory_limit: int | None = None
-) -> None:
-    """Refuse an episode whose :func:`episode_bytes` exceed ``memory_limit`` (default
-    :data:`encctl_gym.resources.MEMORY_LIMIT`), before anything is allocated."""
-    p = params
-    check_memory(
-        f"an episode of num_envs = {format_value(num_envs)} copies, horizon N = {p.horizon}, n = {p.n}, m = {p.m}, "
-        f"input_history = {p.input_history}",
-        episode_bytes(p, num_envs, schedule),
-        memory_limit,
-        "the estimate includes a 5 % margin over the arrays' sizes; use fewer copies, a shorter attack (max_samples) "
-        "or a shorter input_history",
-    )
+__all__ = ["EpisodeCore", "attack_design_for"]
 
 
 def attack_design_for(p: AttackParams) -> Any:
@@ -240,14 +164,14 @@ class EpisodeCore:
         # regressor Gram matrix G of the delivered data and cross term C = sum z x_next^T, kept
         # as [G | C] with the copies innermost (see _kernels); G and C are views of it, (K, d, .)
         self._GC = np.zeros((self.d * (self.d + n), K))
-        gc = self._GC.reshape(self.d, self.d + n, K).transpose(2, 0, 1)
-        self.G, self.C = gc[:, :, : self.d], gc[:, :, self.d :]
+        self.G, self.C = self._gram_views()
         self._gram_scratch = np.zeros((self.d + n, K))  # add_gram's, apart from the step's (the helper runs it)
         self._gram_upto = 1  # G and C hold the columns j < _gram_upto (the fused step lets them lag)
         self._dims = kern.dims(n, m, p.input_history * m)  # the sizes, as the kernels take them
         self.reward = REWARDS[p.reward](p, K)
-        # the attacker's estimator: one that provides kernels (least squares) runs compiled on the
-        # episode's arrays; any other is updated column by column (encctl_gym.ident)
+        # the attacker's estimator: one that provides kernels (least squares, fused; Bayes,
+        # forgetting, IV: moment kernels) runs compiled on the episode's arrays; any other is
+        # updated column by column (encctl_gym.ident)
         est = make_estimator(p.estimator)
         self.kernels: OnlineKernels | None = (
             est.online_kernels(K, self._A, self._B, s.Q, sch.refresh, sch.cond_limit)
@@ -274,9 +198,12 @@ class EpisodeCore:
         fused = q is not None and self.reward.fused and self.kernels is not None and self.kernels.fused
         self.stepper: StepStrategy = choose_step(self, q, fused, parallel)
         # the other party: the plant side's decisions, each step, on what the plant knows
-        self.defender = make_defender(p.defender) if defender is None else make_defender(defender)
+        self.defender = defender_for(p) if defender is None else make_defender(defender)
         self.plant_view = PlantView(s.x, s.U, self._attack_step)
         self.stopped = False  # the defender ended the attack
+        #: the group rotations of the episode (loop.rotation): every episode starts on the loop's first group
+        self.rotation = RotationRecord()
+        self._first_group = getattr(loop, "group", None)
         C = sch.chunk
         self._noise_draws = np.zeros((K, C, n))  # each copy's chunk, as its generator draws it
         self._noise = np.zeros((C, K, n))  # period-major, like X: one period's noise is contiguous
@@ -315,10 +242,31 @@ class EpisodeCore:
         self._wait_noise()
         self._wait_gram()
 
-    def __getstate__(self) -> dict[str, Any]:
-        """Pickling and deep copies see the helper's work finished (a future cannot be copied)."""
+    def close(self) -> None:
+        """The helper's work finished, and the defender's own resources released (its optional
+        ``close``, e.g. the rotating defender's group pool)."""
         self.wait()
-        return self.__dict__.copy()
+        close = getattr(self.defender, "close", None)
+        if close is not None:
+            close()
+
+    def _gram_views(self) -> tuple[np.ndarray, np.ndarray]:
+        """G and C as views of ``[G | C]`` (``_GC``), shape (K, d, d) and (K, d, n)."""
+        gc = self._GC.reshape(self.d, self.d + self.n, self.K).transpose(2, 0, 1)
+        return gc[:, :, : self.d], gc[:, :, self.d :]
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickling and deep copies see the helper's work finished (a future cannot be copied).
+        The views G and C are left out: a copy would make them arrays of their own, which the
+        kernels (writing ``_GC``) no longer update; :meth:`__setstate__` makes them again."""
+        self.wait()
+        state = self.__dict__.copy()
+        del state["G"], state["C"]
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self.G, self.C = self._gram_views()
 
     # ----------------------------------------------------------------- randomness
     def _fill_noise(self, dst: np.ndarray, chunk: int) -> None:
@@ -397,6 +345,9 @@ class EpisodeCore:
         self._noise_pos = self.schedule.chunk
         self._noise_ahead = False
         self._chunks = 0
+        if getattr(self.loop, "group", None) is not self._first_group:  # back to the first group (rotation)
+            move_loop(self.loop, self.stepper, self._first_group)
+        self.rotation = RotationRecord()
         self.loop.start_episode()
         for _ in range(self.p.warmup_steps):  # normal operation under the encrypted controller (eq:ec)
             kern.plant_step(self._dims, self.state.x, self.loop.control(self.state.x), self._draw_noise(), self._A, self._B)
@@ -592,6 +543,9 @@ class EpisodeCore:
                 w = w + noise @ self.consts.B.T
             if stop:
                 self.stopped = ended = True
+            if decision.new_group is not None:  # group rotation: the period runs in the new group
+                group = check_new_group(decision.new_group, getattr(self.loop, "group", None))
+                self.rotation.add(move_loop(self.loop, self.stepper, group))
         if not inject:
             self._obs_out = None
             return self.finish_step(self._pass_period(w, ended))
@@ -665,7 +619,13 @@ class EpisodeCore:
 
     def info_arrays(self) -> dict[str, np.ndarray]:
         """Info of every copy as new arrays of shape (K,) (:func:`~encctl_gym.envs.layout.info_dict`)."""
-        return info_dict(self.eps.copy(), self.state.energy.copy(), self._shared_info(), self.has_gamma_opt, self.K, self.stopped)
+        info = info_dict(self.eps.copy(), self.state.energy.copy(), self._shared_info(), self.has_gamma_opt, self.K, self.stopped)
+        for key, value in self._rotation_info().items():
+            info[key] = np.full(self.K, value)
+        return info
+
+    def _rotation_info(self) -> dict[str, Any]:
+        return rotation_info(self.rotation, self.defender, self.loop, self.p.breaker is not None)
 
     def info(self) -> dict[str, Any]:
         """Info of copy 0 as Python scalars (single environment).
@@ -673,6 +633,8 @@ class EpisodeCore:
         ``epsilon`` is the error (Definition def:error) of the attacker's current estimate: the
         least squares estimate once ``n + m`` columns are delivered, ``[A B] = 0`` before.
         """
-        return info_dict(
+        info = info_dict(
             float(self.eps[0]), float(self.state.energy[0]), self._shared_info(), self.has_gamma_opt, detected=self.stopped
         )
+        info.update(self._rotation_info())
+        return info

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from .config import AttackParams
 
-def render_error_curve(core: Any, params: Any, design: Any = None, size: tuple[int, int] = (640, 420)) -> np.ndarray:
+
+def render_error_curve(core: Any, params: AttackParams, design: Any = None, size: tuple[int, int] = (640, 420)) -> np.ndarray:
     """Draw epsilon(N) of the delivered data with gamma(N) (eq:sic) and gamma_opt(N).
 
     Returns

@@ -20,11 +20,12 @@ from gymnasium.vector.utils import batch_space
 
 from .._validation import check_int, format_value
 from ..errors import ParameterError
-from ..loop import make_defender, make_loop
+from ..loop import defender_for, make_loop
 from .config import AttackParams, resolve_params
 from .encrypted_lti_attack import check_seed, reset_options
-from .episode import EpisodeCore, EpisodeSchedule, attack_design_for, check_episode_memory
+from .episode import EpisodeCore, attack_design_for
 from .helper import HelperThread
+from .schedule import EpisodeSchedule, check_episode_memory
 
 __all__ = ["EncryptedLTIAttackVectorEnv"]
 
@@ -92,7 +93,7 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
             raise ParameterError(f"parallel must be a bool, got {format_value(parallel)}")
         if not isinstance(helper_thread, (bool, np.bool_, HelperThread)):
             raise ParameterError(f"helper_thread must be a bool or a HelperThread, got {format_value(helper_thread)}")
-        defender = make_defender(p.defender)
+        defender = defender_for(p)
         loop = make_loop(p, defender)  # refuses a loop it cannot build (the quantisation table) before the spaces are sized
         self.single_action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
         self.single_observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
@@ -154,6 +155,6 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         return self._core.observation(), reward, flags[0], flags[1], self._core.info_arrays()
 
     def close_extras(self, **kwargs: Any) -> None:
-        self._core.wait()
+        self._core.close()
         if self.helper is not None:
             self.helper.close()

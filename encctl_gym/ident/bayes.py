@@ -31,6 +31,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError, ShapeError
+from . import _moment_kernels as mk
+from .compiled import MomentKernels
 from .estimator import MomentEstimator
 
 __all__ = ["BayesianLeastSquares", "EVIDENCE_GRID"]
@@ -198,54 +200,36 @@ class BayesianLeastSquares(MomentEstimator):
         return self._evidence_solve(G, C, YY, columns, m0)
 
     def _evidence_solve(self, G: np.ndarray, C: np.ndarray, YY: np.ndarray, T: int, m0: np.ndarray) -> np.ndarray:
-        """Empirical Bayes: the posterior mean at the ``v`` of largest profiled marginal likelihood."""
-        lead, d, n = G.shape[:-2], G.shape[-1], C.shape[-1]
-        Gf, Cf, YYf = G.reshape(-1, d, d), C.reshape(-1, d, n), YY.reshape(-1, n, n)
-        out = np.broadcast_to(m0, (Gf.shape[0], n, d)).copy()
-        gbar = np.trace(Gf, axis1=1, axis2=2) / d
-        live = np.flatnonzero(gbar > 0)
-        if T == 0 or live.size == 0:
-            return out.reshape(*lead, n, d)
-        g, Q = np.linalg.eigh(Gf[live])  # (L, d), (L, d, d)
-        g = np.maximum(g, 0.0)
-        ct = Cf[live] - Gf[live] @ m0.T  # D (y - D^T m0): (L, d, n)
-        S = (
-            np.trace(YYf[live], axis1=1, axis2=2)
-            - 2.0 * np.einsum("ij,lji->l", m0, Cf[live])
-            + np.einsum("ij,ljk,ik->l", m0, Gf[live], m0)
-        )
-        b = np.swapaxes(Q, -1, -2) @ ct  # (L, d, n)
-        beta = np.sum(b**2, axis=2)  # (L, d)
-        logv = EVIDENCE_GRID[None, :] - np.log10(gbar[live])[:, None]  # (L, P)
-        ll = self._profiled_evidence(10.0**logv, g, beta, S, n, T)
-        best = np.argmax(ll, axis=1)
-        rows = np.arange(live.size)
-        lo = logv[rows, np.maximum(best - 1, 0)]
-        hi = logv[rows, np.minimum(best + 1, EVIDENCE_GRID.size - 1)]
-        for _ in range(_GOLDEN_STEPS):  # golden-section search inside the best grid cell's bracket
-            p1 = hi - _GOLDEN * (hi - lo)
-            p2 = lo + _GOLDEN * (hi - lo)
-            f1 = self._profiled_evidence(10.0 ** p1[:, None], g, beta, S, n, T)[:, 0]
-            f2 = self._profiled_evidence(10.0 ** p2[:, None], g, beta, S, n, T)[:, 0]
-            left = f1 >= f2
-            hi = np.where(left, p2, hi)
-            lo = np.where(left, lo, p1)
-        v = 10.0 ** (0.5 * (lo + hi))
-        w = v[:, None] / (1.0 + v[:, None] * g)  # (G + I/v)^{-1} in the eigenbasis
-        delta = Q @ (w[:, :, None] * b)  # (L, d, n)
-        out[live] = m0[None] + np.swapaxes(delta, -1, -2)
-        return out.reshape(*lead, n, d)
-
-    @staticmethod
-    def _profiled_evidence(v: np.ndarray, g: np.ndarray, beta: np.ndarray, S: np.ndarray, n: int, T: int) -> np.ndarray:
-        """``log p(targets | v)`` up to a constant, ``sigma_w2`` profiled out: ``(L, P)``.
+        """Empirical Bayes: the posterior mean at the ``v`` of largest profiled marginal likelihood.
 
         Per output row the marginal is ``N(D^T m0_i, sigma^2 (I + v D^T D))``; with
         ``G = Q diag(g) Q^T``, ``log det(I + v D^T D) = sum_k log(1 + v g_k)`` and the residual
-        quadratic form is ``S - sum_k beta_k v / (1 + v g_k)``.
+        quadratic form is ``S - sum_k beta_k v / (1 + v g_k)`` (``b = Q^T (C - G m0^T)``,
+        ``beta_k = ||b_k||^2``), so the log evidence with ``sigma_w2`` profiled out is
+        ``-n/2 sum_k log(1 + v g_k) - n T/2 log(quad)``. It is maximised over
+        :data:`EVIDENCE_GRID` (log10 of ``v`` times the mean eigenvalue of G), then by
+        golden-section search inside the best cell's bracket; the posterior mean is
+        ``m0 + (Q diag(v / (1 + v g)) b)^T``. Compiled
+        (:func:`encctl_gym.ident._moment_kernels.evidence_solve`): the batch, grid and online
+        estimates all run this one implementation.
         """
-        vg = v[:, :, None] * g[:, None, :]  # (L, P, d)
-        logdet = np.sum(np.log1p(vg), axis=2)
-        quad = S[:, None] - np.sum(beta[:, None, :] * v[:, :, None] / (1.0 + vg), axis=2)
-        floor = 1e-300 + 1e-15 * np.abs(S)[:, None]
-        return -0.5 * n * logdet - 0.5 * n * T * np.log(np.maximum(quad, floor))
+        lead, d, n = G.shape[:-2], G.shape[-1], C.shape[-1]
+        Gf = np.ascontiguousarray(G.reshape(-1, d, d))
+        Cf = np.ascontiguousarray(C.reshape(-1, d, n))
+        YYf = np.ascontiguousarray(YY.reshape(-1, n, n))
+        out = np.empty((Gf.shape[0], n, d))
+        mk.evidence_solve(Gf, Cf, YYf, int(T), np.ascontiguousarray(m0), EVIDENCE_GRID, _GOLDEN, _GOLDEN_STEPS, out)
+        return out.reshape(*lead, n, d)
+
+    def online_kernels(
+        self, K: int, A: np.ndarray, B: np.ndarray, Q: np.ndarray, refresh: int, cond_limit: float
+    ) -> MomentKernels:
+        """The compiled online form (:class:`~encctl_gym.ident.compiled.MomentKernels`): the
+        moments by a compiled stage, the estimate by :meth:`solve` (the empirical-Bayes search is
+        compiled, :func:`encctl_gym.ident._moment_kernels.evidence_solve`)."""
+        self.check_dimensions(A.shape[0], B.shape[1])
+        return MomentKernels(self, K, A, B, refresh)
+
+    def online_solve(self, M: np.ndarray, columns: int, n: int, m: int) -> np.ndarray:
+        """The estimates of the online form: :meth:`solve`."""
+        return self.solve(M, columns, n, m)

@@ -12,6 +12,12 @@ recursion ``Q = [P | Theta_hat^T]`` that the environment's fused step runs inlin
 :class:`RecursiveLeastSquaresKernels` is ordinary least squares' (eq:estimate): recursive least
 squares by Sherman-Morrison (:mod:`encctl_gym.ident._rls_kernels`), re-anchored to the exact
 solve from the running Gram matrices every ``refresh`` columns and at the end.
+
+:class:`MomentKernels` is the moment estimators' (:class:`~encctl_gym.ident.estimator.MomentEstimator`:
+Bayesian least squares, forgetting, instrumental variables): the feature rows go into the
+moments by a compiled stage (:func:`encctl_gym.ident._moment_kernels.add_rows`), one column at
+a time as the estimator's own ``update`` and fold add them, and the estimate is the estimator's
+compiled solve on those moments; it is not fused (every delivery settles).
 """
 
 from __future__ import annotations
@@ -20,9 +26,11 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
+from ..errors import SolverError
+from . import _moment_kernels as mk
 from . import _rls_kernels as rk
 
-__all__ = ["OnlineKernels", "ProvidesKernels", "RecursiveLeastSquaresKernels"]
+__all__ = ["OnlineKernels", "ProvidesKernels", "RecursiveLeastSquaresKernels", "MomentKernels"]
 
 
 @runtime_checkable
@@ -188,3 +196,83 @@ class RecursiveLeastSquaresKernels:
         self.Q[:, rows[ok]] = sol[ok].reshape(-1, d * (d + self.n)).T
         self.ready[rows] = ok
         return sol[:, :, d:]
+
+
+class MomentKernels:
+    """A moment estimator online for K copies, compiled (not fused: every delivery settles).
+
+    Parameters
+    ----------
+    estimator : MomentEstimator
+        Gives the feature count, the decay, the minimum sample size, the label and
+        ``online_solve(M, columns, n, m) -> theta (K, n, n + m)`` (NaN for a copy without an
+        estimate): its solve on the moments ``M (K, p, p)``, compiled where it has one (a method,
+        so that an episode pickles).
+    K : int
+        Copies.
+    A, B : numpy.ndarray
+        The true plant (the error of Definition def:error is against it).
+    refresh : int
+        Kept for the protocol (nothing drifts: the moments are exact sums).
+    lags : int, default 0
+        Instrumental variables' ``L`` (the rows carry ``L + 1`` lagged inputs); 0 for ``[z; y]`` rows.
+    """
+
+    fused = False
+    all_ready = False  # no steady state of its own: every delivery goes through settle
+
+    def __init__(self, estimator: Any, K: int, A: np.ndarray, B: np.ndarray, refresh: int, *, lags: int = 0) -> None:
+        self.n, self.m = A.shape[0], B.shape[1]
+        self.d = self.n + self.m
+        self.K = K
+        self.estimator = estimator
+        estimator.check_online_memory(K, self.n, self.m)  # before the moments are allocated
+        self.theta_true = np.hstack([A, B])
+        self.c = float(self.n * self.d)  # Definition def:error
+        self.M = np.zeros((K, estimator.features(self.n, self.m), estimator.features(self.n, self.m)))
+        self.decay = float(estimator.decay)
+        self.lags = int(lags)
+        self.need = int(estimator.min_sample_size(self.n, self.m))
+        self.refresh = refresh
+        self.since_refresh = 0
+        self._sc = np.zeros((self.d + self.n, K))
+        #: the last estimates ``[A_hat B_hat]`` (K, n, n + m), NaN before the first
+        self.theta = np.full((K, self.n, self.d), np.nan)
+
+    def solve(self, M: np.ndarray, columns: int) -> np.ndarray:
+        """The estimator's estimates from the moments ``M`` of ``columns`` columns, ``(K, n, n + m)``."""
+        return self.estimator.online_solve(M, columns, self.n, self.m)
+
+    def reset(self) -> None:
+        self.M[:] = 0.0
+        self.since_refresh = 0
+        self.theta[:] = np.nan
+
+    def add_columns(self, dims: Any, X: np.ndarray, U: np.ndarray, first: int, target: int, GC: np.ndarray) -> None:
+        mk.add_rows(X, U, first, target, self.M, self.decay, self.lags)
+        rk.add_gram(dims, X, U, first, target, GC, self._sc)  # the Gram matrices the rewards read
+
+    def steady_error(self, dims: Any, eps: np.ndarray) -> None:
+        raise SolverError("MomentKernels has no steady state (all_ready is False): settle every delivery")
+
+    def settle(self, dims: Any, G: np.ndarray, C: np.ndarray, columns: int, delivered: int, final: bool, eps: np.ndarray) -> None:
+        """The estimate once ``delivered >= min_sample_size`` and its error into ``eps`` (a copy
+        without an estimate, NaN, keeps its previous error), as the column-by-column update does.
+
+        Raises
+        ------
+        SolverError
+            If an estimate's error overflows float64.
+        """
+        if delivered < self.need:
+            return
+        theta = self.theta = self.solve(self.M, delivered - 1)
+        with np.errstate(over="ignore", invalid="ignore"):
+            err = ((theta - self.theta_true) ** 2).sum(axis=(1, 2)) / self.c
+        if np.isinf(err).any():
+            raise SolverError(
+                f"the {self.estimator.label} estimator's error overflowed float64 (epsilon = inf) after {delivered} samples "
+                f"(copy {int(np.argmax(np.isinf(err)))}): its estimate is too far from any plant to measure"
+            )
+        ok = np.isfinite(err)
+        eps[ok] = err[ok]

@@ -297,11 +297,7 @@ class MomentEstimator(ABC):
         m = check_int("m", m, minimum=1)
         self.check_dimensions(n, m)
         p = self.features(n, m)
-        check_memory(
-            f"the {self.label} estimator's moments for K = {K} copies of an n = {n}, m = {m} plant ({p} features)",
-            self.online_bytes(K, n, m),
-            advice="use fewer copies or an estimator with fewer features",
-        )
+        self.check_online_memory(K, n, m)
         self._K, self._n, self._m = K, n, m
         self._M = np.zeros((K, p, p))
         self._buf = np.empty((K, self.BLOCK, p))
@@ -309,6 +305,17 @@ class MomentEstimator(ABC):
         self._count = 0
         self._cache = None
         self.reset_history(K, n, m)
+
+    def check_online_memory(self, K: int, n: int, m: int) -> None:
+        """Refuse, before allocating, online moments of ``K`` copies beyond the memory limit
+        (:func:`encctl_gym.resources.check_memory` of :meth:`online_bytes`); the column-by-column
+        update and the compiled form (:class:`~encctl_gym.ident.compiled.MomentKernels`) both ask."""
+        check_memory(
+            f"the {self.label} estimator's moments for K = {K} copies of an n = {n}, m = {m} plant "
+            f"({self.features(n, m)} features)",
+            self.online_bytes(K, n, m),
+            advice="use fewer copies or an estimator with fewer features",
+        )
 
     def online_bytes(self, K: int, n: int, m: int) -> int:
         """Bytes :meth:`start` allocates and one estimate uses: per copy, the ``p x p`` moments,

@@ -17,6 +17,8 @@ import numpy as np
 
 from .._validation import check_real, format_value
 from ..errors import ParameterError
+from . import _moment_kernels as mk
+from .compiled import MomentKernels
 from .estimator import MomentEstimator
 from .ordinary import gram_solve
 
@@ -66,3 +68,21 @@ class ForgettingLeastSquares(MomentEstimator):
     def solve(self, M: np.ndarray, columns: int, n: int, m: int) -> np.ndarray:
         """The weighted normal equations (see :func:`~encctl_gym.ident.ordinary.gram_solve`)."""
         return gram_solve(M, n, m)
+
+    def online_kernels(
+        self, K: int, A: np.ndarray, B: np.ndarray, Q: np.ndarray, refresh: int, cond_limit: float
+    ) -> MomentKernels:
+        """The compiled online form (:class:`~encctl_gym.ident.compiled.MomentKernels`) with
+        :meth:`online_solve`."""
+        return MomentKernels(self, K, A, B, refresh)
+
+    def online_solve(self, M: np.ndarray, columns: int, n: int, m: int) -> np.ndarray:
+        """:meth:`solve` compiled: the Jacobi-scaled Cholesky solve of every copy
+        (:func:`encctl_gym.ident._moment_kernels.gram_solve`), and for the copies it refuses
+        :func:`~encctl_gym.ident.ordinary.gram_solve`'s minimum-norm solve."""
+        theta = np.empty((M.shape[0], n, n + m))
+        ok = np.empty(M.shape[0], dtype=bool)
+        mk.gram_solve(M, n, m, theta, ok)
+        if not ok.all():
+            theta[~ok] = gram_solve(M[~ok], n, m)
+        return theta

@@ -25,6 +25,8 @@ import numpy as np
 
 from .._validation import check_int
 from ..errors import ParameterError
+from . import _moment_kernels as mk
+from .compiled import MomentKernels
 from .estimator import MomentEstimator
 
 __all__ = ["InstrumentalVariables", "MAX_LAGS"]
@@ -146,3 +148,18 @@ class InstrumentalVariables(MomentEstimator):
                 continue
             out[i] = np.linalg.solve(Rw, Qw.T @ r).T
         return out.reshape(*lead, n, d)
+
+    def online_kernels(
+        self, K: int, A: np.ndarray, B: np.ndarray, Q: np.ndarray, refresh: int, cond_limit: float
+    ) -> MomentKernels:
+        """The compiled online form (:class:`~encctl_gym.ident.compiled.MomentKernels`): the rows
+        ``[zeta_j; z_j; x_{j+1}]`` (from column ``L`` on) by a compiled stage, with :meth:`online_solve`."""
+        n, m = A.shape[0], B.shape[1]
+        self.check_dimensions(n, m)
+        return MomentKernels(self, K, A, B, refresh, lags=self.lags_for(n, m))
+
+    def online_solve(self, M: np.ndarray, columns: int, n: int, m: int) -> np.ndarray:
+        """:meth:`solve` compiled (:func:`encctl_gym.ident._moment_kernels.iv_solve`; NaN where singular)."""
+        theta = np.empty((M.shape[0], n, n + m))
+        mk.iv_solve(M, n, m, self.instruments(n, m), theta)
+        return theta

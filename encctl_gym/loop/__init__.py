@@ -9,8 +9,13 @@ Backends implement :class:`~encctl_gym.loop.backend.LoopBackend` and are picked 
 * ``"elgamal"`` (:class:`~encctl_gym.loop.elgamal.ElGamalLoop`): real dynamic-key ElGamal
   ciphertexts, one copy.
 
+The encryption scheme the ElGamal backend runs is an
+:class:`~encctl_gym.loop.scheme.EncryptionScheme` of :data:`SCHEMES` (the three ElGamal variants
+of :mod:`encctl_gym.loop.elgamal_scheme`, or a new one: a class and a row).
+
 The defender policies with real levers (input noise, audits, a chi-squared detector) are in
-:mod:`encctl_gym.loop.defenses`.
+:mod:`encctl_gym.loop.defenses`; group rotation (a fresh group every K steps) in
+:mod:`encctl_gym.loop.rotation`.
 
 Both use the group the defender picks (:mod:`encctl_gym.loop.defender`; by default that of
 :func:`~encctl_gym.loop.backend.loop_group` for the key length), so their trajectories agree
@@ -23,16 +28,23 @@ the rounding pattern only.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 from ..crypto.group import SHIPPED_BITS
 from ..errors import ParameterError
 from .backend import LoopBackend, loop_group, lqr_gain, table_limit
 from .defender import DEFENDERS, DefenderAction, DefenderPolicy, FixedDefender, PlantView, make_defender
-from .defenses import AuditDefender, DetectorDefender, NoiseDefender  # registers "noise", "audit", "chi2"
+from .defenses import AuditDefender, CusumDefender, DetectorDefender, NoiseDefender  # registers "noise", "audit", "chi2", "cusum"
 from .elgamal import ElGamalLoop
+from .elgamal_scheme import ElGamalScheme  # registers "modified", "token", "static"
 from .ideal import IdealLoop
 from .quantize import Quantization
+from .rotation import RotatingDefender, defender_for  # registers "rotate"
+from .scheme import SCHEMES, EncryptionScheme, make_scheme
+from .spec import LoopSpec
+
+if TYPE_CHECKING:
+    from ..envs.config import AttackParams
 
 __all__ = [
     "LoopBackend",
@@ -41,6 +53,11 @@ __all__ = [
     "IdealLoop",
     "ElGamalLoop",
     "Quantization",
+    "EncryptionScheme",
+    "ElGamalScheme",
+    "SCHEMES",
+    "make_scheme",
+    "LoopSpec",
     "loop_group",
     "lqr_gain",
     "table_limit",
@@ -50,16 +67,19 @@ __all__ = [
     "FixedDefender",
     "NoiseDefender",
     "AuditDefender",
+    "CusumDefender",
     "DetectorDefender",
     "PlantView",
     "make_defender",
+    "RotatingDefender",
+    "defender_for",
 ]
 
 #: Backends by the name the environment's ``crypto`` key gives.
 BACKENDS: dict[str, type] = {"ideal": IdealLoop, "elgamal": ElGamalLoop}
 
 
-def make_loop(params: Any, defender: DefenderPolicy | None = None) -> LoopBackend:
+def make_loop(params: AttackParams, defender: DefenderPolicy | None = None) -> LoopBackend:
     """The backend selected by ``params.crypto``, on the group the defender picks
     (``defender``, else the policy of ``params.defender``; by default :func:`loop_group` of the
     key length).

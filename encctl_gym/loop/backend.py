@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from typing import Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 import scipy.linalg
@@ -25,6 +25,9 @@ import scipy.linalg
 from .._validation import format_value
 from ..errors import ResourceLimitError
 from .quantize import Quantization
+
+if TYPE_CHECKING:
+    from ..envs.config import AttackParams
 
 __all__ = ["LoopBackend", "lqr_gain", "table_limit", "loop_group"]
 
@@ -74,7 +77,7 @@ def lqr_gain(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return np.linalg.solve(np.eye(B.shape[1]) + B.T @ P @ B, B.T @ P @ A)
 
 
-def table_limit(params: Any, Phi: np.ndarray) -> int:
+def table_limit(params: AttackParams, Phi: np.ndarray) -> int:
     """Largest ``|round(Delta v)|`` the loop must quantise: states, inputs, controller entries.
 
     Raises

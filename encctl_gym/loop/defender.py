@@ -11,8 +11,11 @@ sees and what noise it adds to its own actuator input. A :class:`DefenderPolicy`
 * :meth:`DefenderPolicy.act`, at every attack step before the period runs, with a
   :class:`PlantView` of what the plant side knows (its state, the inputs it decoded). It returns
   ``None`` (nothing to do) or a :class:`DefenderAction`: noise added to the input the plant
-  applies this period, and whether the plant side stops the attack (the episode then ends,
-  ``terminated``, with every paid sample delivered).
+  applies this period, whether the plant side stops the attack (the episode then ends,
+  ``terminated``, with every paid sample delivered), and a fresh group to move the loop to
+  (group rotation, :mod:`encctl_gym.loop.rotation`);
+* ``close()``, optional: called by the environment's ``close`` to release what the policy holds
+  (the rotating defender's group pool stops its worker).
 
 Policies are picked by the environment's ``defender`` key: a name of :data:`DEFENDERS` or an
 object that implements the protocol. The default, :class:`FixedDefender` (``"fixed"``), is the
@@ -29,13 +32,16 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol, overload, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, overload, runtime_checkable
 
 import numpy as np
 
 from .._validation import as_finite_array, format_value
 from ..errors import ParameterError
 from .backend import loop_group
+
+if TYPE_CHECKING:
+    from ..envs.config import AttackParams
 
 __all__ = [
     "DefenderAction",
@@ -60,10 +66,15 @@ class DefenderAction:
     end : bool
         The plant side stops the attack now: the episode ends this step (``terminated``) for
         every copy (the copies of a batch run in lockstep).
+    new_group : GroupParams, optional
+        Move the loop to this safe-prime group (of the loop's size) before the period: KeyGen in
+        it and the server re-provisioned (group rotation, :mod:`encctl_gym.loop.rotation`; the
+        backend's ``rotate_group``).
     """
 
     input_noise: Any = None
     end: bool = False
+    new_group: Any = None
 
 
 class PlantView:
@@ -146,7 +157,7 @@ class DefenderPolicy(Protocol):
 
     name: str
 
-    def group(self, params: Any) -> Any:
+    def group(self, params: AttackParams) -> Any:
         """The group the loop runs on (its key length), for the environment's resolved ``params``."""
         ...
 
@@ -166,7 +177,7 @@ class FixedDefender:
 
     name = "fixed"
 
-    def group(self, params: Any) -> Any:
+    def group(self, params: AttackParams) -> Any:
         """:func:`~encctl_gym.loop.backend.loop_group` of ``params.key_length``."""
         return loop_group(params.key_length)
 

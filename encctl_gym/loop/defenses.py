@@ -1,4 +1,4 @@
-"""Defender policies with real levers: input noise, random audits and a chi-squared detector.
+"""Defender policies with real levers: input noise, random audits, a chi-squared and a CUSUM detector.
 
 Each is a :class:`~encctl_gym.loop.defender.DefenderPolicy` (registered in ``DEFENDERS`` by name,
 with its options from a mapping such as ``{"name": "audit", "rate": 5e-4}``) built on the
@@ -12,6 +12,8 @@ analysis of :mod:`encctl_gym.security.defenses` and the checks of :mod:`encctl_g
   beyond the encoding's error (:func:`audit_tolerance`).
 * ``"chi2"`` (:class:`DetectorDefender`): the window chi-squared test on the closed-loop
   innovation with a false-alarm rate per step; it needs no controller computation of its own.
+* ``"cusum"`` (:class:`CusumDefender`): Page's CUSUM on the same innovation, tuned for a
+  covariance inflation ``variance_ratio``, with a false-alarm rate per step.
 
 The plant side knows ``A``, ``B`` and the controller ``Phi`` (the loop's LQR gain,
 :func:`~encctl_gym.loop.backend.lqr_gain`): the policies take them from the resolved parameters in
@@ -22,7 +24,7 @@ of all (the environment's ``info["detected"]``).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -31,9 +33,12 @@ from ..crypto.residue_table import residue_table
 from ..errors import ParameterError
 from .backend import loop_group, lqr_gain, table_limit
 from .defender import DEFENDERS, DefenderAction, PlantView
-from .detection import Audit, ChiSquaredDetector, check_audit_rate
+from .detection import Audit, ChiSquaredDetector, CusumDetector, check_audit_rate
 
-__all__ = ["AuditDefender", "DetectorDefender", "NoiseDefender", "audit_tolerance"]
+if TYPE_CHECKING:
+    from ..envs.config import AttackParams
+
+__all__ = ["AuditDefender", "CusumDefender", "DetectorDefender", "NoiseDefender", "audit_tolerance"]
 
 
 def audit_tolerance(Phi: np.ndarray, x: np.ndarray, delta: float, max_shift: int = 0) -> np.ndarray:
@@ -56,15 +61,21 @@ class _PlantSidePolicy:
 
     name = "plant-side"
 
-    def group(self, params: Any) -> Any:
+    def group(self, params: AttackParams) -> Any:
         self.A = np.asarray(params.A, dtype=float)
         self.B = np.asarray(params.B, dtype=float)
         self.Phi = -lqr_gain(self.A, self.B)
         self.delta = float(params.delta)
         self.sigma_w2 = float(params.sigma_w2)
         group = loop_group(params.key_length)
-        self.max_shift = residue_table(group, table_limit(params, self.Phi)).max_shift  # cached: the loop's own table
+        self._limit = table_limit(params, self.Phi)
+        self.max_shift = residue_table(group, self._limit).max_shift  # cached: the loop's own table
         return group
+
+    def on_new_group(self, group: Any) -> None:
+        """The loop moved to ``group`` (group rotation, :mod:`encctl_gym.loop.rotation`): the
+        encoding's error bound takes that group's largest shift."""
+        self.max_shift = residue_table(group, self._limit).max_shift
 
     def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
         self.K, self.rngs = K, rngs
@@ -132,7 +143,32 @@ class AuditDefender(_PlantSidePolicy):
         return f"AuditDefender(rate={self.rate!r})"
 
 
-class DetectorDefender(_PlantSidePolicy):
+class _InnovationDefender(_PlantSidePolicy):
+    """A test on ``x[t+1] - (A + B Phi) x[t]`` that ends the attack on its first alarm."""
+
+    def _detector(self, n: int, K: int) -> Any:
+        raise NotImplementedError
+
+    def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
+        super().reset(K, n, m, rngs)
+        self.detector = self._detector(n, K)
+
+    def act(self, view: PlantView) -> DefenderAction | None:
+        x, x_prev = np.array(view.state, dtype=float), self._x_prev
+        self._x_prev = x
+        if x_prev is None:
+            return None
+        return DefenderAction(end=True) if self.detector.update(x_prev, x).any() else None
+
+
+def _check_false_alarm_rate(rate: Any) -> float:
+    rate = check_positive("false_alarm_rate", rate)
+    if rate >= 1:
+        raise ParameterError(f"false_alarm_rate must lie in (0, 1), got {rate}")
+    return rate
+
+
+class DetectorDefender(_InnovationDefender):
     """The window chi-squared test on ``x[t+1] - (A + B Phi) x[t]`` (registry name ``"chi2"``).
 
     Parameters
@@ -147,13 +183,10 @@ class DetectorDefender(_PlantSidePolicy):
 
     def __init__(self, window: int = 10, false_alarm_rate: float = 1e-4) -> None:
         self.window = check_int("window", window, minimum=1, maximum=10**6)
-        self.false_alarm_rate = check_positive("false_alarm_rate", false_alarm_rate)
-        if self.false_alarm_rate >= 1:
-            raise ParameterError(f"false_alarm_rate must lie in (0, 1), got {false_alarm_rate}")
+        self.false_alarm_rate = _check_false_alarm_rate(false_alarm_rate)
 
-    def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
-        super().reset(K, n, m, rngs)
-        self.detector = ChiSquaredDetector(
+    def _detector(self, n: int, K: int) -> ChiSquaredDetector:
+        return ChiSquaredDetector(
             self.A + self.B @ self.Phi,
             self.sigma_w2 * np.eye(n),
             window=self.window,
@@ -161,15 +194,40 @@ class DetectorDefender(_PlantSidePolicy):
             num_loops=K,
         )
 
-    def act(self, view: PlantView) -> DefenderAction | None:
-        x, x_prev = np.array(view.state, dtype=float), self._x_prev
-        self._x_prev = x
-        if x_prev is None:
-            return None
-        return DefenderAction(end=True) if self.detector.update(x_prev, x).any() else None
-
     def __repr__(self) -> str:
         return f"DetectorDefender(window={self.window!r}, false_alarm_rate={self.false_alarm_rate!r})"
 
 
-DEFENDERS.update({"noise": NoiseDefender, "audit": AuditDefender, "chi2": DetectorDefender})
+class CusumDefender(_InnovationDefender):
+    """Page's CUSUM on ``x[t+1] - (A + B Phi) x[t]`` (registry name ``"cusum"``).
+
+    Parameters
+    ----------
+    false_alarm_rate : float
+        Target alarm rate per step without an attack.
+    variance_ratio : float
+        The inflation ``c > 1`` of the innovation covariance the test is tuned for.
+    """
+
+    name = "cusum"
+
+    def __init__(self, false_alarm_rate: float = 1e-4, variance_ratio: float = 2.0) -> None:
+        self.false_alarm_rate = _check_false_alarm_rate(false_alarm_rate)
+        self.variance_ratio = check_positive("variance_ratio", variance_ratio)
+        if self.variance_ratio <= 1:
+            raise ParameterError(f"variance_ratio must be > 1, got {variance_ratio}")
+
+    def _detector(self, n: int, K: int) -> CusumDetector:
+        return CusumDetector(
+            self.A + self.B @ self.Phi,
+            self.sigma_w2 * np.eye(n),
+            false_alarm_rate=self.false_alarm_rate,
+            variance_ratio=self.variance_ratio,
+            num_loops=K,
+        )
+
+    def __repr__(self) -> str:
+        return f"CusumDefender(false_alarm_rate={self.false_alarm_rate!r}, variance_ratio={self.variance_ratio!r})"
+
+
+DEFENDERS.update({"noise": NoiseDefender, "audit": AuditDefender, "chi2": DetectorDefender, "cusum": CusumDefender})

@@ -1,8 +1,11 @@
-"""The ElGamal backend (``crypto="elgamal"``): real dynamic-key ElGamal ciphertexts through the loop.
+"""The ElGamal backend (``crypto="elgamal"``): real ciphertexts of the configured scheme through the loop.
 
-Keys are updated every period, with the modified evaluation/decryption of Definition
-def:modification (``scheme="modified"``), the conventional token-based dynamic key
-(``"token"``) or one fixed key pair (``"static"``). One copy.
+The scheme is an :class:`~encctl_gym.loop.scheme.EncryptionScheme` (the environment's ``scheme``):
+by default dynamic-key ElGamal with keys updated every period, with the modified
+evaluation/decryption of Definition def:modification (``scheme="modified"``), the conventional
+token-based dynamic key (``"token"``) or one fixed key pair (``"static"``); any scheme of
+:data:`~encctl_gym.loop.scheme.SCHEMES` (or object implementing the protocol) runs the same way.
+One copy.
 
 The parties hold their own randomness and nothing of each other's: the plant (keys, state
 encryptions), the controller server (the token scheme's CtUpd re-randomisation), the
@@ -19,12 +22,16 @@ the period's public key.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import ParameterError
 from .backend import lqr_gain
+from .scheme import EncryptionScheme, make_scheme
+
+if TYPE_CHECKING:
+    from ..envs.config import AttackParams
 
 __all__ = ["ElGamalLoop", "party_random_sources"]
 
@@ -50,19 +57,19 @@ def party_random_sources(crypto_seed: int | None) -> dict[str, Any]:
 
 
 class ElGamalLoop:
-    """Real dynamic-key ElGamal ciphertexts through the loop (one copy).
+    """Real ciphertexts of the configured scheme through the loop (one copy).
 
-    The parties come from the scheme (:data:`encctl_gym.crypto.schemes.SCHEMES`): the plant
-    side (:mod:`encctl_gym.crypto.plant_side`) holds the keys, encrypts the state under
-    ``pk_t``, decrypts (two-key ``Dec_bar(sk_0, sk_t, .)`` in the modified scheme, ``Dec(sk_t,
-    .)`` otherwise), sums and decodes; the controller server (:mod:`encctl_gym.crypto.servers`)
-    holds public keys and ciphertexts only; the forged input comes from
-    :func:`encctl_gym.attacks.forgery.forge`. ``"modified"``: Phi encrypted once under ``pk_0``, keys
-    updated every period, no token leaves the plant. ``"token"``: the server receives every
-    update token and CtUpds Phi's ciphertexts. ``"static"``: one key pair, never updated.
+    Every step of the scheme is the scheme object's (:attr:`encryption`, an
+    :class:`~encctl_gym.loop.scheme.EncryptionScheme`): the plant side holds the keys, encrypts
+    the state under the period's key, decrypts, sums and decodes; the controller server holds
+    public keys and ciphertexts only; the forged input comes from the scheme's ``forge`` (public
+    keys only). For the ElGamal variants (:mod:`encctl_gym.loop.elgamal_scheme`):
+    ``"modified"``: Phi encrypted once under ``pk_0``, keys updated every period, no token leaves
+    the plant. ``"token"``: the server receives every update token and CtUpds Phi's
+    ciphertexts. ``"static"``: one key pair, never updated.
 
     The adversary's break of a state ciphertext (paid for in time by the environment) is
-    done by :attr:`decipherer`: simulated by decrypting with the plant's key of that period
+    done by :attr:`decipherer`: simulated by reading the plant's secret of that period
     (default), or a real break of the period's public key with ``params.breaker``
     (:class:`~encctl_gym.attacks.decipherer.KeyBreaking`: then nothing of the plant's is read).
 
@@ -78,35 +85,54 @@ class ElGamalLoop:
     needs_key_length_group = True
     quantization = None
 
-    def __init__(self, params: Any, group: Any) -> None:
-        from ..crypto.encoding import Encoder
-        from ..crypto.schemes import get_scheme
+    def __init__(self, params: AttackParams, group: Any) -> None:
+        from ..attacks.decipherer import make_decipherer
 
         self.params = params
         self.group = group
         self.n, self.m = params.n, params.m
-        self.scheme = params.scheme
-        self._scheme = get_scheme(params.scheme)
-        self.encoder = Encoder(group, float(params.delta))
+        #: the scheme's object (:class:`~encctl_gym.loop.scheme.EncryptionScheme`)
+        self.encryption: EncryptionScheme = make_scheme(params.scheme)
+        #: the scheme's name
+        self.scheme = self.encryption.name
+        self.encoder = self.encryption.encoder(group, float(params.delta))
         self.Phi = -lqr_gain(params.A, params.B)
         #: each party's random source (privileged: who holds which randomness), see :func:`party_random_sources`
         self.random_sources = party_random_sources(params.crypto_seed)
-        from ..attacks.decipherer import make_decipherer
-
-        #: how the adversary obtains the exponent of each period's key (:mod:`encctl_gym.attacks.decipherer`)
-        self.decipherer = make_decipherer(params, group, lambda: self.plant.secret_key, self.random_sources["breaker"])
+        #: how the adversary obtains the secret of each period's key (:mod:`encctl_gym.attacks.decipherer`)
+        self.decipherer = make_decipherer(
+            params.breaker,
+            group,
+            lambda: self.encryption.oracle_secret(self.plant),
+            scheme=self.encryption,
+            adversary=params.adversary,
+            time_limit=params.breaker_time_limit,
+            rng=self.random_sources["breaker"],
+        )
         self.plant: Any = None
         self.server: Any = None
         self.last_state_ciphertexts: list[Any] | None = None
-        self.last_output_ciphertexts: list[list[Any]] | None = None
+        self.last_output_ciphertexts: Any = None
 
     def start_episode(self) -> None:
         """Fresh keys (KeyGen) and Phi encrypted under ``pk_0``; the server of the scheme is set up."""
+        self.provision()
+        self.decipherer.start_episode()
+
+    def provision(self) -> None:
+        """KeyGen in the loop's group and the server of the scheme set up with ``Enc(pk_0, Ecd(Phi))``."""
         from ..crypto.quantized import QuantizedLinearController
 
         quant = QuantizedLinearController(self.Phi, self.encoder, self.params.x_bound)
-        self.plant, self.server = self._scheme.parties(quant, self.random_sources["plant"], self.random_sources["server"])
-        self.decipherer.start_episode()
+        self.plant, self.server = self.encryption.parties(quant, self.random_sources["plant"], self.random_sources["server"])
+
+    def rotate_group(self, group: Any) -> Any:
+        """Move to a fresh ``group`` (group rotation): KeyGen in it, the server re-provisioned, the
+        adversary's breaker on the new group; returns the
+        :class:`~encctl_gym.loop.provisioning.ProvisioningCost` (:func:`~encctl_gym.loop.provisioning.rotate_elgamal_loop`)."""
+        from .provisioning import rotate_elgamal_loop
+
+        return rotate_elgamal_loop(self, group)
 
     @staticmethod
     def _single(v: np.ndarray) -> np.ndarray:
@@ -115,15 +141,13 @@ class ElGamalLoop:
         return v[0]
 
     def collect_state(self, x: np.ndarray) -> np.ndarray:
-        """Encrypt ``x_t`` under ``pk_t`` (what the server and an eavesdropper receive) and
-        return what breaking those ciphertexts reveals: ``Dcd(Dec(s_t, ct))`` with the exponent
-        ``s_t`` of :attr:`decipherer`."""
-        from ..crypto.elgamal import decrypt_components
-
-        pk = self.plant.pk
-        cts = self.last_state_ciphertexts = self.plant.encrypt_state(self._single(x))
-        s_t = self.decipherer.secret(pk)
-        return np.array([[self.encoder.decode(decrypt_components(self.group, s_t, ct.c1, ct.c2)) for ct in cts]])
+        """Encrypt ``x_t`` under the period's key (what the server and an eavesdropper receive)
+        and return what breaking those ciphertexts reveals: the scheme's ``reveal`` with the
+        secret of :attr:`decipherer` (``Dcd(Dec(s_t, ct))`` for ElGamal)."""
+        scheme = self.encryption
+        cts = self.last_state_ciphertexts = scheme.encrypt_state(self.plant, self._single(x))
+        secret = self.decipherer.secret(scheme.public_key(self.plant))
+        return np.array([[scheme.reveal(self.group, secret, ct, self.encoder) for ct in cts]])
 
     @property
     def deciphering_seconds(self) -> float:
@@ -133,26 +157,21 @@ class ElGamalLoop:
     def control(self, x: np.ndarray) -> np.ndarray:
         """A full period of normal operation: encrypt, server evaluation (eq:ec), decrypt, Sum,
         decode, key update."""
-        ct_x = self.plant.encrypt_state(self._single(x))
-        out = self.server.evaluate(ct_x)
-        u = self.plant.decrypt_output(out)
+        scheme = self.encryption
+        ct_x = scheme.encrypt_state(self.plant, self._single(x))
+        u = scheme.decrypt_output(self.plant, scheme.evaluate(self.server, ct_x))
         self.tick()
-        return u[None]
+        return np.asarray(u)[None]
 
     def inject(self, a: np.ndarray) -> np.ndarray:
         """The adversary forges the input ciphertexts from public keys only; the plant decrypts."""
-        from ..attacks.forgery import forge
-
-        a0 = self._single(a)
-        out = forge(self.scheme, self.plant.pk0, self.plant.pk, a0, self.encoder, self.n, self.random_sources["adversary"])
+        out = self.encryption.forge(self.plant, self._single(a), self.encoder, self.n, self.random_sources["adversary"])
         self.last_output_ciphertexts = out
-        return self.plant.decrypt_output(out)[None]
+        return np.asarray(self.encryption.decrypt_output(self.plant, out))[None]
 
     def tick(self) -> None:
-        """KeyUpd at the end of the period (none for static keys); the token scheme sends the
-        token to the server, which CtUpds Phi's ciphertexts."""
-        token = self.plant.update_keys()
-        if self._scheme.token_to_server:
-            self.server.receive_token(token)
-            if self.params.adversary == "server":  # the malicious server sees what it receives
-                self.decipherer.observe_token(token)
+        """The scheme's key update at the end of the period (none for static keys); a token the
+        server receives is seen by a malicious server."""
+        token = self.encryption.update_keys(self.plant, self.server)
+        if token is not None and self.params.adversary == "server":  # the malicious server sees what it receives
+            self.decipherer.observe_token(token)

@@ -11,7 +11,7 @@ copies; the environment's compiled step runs its per-period arithmetic itself fr
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -19,6 +19,9 @@ from .._validation import format_value
 from ..errors import EncodingOverflowError, ResourceLimitError
 from .backend import lqr_gain, table_limit
 from .quantize import OK, Quantization, collect_states, forge_inputs
+
+if TYPE_CHECKING:
+    from ..envs.config import AttackParams
 
 __all__ = ["IdealLoop", "MAX_TABLE_LIMIT"]
 
@@ -46,13 +49,21 @@ class IdealLoop:
     #: nothing is broken: the time charged is the cost model's
     deciphering_seconds = 0.0
 
-    def __init__(self, params: Any, group: Any) -> None:
-        from ..crypto.residue_table import residue_table
+    def __init__(self, params: AttackParams, group: Any) -> None:
 
         self.delta = float(params.delta)
         self.x_bound = float(params.x_bound)
         self.n, self.m = params.n, params.m
         self.Phi = -lqr_gain(params.A, params.B)
+        self._params = params
+        self.use_group(group)
+
+    def use_group(self, group: Any) -> None:
+        """The quantisation of ``group`` (its residue table, ``Ecd(Phi)``, ``Ecd(1)``, ``Ecd(0)``)."""
+        from ..crypto.residue_table import residue_table
+
+        params = self._params
+        self.group = group
         limit = table_limit(params, self.Phi)
         if limit > MAX_TABLE_LIMIT:
             raise ResourceLimitError(
@@ -88,6 +99,18 @@ class IdealLoop:
 
     def start_episode(self) -> None:
         pass
+
+    def rotate_group(self, group: Any) -> Any:
+        """Move to a fresh ``group`` (group rotation): its quantisation (:meth:`use_group`); returns
+        the :class:`~encctl_gym.loop.provisioning.ProvisioningCost` the ElGamal loop has, counted
+        (``n m`` encryptions of ``Ecd(Phi)``, :func:`~encctl_gym.loop.provisioning.provisioning_bytes`)."""
+        import time
+
+        from .provisioning import ProvisioningCost, provisioning_bytes
+
+        t0 = time.perf_counter()
+        self.use_group(group)
+        return ProvisioningCost(self.n * self.m, provisioning_bytes(group, self.n * self.m), 1, time.perf_counter() - t0)
 
     def _overflow(self, x: np.ndarray) -> EncodingOverflowError:
         return EncodingOverflowError(f"state {np.asarray(x).tolist()} leaves the declared range |x| <= {self.x_bound} (x_bound)")

@@ -62,8 +62,8 @@ class EncryptedControlGame(ParallelEnv):
     ----------
     config : dict, optional
         The environment's configuration (:func:`encctl_gym.envs.config.default_config`), as for
-        ``EncryptedLTIAttack-v0``; its ``defender`` key must be left at ``"fixed"`` (the defender
-        is the other agent).
+        ``EncryptedLTIAttack-v0``; its ``defender`` key must be left at ``"fixed"`` and
+        ``rotate_group_every`` at ``None`` (the defender is the other agent).
     rules : GameRules or dict, optional
         Budgets, costs and penalties (:class:`~encctl_gym.multiagent.levers.GameRules`).
     schedule : EpisodeSchedule, optional
@@ -96,6 +96,10 @@ class EncryptedControlGame(ParallelEnv):
         if p.defender != "fixed":
             raise ParameterError(
                 f"the game's defender is its 'defender' agent; leave the configuration's defender at 'fixed', got {format_value(p.defender)}"
+            )
+        if p.rotate_group_every is not None:
+            raise ParameterError(
+                f"rotate_group_every = {p.rotate_group_every} rotates outside the game's defender; the game has no rotation lever yet, leave it None"
             )
         p.warn_if_capped()
         check_episode_memory(p, 1, schedule)

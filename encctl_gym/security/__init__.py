@@ -34,6 +34,9 @@ key_length
 defenses
     The defences' closed forms: eq:sic with the defender's input noise, its Lyapunov price,
     audit rates, the chi-squared detector's threshold, group rotation's precomputations.
+rotation
+    Group rotation charged per group under every cost model: tau(N), the affordable samples and
+    the key length a rotation period needs.
 empirical
     An empirical sample identifying complexity (a fitted ``c / N^a`` with bootstrap intervals)
     for estimators without a closed form, and the design with intervals for N*, lambda*, k*.
@@ -42,8 +45,14 @@ attack_design
     cvxpy; imported on use).
 report
     ``design_report``: everything the design command reports for a plant, as a dict.
+defense_design
+    The cheapest secure mix of key length, group rotation, audits and noise per cost model,
+    with the defender's cost per step (its time models are passed in by the loop layer).
+defense_cli
+    The defender's options of ``encctl-gym design`` and their section of the output.
 design_cli
-    The ``encctl-gym design`` subcommand (prints :func:`.report.design_report`).
+    The ``encctl-gym design`` subcommand (prints :func:`.report.design_report`; with the
+    defender's levers through :mod:`encctl_gym.design_command`).
 """
 
 from __future__ import annotations
@@ -62,6 +71,7 @@ from .exact import *  # noqa: F403
 from .gramians import *  # noqa: F403
 from .key_length import *  # noqa: F403
 from .records import *  # noqa: F403
+from .rotation import *  # noqa: F403
 from .sample_size import *  # noqa: F403
 from .threat import *  # noqa: F403
 
@@ -82,6 +92,7 @@ __all__ = list(
             "design",
             "key_length",
             "defenses",
+            "rotation",
             "empirical",
             "attack_design",
         )

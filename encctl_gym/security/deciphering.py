@@ -50,7 +50,7 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
-from typing import Any
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -72,6 +72,7 @@ __all__ = [
     "max_affordable_samples",
     "keys_to_break",
     "independent_keys",
+    "KeyExposure",
     "exact_number",
     "check_security_parameter",
 ]
@@ -80,18 +81,38 @@ SCHEMES: tuple[str, ...] = ("modified", "token", "static")
 ADVERSARIES: tuple[str, ...] = ("eavesdropper", "server")
 
 
-def independent_keys(scheme: str = "modified", adversary: str = "eavesdropper") -> bool:
+@runtime_checkable
+class KeyExposure(Protocol):
+    """What a scheme tells the budget: whether each sample is under its own key for an adversary
+    (the scheme seam's :meth:`~encctl_gym.loop.scheme.EncryptionScheme.independent_keys`)."""
+
+    def independent_keys(self, adversary: str) -> bool:
+        """True if every sample is under its own key, False if one break reveals every sample."""
+
+
+def independent_keys(scheme: str | KeyExposure = "modified", adversary: str = "eavesdropper") -> bool:
     """Whether every sample is under its own key for this adversary (else one break reveals all).
+
+    Parameters
+    ----------
+    scheme : str or KeyExposure
+        One of the paper's schemes :data:`SCHEMES` (the module table), or a scheme object that
+        answers for itself (``scheme.independent_keys(adversary)``, the scheme seam of
+        :mod:`encctl_gym.loop.scheme`).
+    adversary : {"eavesdropper", "server"}
 
     Raises
     ------
     ParameterError
         For an unknown scheme or adversary (named in the message).
     """
-    if not isinstance(scheme, str) or scheme not in SCHEMES:
+    exposure = not isinstance(scheme, (str, type)) and isinstance(scheme, KeyExposure)
+    if not exposure and (not isinstance(scheme, str) or scheme not in SCHEMES):
         raise ParameterError(f"unknown scheme {format_value(scheme)}; expected one of {', '.join(SCHEMES)}")
     if not isinstance(adversary, str) or adversary not in ADVERSARIES:
         raise ParameterError(f"unknown adversary {format_value(adversary)}; expected one of {', '.join(ADVERSARIES)}")
+    if exposure:
+        return bool(scheme.independent_keys(adversary))  # type: ignore[union-attr]
     if scheme == "static":
         return False
     if scheme == "token":
@@ -99,7 +120,7 @@ def independent_keys(scheme: str = "modified", adversary: str = "eavesdropper") 
     return True
 
 
-def keys_to_break(N: int, scheme: str = "modified", adversary: str = "eavesdropper") -> int:
+def keys_to_break(N: int, scheme: str | KeyExposure = "modified", adversary: str = "eavesdropper") -> int:
     """Number of keys the adversary must break to read ``N`` ciphertexts.
 
     Parameters
@@ -171,7 +192,7 @@ def _cost(lam: Any) -> KeyBreakCost:
 
 
 def sample_deciphering_time_exact(
-    N: int, lam: Any, upsilon: Any, *, scheme: str = "modified", adversary: str = "eavesdropper"
+    N: int, lam: Any, upsilon: Any, *, scheme: str | KeyExposure = "modified", adversary: str = "eavesdropper"
 ) -> Fraction:
     """Exact sample deciphering time (Definition def:sdt).
 
@@ -209,7 +230,7 @@ def _to_float(x: Fraction) -> float:
 
 
 def sample_deciphering_time(
-    N: Any, lam: Any, upsilon: Any, *, scheme: str = "modified", adversary: str = "eavesdropper"
+    N: Any, lam: Any, upsilon: Any, *, scheme: str | KeyExposure = "modified", adversary: str = "eavesdropper"
 ) -> float | np.ndarray:
     """Sample deciphering time of Definition def:sdt, ``tau(N, lam) = 2^lam N / Upsilon``, or under a model.
 
@@ -279,7 +300,7 @@ def per_sample_cost(lam: Any, upsilon: Any) -> float:
 
 
 def max_affordable_samples(
-    tau_c: Any, lam: Any, upsilon: Any, *, scheme: str = "modified", adversary: str = "eavesdropper"
+    tau_c: Any, lam: Any, upsilon: Any, *, scheme: str | KeyExposure = "modified", adversary: str = "eavesdropper"
 ) -> int | float:
     """Largest sample size ``N`` with ``tau(N) <= tau_c`` (Definitions def:sdt, def:security), exactly.
 

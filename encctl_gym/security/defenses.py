@@ -24,6 +24,10 @@ the experiments that measure them live elsewhere):
   covariance without an attack is ``Sigma``: the window statistic is chi-squared with ``n W``
   degrees of freedom (:func:`chi2_threshold` for a false-alarm rate per step,
   :func:`chi2_detection_probability` for an attack of a given energy).
+* **A CUSUM detector** on the same innovation: the log-likelihood ratio of a covariance
+  ``c Sigma`` against ``Sigma`` accumulated as ``g = max(0, g + z)``, alarm at ``g > h``
+  (:func:`cusum_threshold` for a false-alarm rate per step, :func:`cusum_run_length` for the mean
+  delay under an innovation covariance ``r Sigma``; Brook and Evans' Markov chain).
 * **Group rotation** every ``K`` steps: the attacker pays the precomputation of a discrete
   logarithm once per group, ``ceil(N / K)`` times (:func:`rotated_deciphering_operations`).
 """
@@ -31,6 +35,7 @@ the experiments that measure them live elsewhere):
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -47,6 +52,8 @@ from .threat import ThreatModel
 __all__ = [
     "chi2_detection_probability",
     "chi2_threshold",
+    "cusum_run_length",
+    "cusum_threshold",
     "closed_loop_state_covariance",
     "input_noise_covariance",
     "minimum_audit_rate",
@@ -260,6 +267,74 @@ def chi2_detection_probability(n: int, window: int, false_alarm_rate: float, non
     if lam == 0:
         return float(false_alarm_rate)
     return float(ncx2.sf(h, n * window, lam))
+
+
+def _cusum_increment(n: int, variance_ratio: float) -> tuple[float, float]:
+    """``(a, b)`` of the CUSUM's log-likelihood-ratio increment ``z = a s - b`` for the statistic
+    ``s = r^T Sigma^-1 r`` of an innovation whose covariance is ``Sigma`` (no attack) or
+    ``c Sigma`` (the change it is tuned for): ``a = (1 - 1/c) / 2``, ``b = n ln(c) / 2``."""
+    c = check_positive("variance_ratio", variance_ratio)
+    if c <= 1:
+        raise ParameterError(f"variance_ratio must be > 1, got {c}")
+    return 0.5 * (1.0 - 1.0 / c), 0.5 * n * math.log(c)
+
+
+def cusum_run_length(n: int, variance_ratio: float, threshold: float, *, actual_ratio: float = 1.0, cells: int = 100) -> float:
+    """Mean steps to the first alarm of the CUSUM ``g[t] = max(0, g[t-1] + z[t])``, alarm at
+    ``g > h``, from ``g = 0``, when the innovation's covariance is ``actual_ratio Sigma``
+    (1: no attack, the average run length to a false alarm).
+
+    ``z = a s - b`` (:func:`_cusum_increment`) with ``s / actual_ratio`` chi-squared with ``n``
+    degrees of freedom. Brook and Evans' Markov chain: ``cells`` states ``g = j w``,
+    ``w = 2 h / (2 cells - 1)``; the run length is the first entry of ``(I - R)^-1 1``.
+    """
+    from scipy.stats import chi2
+
+    n = check_int("n", n, minimum=1)
+    a, b = _cusum_increment(n, variance_ratio)
+    h = check_positive("threshold", threshold)
+    r = check_positive("actual_ratio", actual_ratio)
+    cells = check_int("cells", cells, minimum=2, maximum=5000)
+    w = 2.0 * h / (2 * cells - 1)
+    v = w * np.arange(cells)
+
+    def F(t: np.ndarray) -> np.ndarray:  # P(z <= t)
+        return chi2.cdf(np.maximum((t + b) / (a * r), 0.0), n)
+
+    d = v[None, :] - v[:, None]  # (j -> k): g moves by k w - j w
+    R = F(d + w / 2) - F(d - w / 2)
+    R[:, 0] = F(-v + w / 2)
+    arl = np.linalg.solve(np.eye(cells) - R, np.ones(cells))
+    return float(arl[0])
+
+
+def cusum_threshold(n: int, variance_ratio: float, false_alarm_rate: float, *, cells: int = 100) -> float:
+    """Threshold ``h`` of the CUSUM with a false-alarm rate per step ``alpha``: its average run
+    length without an attack (:func:`cusum_run_length`, restarted after each alarm) is
+    ``1 / alpha``. Bisection in ``h`` to a relative 1e-7 (cached: defenders ask once per episode)."""
+    n = check_int("n", n, minimum=1)
+    _cusum_increment(n, variance_ratio)
+    alpha = check_positive("false_alarm_rate", false_alarm_rate)
+    if alpha >= 1:
+        raise ParameterError(f"false_alarm_rate must lie in (0, 1), got {alpha}")
+    return _cusum_threshold(n, float(variance_ratio), alpha, check_int("cells", cells, minimum=2, maximum=5000))
+
+
+@lru_cache(maxsize=64)
+def _cusum_threshold(n: int, c: float, alpha: float, cells: int) -> float:
+    target = 1.0 / alpha
+    lo, hi = 0.0, 1.0
+    while cusum_run_length(n, c, hi, cells=cells) < target:
+        lo, hi = hi, 2.0 * hi
+        if hi > 1e4:
+            raise ParameterError(f"no CUSUM threshold below 1e4 reaches a false-alarm rate of {alpha}")
+    while hi - lo > 1e-7 * hi:
+        mid = 0.5 * (lo + hi)
+        if cusum_run_length(n, c, mid, cells=cells) < target:
+            lo = mid
+        else:
+            hi = mid
+    return hi
 
 
 def rotation_precomputations(N: Any, K: Any) -> int:

@@ -36,6 +36,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -45,8 +46,10 @@ from ..errors import ConfigError, ParameterError
 from ..plant_file import load_plant_file, load_system
 from ..presets import DESIGN_FIELDS, design_defaults, get_preset, preset_names
 from ..units import SECONDS_PER_UNIT, parse_duration
+from . import defense_cli
 from .attack_design import SDP_MAX_DIMENSION
 from .cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION, check_gnfs_correction
+from .defense_design import DefenseDesign
 from .records import load_records
 from .report import COMPLEXITIES, LABELS, design_report
 from .threat import ThreatModel
@@ -266,8 +269,10 @@ def _format_table(res: dict[str, Any], title: str, sources: str | None = None) -
 
 
 # --------------------------------------------------------------------------- the command
-def run(args: argparse.Namespace) -> int:
-    """Run ``encctl-gym design``: print the tables (or JSON); return 0."""
+def run(args: argparse.Namespace, defenses: Callable[..., DefenseDesign] | None = None) -> int:
+    """Run ``encctl-gym design``: print the tables (or JSON); return 0. ``defenses`` designs the
+    defender's levers when one of their options is given (:mod:`encctl_gym.design_command`
+    passes :func:`encctl_gym.loop.defense_costs.design_loop_defenses`)."""
     if args.preset and args.system_file:
         raise ConfigError("give either SYSTEM_FILE or --preset, not both")
     base: dict[str, Any] = dict(DEFAULTS)
@@ -329,12 +334,29 @@ def run(args: argparse.Namespace) -> int:
         key_length=key_length,
         calibration=records,
     )
+    defense = defense_cli.defense_options(args)
+    if defense is not None:
+        if defenses is None:
+            raise ConfigError("the defender's options need the loop's cost terms: run them through encctl-gym design")
+        res["defenses"] = defenses(
+            (A, B),
+            threat,
+            cost_models=models or tuple(DECIPHERING_MODELS),
+            gnfs_correction=correction,
+            calibration=records,
+            **defense,
+        )
     if args.json:
+        if "defenses" in res:
+            res["defenses"] = res["defenses"].to_dict()
         res["title"] = title
         res["sources"] = sources
         print(json.dumps(_sanitize(res), indent=2, allow_nan=False))
     else:
-        print(_format_table(res, title, sources_line))
+        text = _format_table(res, title, sources_line)
+        if "defenses" in res:
+            text += "\n" + "\n".join(defense_cli.format_defenses(res["defenses"]))
+        print(text)
     return 0
 
 

@@ -30,8 +30,8 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from .._validation import check_bool, check_int, check_nonnegative, check_positive, format_value
-from ..errors import ConfigError, ParameterError, ResourceLimitError
+from .._validation import check_bool, check_int, check_nonnegative, check_positive, format_value, read_bounded
+from ..errors import ConfigError, ParameterError
 from ..units import SECONDS_PER_YEAR
 
 __all__ = [
@@ -54,7 +54,8 @@ DATA_FILE = Path(__file__).with_name("data") / "deciphering_records.json"
 #: How the shipped data file is named in outputs.
 DATA_LABEL = "package data encctl_gym/security/data/deciphering_records.json"
 
-_MAX_FILE_BYTES = 1 << 20  # a calibration file is a few kilobytes
+#: Largest records (calibration) file read, in bytes: such a file is a few kilobytes.
+MAX_RECORDS_FILE_BYTES = 1 << 20
 
 #: Seconds per time unit of a record (a year is 365 days, as everywhere in the package).
 _UNIT_SECONDS: dict[str, float] = {
@@ -387,11 +388,9 @@ def default_records() -> RecordSet:
 def _load(p: Path) -> RecordSet:
     if not p.is_file():
         raise ConfigError(f"records file {str(p)!r} does not exist")
-    size = p.stat().st_size
-    if size > _MAX_FILE_BYTES:
-        raise ResourceLimitError(f"records file {str(p)!r} has {size} bytes; the limit is {_MAX_FILE_BYTES}")
+    raw = read_bounded("records file", p, MAX_RECORDS_FILE_BYTES, "MAX_RECORDS_FILE_BYTES")
     try:
-        data = json.loads(p.read_text(encoding="utf-8"))
+        data = json.loads(raw.decode("utf-8"))
     except (ValueError, UnicodeDecodeError, RecursionError) as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise ConfigError(f"cannot read records file {str(p)!r}: {format_value(first)}") from None

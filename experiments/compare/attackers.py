@@ -17,10 +17,10 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
+from encctl_gym.agents import Attacker, ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker, PRBSAttacker
+from encctl_gym.agents.evaluate import budget_config
+from encctl_gym.agents.runs import RUN_FILE, RunInfo
 
-from agents import Attacker, ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker, PRBSAttacker
-from agents.evaluate import budget_config
-from agents.runs import RUN_FILE, RunInfo
 from encctl_gym._validation import format_value
 from encctl_gym.envs.config import AttackParams, resolve_params
 from encctl_gym.errors import ConfigError, EncctlError
@@ -169,7 +169,7 @@ def learned_players(
     if not chosen:
         return []
     try:
-        from agents.sb3 import load_attacker
+        from encctl_gym.agents.sb3 import load_attacker
     except ModuleNotFoundError as exc:
         raise EncctlError(
             f"learned attackers need stable-baselines3 (module {exc.name!r} is missing); "

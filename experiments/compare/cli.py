@@ -23,7 +23,8 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from agents.runs import MODEL_FILES, check_output_dir, find_runs
+from encctl_gym.agents.runs import MODEL_FILES, check_output_dir, find_runs
+
 from encctl_gym._validation import format_value
 from encctl_gym.errors import ConfigError
 
@@ -197,7 +198,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run as a script (``python -m experiments.compare.cli``)."""
+    """Run as a script (``python -m encctl_gym.experiments.compare.cli``)."""
     from encctl_gym.cli import main as cli_main
 
     return cli_main(["compare", *(sys.argv[1:] if argv is None else argv)])

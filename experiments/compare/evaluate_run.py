@@ -25,9 +25,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from agents import Attacker
-from agents.runs import MODEL_FILES, RunInfo, check_output_dir, read_run
-from agents.sb3 import load_attacker  # the [rl] extra: without it the CLI says which extra to install
+from encctl_gym.agents import Attacker
+from encctl_gym.agents.runs import MODEL_FILES, RunInfo, check_output_dir, read_run
+from encctl_gym.agents.sb3 import load_attacker  # the [rl] extra: without it the CLI says which extra to install
+
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ConfigError
 

@@ -70,7 +70,7 @@ def design_efficiencies(result: Result) -> str:
     """One line per setting: each attacker's design efficiency ``tr(Sigma_opt^-1) / tr(Sigma^-1)``
     of the regressors its attacks at the horizon delivered (:func:`agents.evaluate.design_efficiency`;
     1 is the setting's optimal design, closed loop with delivered states, open loop when blind)."""
-    from agents.evaluate import design_efficiency
+    from encctl_gym.agents.evaluate import design_efficiency
 
     out = []
     for s in result.settings:

@@ -17,7 +17,7 @@ from .harness import Case, CliRun
 
 K = "cli"
 NUMBERS_BAD = ["abc", "nan", "inf", "-1", "0", "1e400", "9" * 401, "", "1e-6e3", "0x10"]
-RL = ("torch", "stable_baselines3", "agents.train")
+RL = ("torch", "stable_baselines3", "encctl_gym.agents.train")
 
 
 def _design() -> list[Case]:

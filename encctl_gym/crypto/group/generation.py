@@ -35,6 +35,7 @@ __all__ = [
     "MIN_GENERATE_BITS",
     "DEFAULT_MAX_GENERATION_SECONDS",
     "estimate_generation_seconds",
+    "modular_exponentiation_seconds",
     "generate_safe_prime_group",
     "get_group",
     "as_group",
@@ -112,6 +113,19 @@ def _powmod_seconds(bits: float) -> float:
             except OverflowError:
                 return math.inf
     raise AssertionError("unreachable")  # pragma: no cover
+
+
+def modular_exponentiation_seconds(bits: Any) -> float:
+    """Time of one modular exponentiation with a full-size exponent modulo a ``bits``-bit p on the
+    reference machine: the measured table of the safe-prime search's time model, interpolated in
+    log-log scale (the per-size model every cost per step of the package is built on).
+
+    Raises
+    ------
+    ParameterError
+        If ``bits`` is not an integer >= 1.
+    """
+    return _powmod_seconds(float(check_int("bits", bits, minimum=1)))
 
 
 @cache

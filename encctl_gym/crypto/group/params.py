@@ -23,12 +23,12 @@ from functools import cached_property
 from pathlib import Path
 from typing import Any
 
-from ..._validation import check_bool, check_int, format_value
+from ..._validation import check_bool, check_int, format_value, read_bounded
 from ...errors import ConfigError, GroupError, ParameterError
 from .. import arith
 from ..arith import format_int as fmt
 
-__all__ = ["GroupParams", "MAX_GROUP_BITS", "MAX_GROUP_FILE_BYTES"]
+__all__ = ["GroupParams", "MAX_GROUP_BITS", "MAX_GROUP_FILE_BYTES", "parse_group_integer"]
 
 #: Largest bit length of p accepted by :class:`GroupParams`: above it a single verification or
 #: exponentiation takes from seconds to hours (NIST SP 800-57 asks 15360 bits of p for the
@@ -44,19 +44,17 @@ _MPZ = type(arith.mpz(0))
 _VERIFIED: set[tuple[int, int, int]] = set()
 
 
-def _as_int(name: str, value: Any) -> int:
+def parse_group_integer(name: str, value: Any) -> int:
+    """A group parameter ``p``, ``q`` or ``g`` as an int: a string of a group file in decimal or
+    ``0x`` hex (``int(value, 0)``), else by the package's one integer rule
+    (:func:`encctl_gym._validation.check_int`); :class:`GroupError` naming it otherwise."""
     if isinstance(value, str):
         try:
             return int(value, 0)
         except ValueError as exc:
             shown = value if len(value) <= 60 else f"{value[:40]}... ({len(value)} characters)"
             raise GroupError(f"{name} must be an integer (decimal or 0x hex), got {shown!r}: {exc}") from None
-    if type(value).__name__ == "mpz":
-        return int(value)
-    try:
-        return check_int(name, value)
-    except ParameterError as exc:
-        raise GroupError(str(exc)) from exc
+    return check_int(name, value, error=GroupError)
 
 
 def _as_path(path: Any) -> Path:
@@ -103,7 +101,7 @@ class GroupParams:
     g: int
 
     def __post_init__(self) -> None:
-        p, q, g = _as_int("p", self.p), _as_int("q", self.q), _as_int("g", self.g)
+        p, q, g = parse_group_integer("p", self.p), parse_group_integer("q", self.q), parse_group_integer("g", self.g)
         if p < 5:
             raise GroupError(f"p must be a prime >= 5, got p = {fmt(p)}")
         if p.bit_length() > MAX_GROUP_BITS:
@@ -231,7 +229,7 @@ class GroupParams:
                 f"with fields {sorted(map(str, data)) if isinstance(data, Mapping) else None}"
             ) from exc
         for name in ("bits", "cofactor"):
-            if name in data and _as_int(name, data[name]) != getattr(group, name):
+            if name in data and parse_group_integer(name, data[name]) != getattr(group, name):
                 raise GroupError(
                     f"declared {name} = {fmt(data[name])} does not match the parameters ({name} = {getattr(group, name)})"
                 )
@@ -300,16 +298,7 @@ class GroupParams:
         if verify is not True:
             verify = check_bool("verify", verify)
         shown = format_value(str(source))
-        try:
-            with source.open("rb") as f:
-                raw = f.read(MAX_GROUP_FILE_BYTES + 1)
-        except OSError as exc:
-            raise ConfigError(f"cannot read the group file {shown}: {exc.strerror or exc}") from None
-        if len(raw) > MAX_GROUP_FILE_BYTES:
-            raise ConfigError(
-                f"the group file {shown} is larger than MAX_GROUP_FILE_BYTES = {MAX_GROUP_FILE_BYTES} bytes "
-                "(a group file is a few kilobytes)"
-            )
+        raw = read_bounded("the group file", source, MAX_GROUP_FILE_BYTES, "MAX_GROUP_FILE_BYTES", error=ConfigError)
         try:
             text = raw.decode("utf-8")
         except UnicodeDecodeError as exc:
