@@ -8,7 +8,8 @@ of :class:`~encctl_gym.multiagent.game.EncryptedControlGame` (its observation an
   in [-1, 1], built by :func:`defender_action`):
   :class:`NoDefence`, :class:`RandomAudit` (audit with probability ``p`` per step),
   :class:`DetectorAudit` (audit when the chi-squared statistic it observes passes its threshold),
-  :class:`ConstantNoise` (a fixed noise level);
+  :class:`ConstantNoise` (a fixed noise level), :class:`RotateEvery` (a fresh group every ``K``
+  steps);
 * attackers: :class:`ScheduledAttacker` turns any attacker of :mod:`encctl_gym.agents` (Gaussian, AR(1),
   the optimal design, a learned one) into a game player that injects on a schedule: at every
   step, at random steps with probability ``q`` (sparse), or in bursts of ``duty`` steps every
@@ -50,6 +51,7 @@ __all__ = [
     "RandomAudit",
     "DetectorAudit",
     "ConstantNoise",
+    "RotateEvery",
     "ScheduledAttacker",
     "PassThrough",
     "LearnedPlayer",
@@ -157,6 +159,29 @@ class ConstantNoise:
 
     def act(self, obs: np.ndarray) -> np.ndarray:
         return defender_action(noise=self.level)
+
+
+class RotateEvery:
+    """Moves the loop to a fresh group every ``K`` steps (before the period of steps ``K - 1,
+    2K - 1, ...``, as the ``"rotate"`` defender does), no audits, no noise.
+
+    Parameters
+    ----------
+    K : int
+        Steps per group.
+    """
+
+    def __init__(self, K: int) -> None:
+        self.K = check_int("K", K, minimum=1)
+        self.name = f"rotate(K={self.K})"
+        self.k = 0
+
+    def reset(self, seed: int | None = None) -> None:
+        self.k = 0
+
+    def act(self, obs: np.ndarray) -> np.ndarray:
+        self.k += 1
+        return defender_action(rotate=1.0 if self.k % self.K == 0 else -1.0)
 
 
 # ---------------------------------------------------------------------- attackers

@@ -209,3 +209,39 @@ def test_passed_through_steps_give_the_same_numbers_on_every_step_path():
             seq.append(np.r_[obs["attacker"], obs["defender"], rew["attacker"]])
         runs.append(np.concatenate(seq))
     assert np.array_equal(runs[0], runs[1])
+
+
+def test_rotating_every_k_steps_reproduces_the_rotate_defender_bit_for_bit():
+    from encctl_gym.agents.game import RotateEvery
+
+    cfg = {"key_length": 64, "max_samples": 14, "crypto_seed": 5, "delta": 64, "x_bound": 48.0, "gamma_opt": False}
+    env = gym.make("encctl_gym/EncryptedLTIAttack-v0", config={**cfg, "defender": {"name": "rotate", "every": 4}})
+    game = EncryptedControlGame(cfg, {"rotation_cost": 0.5})
+    rotate = RotateEvery(4)
+    o1, _ = env.reset(seed=2)
+    o2, _ = game.reset(seed=2)
+    rotate.reset()
+    rng = np.random.default_rng(7)
+    done, costs = False, []
+    while not done:
+        a = rng.uniform(-1, 1, game.params.m).astype(np.float32)
+        o1, r1, te, tr, i1 = env.step(a)
+        o2, r2, _, _, i2 = game.step({"attacker": np.r_[a, 1.0], "defender": rotate.act(o2["defender"])})
+        assert np.array_equal(o1, o2["attacker"]) and r1 == r2["attacker"] and i1["epsilon"] == i2["attacker"]["epsilon"]
+        costs.append(i2["defender"]["cost"])
+        done = te or tr
+    assert i1["group_rotations"] == i2["attacker"]["group_rotations"] == i2["defender"]["rotations"] == 3  # steps 3, 7, 11 of 14
+    assert costs == [0.5 if k in (3, 7, 11) else 0.0 for k in range(14)]
+    env.close()
+    game.close()
+
+
+def test_with_the_rotation_lever_off_its_entry_is_ignored():
+    game = EncryptedControlGame(_cfg(), {"rotation": False, "rotation_cost": 1.0})
+    m = game.params.m
+    game.reset(seed=0)
+    for _ in range(5):
+        _, _, _, _, info = game.step({"attacker": np.r_[np.zeros(m), -1.0], "defender": defender_action(rotate=1.0)})
+        assert (
+            info["defender"]["rotations"] == 0 and info["defender"]["cost"] == 0.0 and "group_rotations" not in info["attacker"]
+        )

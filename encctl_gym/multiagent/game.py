@@ -9,7 +9,7 @@ Two agents act at every attack step, simultaneously:
   pass the controller's input through (the period runs the encrypted controller of eq:ec; no
   energy is spent, no audit can catch the step, and its regression column is closed-loop data).
 * ``"defender"``, the plant side: ``Box(-1, 1, (len(LEVERS),))``, one entry per lever of
-  :data:`~encctl_gym.multiagent.levers.LEVERS` (audit, input noise), and an observation of the
+  :data:`~encctl_gym.multiagent.levers.LEVERS` (audit, input noise, group rotation), and an observation of the
   plant side's own data only (:class:`~encctl_gym.multiagent.levers.DefenderLevers`).
 
 The game runs the same :class:`~encctl_gym.envs.episode.EpisodeCore` as the single environment;
@@ -63,7 +63,7 @@ class EncryptedControlGame(ParallelEnv):
     config : dict, optional
         The environment's configuration (:func:`encctl_gym.envs.config.default_config`), as for
         ``EncryptedLTIAttack-v0``; its ``defender`` key must be left at ``"fixed"`` and
-        ``rotate_group_every`` at ``None`` (the defender is the other agent).
+        ``rotate_group_every`` at ``None`` (the defender is the other agent; it rotates with its lever).
     rules : GameRules or dict, optional
         Budgets, costs and penalties (:class:`~encctl_gym.multiagent.levers.GameRules`).
     schedule : EpisodeSchedule, optional
@@ -99,7 +99,7 @@ class EncryptedControlGame(ParallelEnv):
             )
         if p.rotate_group_every is not None:
             raise ParameterError(
-                f"rotate_group_every = {p.rotate_group_every} rotates outside the game's defender; the game has no rotation lever yet, leave it None"
+                f"rotate_group_every = {p.rotate_group_every} rotates outside the game's defender; leave it None and use the rotate lever"
             )
         p.warn_if_capped()
         check_episode_memory(p, 1, schedule)
@@ -197,6 +197,7 @@ class EncryptedControlGame(ParallelEnv):
             "audited": lv.audited,
             "detected": self.episode.stopped,
             "sigma_d2": lv.decision.sigma_d2,
+            "rotations": lv.rotations,
         }
 
     def render(self) -> None:
@@ -204,4 +205,5 @@ class EncryptedControlGame(ParallelEnv):
         return None
 
     def close(self) -> None:
-        """Nothing to release."""
+        """Stop the defender's group pool (its worker thread)."""
+        self.levers.close()

@@ -20,8 +20,15 @@ The defender's action is a vector in ``[-1, 1]``, one entry per lever of :data:`
   normal-operation quadratic cost, :func:`~encctl_gym.security.defenses.noise_defense_price`
   ``cost_increase / cost_base`` (linear in ``sigma_d2``).
 
-A new lever (group rotation) is one more name in :data:`LEVERS`, one more entry of the action,
-one more field of :class:`Decision`, and its cost in :meth:`DefenderLevers.cost`.
+* ``"rotate"`` (> 0: rotate now): the loop moves to a fresh safe-prime group of its size before
+  this step's period (:mod:`encctl_gym.loop.rotation`: the groups come from a
+  :class:`~encctl_gym.loop.rotation.GroupPool` seeded from the plant's stream, the same sequence
+  as the ``"rotate"`` defender's), so the samples from the next one on lie in the new group and
+  the attacker's deciphering pays for it (its cost model charges per group). Each rotation costs
+  :attr:`GameRules.rotation_cost`.
+
+A new lever is one more name in :data:`LEVERS`, one more entry of the action, one more field
+of :class:`Decision`, and its cost in :meth:`DefenderLevers.cost`.
 
 The defender observes (:meth:`DefenderLevers.observation`) what the plant side has: its state
 ``x_k``, the input ``u_{k-1}`` it decrypted, its chi-squared detector's window statistic over
@@ -41,16 +48,18 @@ from typing import Any
 import numpy as np
 
 from .._validation import as_finite_array, check_bool, check_int, check_nonnegative, check_positive
+from ..crypto.group import GroupParams
 from ..errors import ParameterError
 from ..loop.defender import DefenderAction, PlantView
 from ..loop.defenses import _PlantSidePolicy, audit_tolerance
 from ..loop.detection import Audit, ChiSquaredDetector
+from ..loop.rotation import GenerationTally, GroupPool
 from ..security.defenses import noise_defense_price
 
 __all__ = ["LEVERS", "GameRules", "Decision", "DefenderLevers"]
 
 #: The defender's levers, in the order of its action's entries.
-LEVERS: tuple[str, ...] = ("audit", "noise")
+LEVERS: tuple[str, ...] = ("audit", "noise", "rotate")
 
 
 @dataclass(frozen=True)
@@ -77,6 +86,14 @@ class GameRules:
     window, false_alarm_rate : int, float
         The defender's chi-squared detector (its observed statistic is over the threshold of this
         false-alarm rate per step).
+    rotation_cost : float
+        The defender's cost per group rotation.
+    rotation_ahead : int
+        Groups the pool generates ahead (off the control path).
+    rotation : bool
+        The rotate lever is live; ``False`` ignores its entry (a defender without rotation; a
+        fresh 712-bit group takes about 0.1 s to generate, which a learner that rotates at random
+        pays at every other step).
     """
 
     audit_budget: int | None = None
@@ -87,6 +104,9 @@ class GameRules:
     zero_sum: bool = False
     window: int = 10
     false_alarm_rate: float = 1e-3
+    rotation_cost: float = 0.1
+    rotation_ahead: int = 2
+    rotation: bool = True
 
     def __post_init__(self) -> None:
         if self.audit_budget is not None:
@@ -101,6 +121,9 @@ class GameRules:
         fa = check_positive("false_alarm_rate", self.false_alarm_rate)
         if fa >= 1:
             raise ParameterError(f"false_alarm_rate must lie in (0, 1), got {self.false_alarm_rate}")
+        check_nonnegative("rotation_cost", self.rotation_cost)
+        check_int("rotation_ahead", self.rotation_ahead, minimum=0)
+        check_bool("rotation", self.rotation)
 
     @classmethod
     def of(cls, spec: Any) -> GameRules:
@@ -127,10 +150,13 @@ class Decision:
         Audit last step's decrypted input.
     sigma_d2 : float
         Variance of the input noise this step.
+    rotate : bool
+        Move the loop to a fresh group before this step's period.
     """
 
     audit: bool = False
     sigma_d2: float = 0.0
+    rotate: bool = False
 
 
 class DefenderLevers(_PlantSidePolicy):
@@ -156,6 +182,14 @@ class DefenderLevers(_PlantSidePolicy):
         self.noise_max = float(params.sigma_u2) if self.rules.noise_max is None else float(self.rules.noise_max)
         price = noise_defense_price(self.A, self.B, self.Phi, sigma_w2=self.sigma_w2, sigma_d2=1.0)
         self.unit_noise_price = price["cost_increase"] / price["cost_base"]  # per unit sigma_d2 (linear)
+        self.pool: GroupPool | None = None
+        if (
+            self.rules.rotation and isinstance(group, GroupParams) and group.is_safe_prime
+        ):  # the groups the "rotate" defender meets
+            from ..loop.elgamal import party_random_sources
+
+            source = party_random_sources(params.crypto_seed)["plant"].spawn("group-rotation")
+            self.pool = GroupPool(group.bits, source, self.rules.rotation_ahead)
         return group
 
     def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
@@ -172,6 +206,12 @@ class DefenderLevers(_PlantSidePolicy):
         self._noise_prev = np.zeros((K, m))
         self._x_seen: np.ndarray | None = None  # the state at the last observe()
         self.audits = 0  # audits run this episode
+        self.rotations = 0  # groups moved to this episode
+        self.rotated = False  # the loop moved at the last step
+        self.tally = GenerationTally()  # read by the episode's rotation info
+        self._next_group = 1
+        if self.pool is not None and self.rules.rotation_ahead:
+            self.pool.prefetch(1)
         self.audited = False  # an audit ran at the last step
         self.caught = False
 
@@ -183,7 +223,11 @@ class DefenderLevers(_PlantSidePolicy):
             raise ParameterError(f"the defender's action must have shape ({len(LEVERS)},), got {np.shape(action)}")
         if np.any(np.abs(a) > 1.0 + 1e-6):
             raise ParameterError(f"the defender's action must lie in [-1, 1], got {a.tolist()}")
-        self._decision = Decision(audit=bool(a[0] > 0.0), sigma_d2=self.noise_max * float(np.clip(a[1], 0.0, 1.0)))
+        rotate = self.rules.rotation and bool(a[2] > 0.0)
+        if rotate and self.pool is None:
+            raise ParameterError("the rotate lever needs a loop on a safe-prime group (a shipped or generated one)")
+        sigma_d2 = self.noise_max * float(np.clip(a[1], 0.0, 1.0))
+        self._decision = Decision(audit=bool(a[0] > 0.0), sigma_d2=sigma_d2, rotate=rotate)
         return self._decision
 
     def act(self, view: PlantView) -> DefenderAction | None:
@@ -201,16 +245,43 @@ class DefenderLevers(_PlantSidePolicy):
         if dec.sigma_d2 > 0.0:  # the draws of NoiseDefender
             noise = np.stack([rng.normal(scale=math.sqrt(dec.sigma_d2), size=self.m) for rng in self.rngs[: self.K]])
         self._noise_prev = np.zeros((self.K, self.m)) if noise is None else noise
-        if noise is None and not self.caught:
+        group = self._new_group(view.step) if dec.rotate else None
+        self.rotated = group is not None
+        if noise is None and not self.caught and group is None:
             return None
-        return DefenderAction(input_noise=noise, end=self.caught)
+        return DefenderAction(input_noise=noise, end=self.caught, new_group=group)
+
+    def _new_group(self, step: int) -> GroupParams | None:
+        """The next group of the pool (as :class:`~encctl_gym.loop.rotation.RotatingDefender`
+        takes it), or None at the last step (no sample is collected after it)."""
+        if step + 1 >= self.horizon:
+            return None
+        assert self.pool is not None
+        group, waited = self.pool.get(self._next_group)
+        t = self.tally
+        t.groups += 1
+        t.indices.append(self._next_group)
+        t.seconds += self.pool.seconds[self._next_group]
+        t.model_seconds += self.pool.model_seconds
+        t.waited += waited
+        self._next_group += 1
+        self.rotations += 1
+        self.on_new_group(group)  # the audit's error bound follows the new group's encoding
+        return group
+
+    def close(self) -> None:
+        """Stop the group pool's worker."""
+        if self.pool is not None:
+            self.pool.close()
 
     # ------------------------------------------------------------- the game's side
     def cost(self) -> float:
-        """The defender's cost of the last step: the audit run and the noise applied."""
+        """The defender's cost of the last step: the audit run, the noise applied, the rotation."""
+        r = self.rules
         return (
-            self.rules.audit_cost * float(self.audited)
-            + self.rules.noise_weight * self.unit_noise_price * self._decision.sigma_d2
+            r.audit_cost * float(self.audited)
+            + r.noise_weight * self.unit_noise_price * self._decision.sigma_d2
+            + r.rotation_cost * float(self.rotated)
         )
 
     @property
