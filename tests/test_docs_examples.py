@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from encctl_gym.errors import OptionalDependencyError
+
 ROOT = Path(__file__).resolve().parents[1]
 SLOW_MARK = "<!-- docs:slow -->"
 FENCE = re.compile(r"^(`{3,})([^`\s]*)\s*$")
@@ -64,6 +66,7 @@ EXTRA_MODULES = {
     "ray": "ray",
     "distributed": "dask",
     "dask": "dask",
+    "pettingzoo": "multiagent",
 }
 
 
@@ -82,6 +85,8 @@ def _run_blocks(path: Path, include_slow: bool, monkeypatch: pytest.MonkeyPatch,
             if top not in EXTRA_MODULES:
                 raise
             pytest.skip(f"{rel}:{line} needs the {EXTRA_MODULES[top]} extra ({top} is not installed)")
+        except OptionalDependencyError as exc:  # the package's own one-line error naming the extra
+            pytest.skip(f"{rel}:{line}: {exc}")
         ran += 1
     return ran
 

@@ -521,8 +521,14 @@ class EpisodeCore:
             raise ParameterError(f"action must be {what}, got {np.asarray(action).tolist()}")
         return self._act
 
-    def step(self, action: Any) -> tuple[np.ndarray, bool, bool]:
-        """Apply the actions of all copies. Returns (rewards (K,), terminated, truncated)."""
+    def step(self, action: Any, *, inject: bool = True) -> tuple[np.ndarray, bool, bool]:
+        """Apply the actions of all copies. Returns (rewards (K,), terminated, truncated).
+
+        ``inject=False`` (every copy at once): the attacker forges nothing this period and the
+        plant applies the encrypted controller's own input ``u_k = Phi x_k`` (eq:ec,
+        :meth:`_pass_period`); ``action`` is still checked but unused. Such a step cannot fail an
+        audit, and its regression column is closed-loop data (``u`` a function of ``x``).
+        """
         if not self._rngs:
             raise ParameterError("step() called before reset(); call reset() first")
         if self.done:
@@ -540,7 +546,26 @@ class EpisodeCore:
             if decision.new_group is not None:  # group rotation: the period runs in the new group
                 group = check_new_group(decision.new_group, getattr(self.loop, "group", None))
                 self.rotation.add(move_loop(self.loop, self.stepper, group))
+        if not inject:
+            self._obs_out = None
+            return self.finish_step(self._pass_period(w, ended))
         return self.stepper.step(act, w, ended)
+
+    def _pass_period(self, w: np.ndarray, ended: bool) -> bool:
+        """A period of normal operation inside the attack: the backend's :meth:`control` (eq:ec,
+        with its key update) computes the input the plant applies, recorded like a forged one;
+        no input energy is spent and the agent's input history takes zeros (it injected nothing).
+        Returns whether the attack has ended (as :meth:`StepStrategy.period`)."""
+        s = self.state
+        u = self.loop.control(s.x)
+        s.U[self.collected - 1] = u
+        kern.plant_step(self._dims, s.x, np.ascontiguousarray(u, dtype=np.float64), w, self._A, self._B)
+        if self.p.input_history:
+            kern.shift_history(self._dims, s.hist, np.zeros((self.K, self.m)))
+        if not ended:
+            self._collect()
+            ended = self.expired
+        return ended
 
     def _attack_step(self) -> int:
         """The attack step about to run (0 at the first): its input goes to ``U[collected - 1]``."""
