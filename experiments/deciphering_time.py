@@ -77,8 +77,6 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import numpy as np
-from encctl_gym.experiments.common import add_common_arguments, ensure_out_dir, entry_point
-from encctl_gym.experiments.deciphering_models import format_lp_fits, lp_fits, model_curves, plot_models
 
 from encctl_gym.cryptanalysis import get_breaker, pari_available
 from encctl_gym.cryptanalysis.keys import key_sequence
@@ -86,6 +84,8 @@ from encctl_gym.cryptanalysis.sequence import break_sequence
 from encctl_gym.crypto import arith
 from encctl_gym.crypto.group import generate_safe_prime_group
 from encctl_gym.errors import BreakerError, ParameterError
+from encctl_gym.experiments.common import add_common_arguments, ensure_out_dir, entry_point
+from encctl_gym.experiments.deciphering_models import format_lp_fits, lp_fits, model_curves, plot_models
 from encctl_gym.parallel import child_seeds, run_tasks
 from encctl_gym.plotting import save_figure
 

@@ -371,9 +371,9 @@ def rotation_rows(samples: int = 200, seed: int = 0, breaker: str = "index-calcu
     import time as _time
 
     import gymnasium as gym
-    from encctl_gym.agents import GaussianAttacker
 
     import encctl_gym  # noqa: F401  (registers the environment)
+    from encctl_gym.agents import GaussianAttacker
     from encctl_gym.crypto.group import estimate_generation_seconds, generate_safe_prime_group
     from encctl_gym.loop.provisioning import provisioning_bytes
     from encctl_gym.security.cost_models import PaperModel, PrecomputationModel

@@ -32,7 +32,6 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from encctl_gym.experiments.common import add_common_arguments, ensure_out_dir, entry_point
-
 from encctl_gym.presets import PAPER_DESIGN_PARAMETERS, PAPER_REPORTED, get_preset
 from encctl_gym.security.cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION
 from encctl_gym.security.design import SecurityDesign, design_security_parameter, paper_design_example

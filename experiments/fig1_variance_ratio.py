@@ -26,7 +26,6 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 
 
 from encctl_gym.experiments.common import FULL, GridConfig, Table, figure_entry_points, figure_table, panel_figure, preset_spec
-
 from encctl_gym.sim.montecarlo import AttackSpec
 
 __all__ = ["PANELS", "panel_systems", "compute", "plot", "add_arguments", "run", "main"]

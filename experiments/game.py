@@ -37,6 +37,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from encctl_gym._validation import check_int
 from encctl_gym.agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker
 from encctl_gym.agents.evaluate import budget_config, env_config
 from encctl_gym.agents.game import (
@@ -51,12 +53,10 @@ from encctl_gym.agents.game import (
     play,
 )
 from encctl_gym.agents.game_training import Curve, alternate, train_side
+from encctl_gym.envs.config import resolve_params
 from encctl_gym.experiments.common import _checked, ensure_out_dir, script_main
 from encctl_gym.experiments.compare.statistics import Z95
 from encctl_gym.experiments.identification_strategies import replicate_interval
-
-from encctl_gym._validation import check_int
-from encctl_gym.envs.config import resolve_params
 from encctl_gym.multiagent import GameRules
 from encctl_gym.plotting import legend_below, save_figure
 

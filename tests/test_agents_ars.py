@@ -10,15 +10,15 @@ import pytest
 pytest.importorskip("sb3_contrib")  # the rl extra; torch comes with it
 
 import torch as th  # noqa: E402
+from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.vec_env import VecNormalize
+
 from encctl_gym.agents.ars import PairedARS
 from encctl_gym.agents.config import apply_override, env_config, load_config
 from encctl_gym.agents.hyperparams import LinearSchedule, make_schedules
 from encctl_gym.agents.runs import read_run
 from encctl_gym.agents.sb3 import SB3VecEnv, load_attacker
 from encctl_gym.agents.train import train
-from stable_baselines3.common.callbacks import BaseCallback
-from stable_baselines3.common.vec_env import VecNormalize
-
 from encctl_gym.errors import ConfigError
 
 CFG = {"preset": "small", "gamma_opt": False, "reward": "a_optimality", "input_history": 0, "max_samples": 24}

@@ -7,6 +7,8 @@ import math
 import gymnasium as gym
 import numpy as np
 import pytest
+
+import encctl_gym  # noqa: F401  (registers the environment)
 from encctl_gym.agents import (
     Attacker,
     ColoredGaussianAttacker,
@@ -17,8 +19,6 @@ from encctl_gym.agents import (
     rollout,
 )
 from encctl_gym.agents.evaluate import budget_config
-
-import encctl_gym  # noqa: F401  (registers the environment)
 from encctl_gym.envs import ENV_ID, EncryptedLTIAttackEnv
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.envs.layout import ObservationLayout

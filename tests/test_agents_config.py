@@ -12,6 +12,7 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
+from encctl_gym import cli
 from encctl_gym.agents.config import (
     CONFIG_DIR,
     DEFAULTS_DIR,
@@ -25,8 +26,6 @@ from encctl_gym.agents.config import (
 from encctl_gym.agents.hyperparams import check_value
 from encctl_gym.agents.runs import find_runs, new_run_dir, read_run
 from encctl_gym.agents.sb3 import ALGORITHMS, SB3VecEnv, algorithm_class, load_attacker
-
-from encctl_gym import cli
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ConfigError, ResourceLimitError
 from encctl_gym.presets import get_preset

@@ -13,7 +13,6 @@ pytest.importorskip("stable_baselines3")
 from encctl_gym.agents.config import load_config, validate_config
 from encctl_gym.agents.features import FEATURES, DitherFeature, FeatureSet, check_features
 from encctl_gym.agents.sb3 import SB3VecEnv
-
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ConfigError
 

@@ -9,6 +9,8 @@ import pytest
 
 pytest.importorskip("pettingzoo")
 
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+
 from encctl_gym.agents import GaussianAttacker  # noqa: E402
 from encctl_gym.agents.evaluate import budget_config, env_config  # noqa: E402
 from encctl_gym.agents.game import (  # noqa: E402
@@ -23,8 +25,6 @@ from encctl_gym.agents.game import (  # noqa: E402
     ScheduledAttacker,
     play,
 )
-from gymnasium.utils.env_checker import check_env  # noqa: E402
-
 from encctl_gym.envs.config import resolve_params  # noqa: E402
 from encctl_gym.errors import ParameterError  # noqa: E402
 
@@ -133,7 +133,6 @@ def test_the_rllib_game_without_ray_names_the_extra(monkeypatch):
     import sys
 
     from encctl_gym.agents import rllib_game
-
     from encctl_gym.errors import EncctlError
 
     monkeypatch.setitem(sys.modules, "ray", None)

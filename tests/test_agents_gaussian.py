@@ -13,8 +13,8 @@ import math
 
 import numpy as np
 import pytest
-from encctl_gym.agents import GaussianAttacker, rollout
 
+from encctl_gym.agents import GaussianAttacker, rollout
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.sim.montecarlo import gaussian_attack_errors
 from encctl_gym.sim.plant import LinearPlant

@@ -7,8 +7,8 @@ import math
 
 import numpy as np
 import pytest
-from encctl_gym.agents.resolution import median_resolution, paired_resolution, reference_resolution, resolution_line
 
+from encctl_gym.agents.resolution import median_resolution, paired_resolution, reference_resolution, resolution_line
 from encctl_gym.errors import ParameterError
 
 #: t_{0.975} with 99 and 399 degrees of freedom (statistical tables).

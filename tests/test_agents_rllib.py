@@ -7,8 +7,8 @@ import sys
 
 import numpy as np
 import pytest
-from encctl_gym.agents import rllib
 
+from encctl_gym.agents import rllib
 from encctl_gym.errors import EncctlError
 
 SMALL = {"preset": "small", "gamma_opt": False, "max_samples": 32}

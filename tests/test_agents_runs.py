@@ -10,9 +10,8 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from encctl_gym.agents.runs import read_run
-
 from encctl_gym import cli
+from encctl_gym.agents.runs import read_run
 from encctl_gym.errors import ConfigError
 
 
@@ -42,7 +41,6 @@ def test_a_missing_run_directory_says_so_and_names_its_quick_sibling(tmp_path, c
 def test_train_system_reports_the_systems_defense_period_and_the_shortened_training_one(tmp_path):
     from encctl_gym.agents.config import env_config, load_config
     from encctl_gym.agents.train import system_summary
-
     from encctl_gym.envs.config import resolve_params
     from encctl_gym.presets import get_preset
 
@@ -191,7 +189,6 @@ def test_compare_says_which_runs_it_leaves_out_and_why(ars_run, tmp_path, capsys
 
 def test_a_refusal_to_play_names_the_run(ars_run):
     from encctl_gym.agents.sb3 import load_attacker
-
     from encctl_gym.envs.config import resolve_params
 
     with pytest.raises(ConfigError, match="input_history = 0 in training, 2 here") as exc:
@@ -202,7 +199,6 @@ def test_a_refusal_to_play_names_the_run(ars_run):
 # ------------------------------------------------------------------ plant files wherever a system is taken
 def test_every_command_that_takes_a_system_takes_a_plant_file(ars_run, tmp_path, capsys):
     from encctl_gym.experiments.compare.settings import system_entry
-
     from encctl_gym.presets import get_preset
 
     small = get_preset("small")

@@ -8,8 +8,8 @@ import math
 
 import numpy as np
 import pytest
-from encctl_gym.agents.stopping import OracleStopper, StoppingRule, decide, plant_budget
 
+from encctl_gym.agents.stopping import OracleStopper, StoppingRule, decide, plant_budget
 from encctl_gym.errors import ConfigError
 
 K = 32
@@ -152,7 +152,6 @@ def test_the_ars_default_budget_is_scaled_to_the_plant_and_an_explicit_one_is_fi
     from encctl_gym.agents.config import apply_override, env_config, load_config
     from encctl_gym.agents.curves import curve_for
     from encctl_gym.agents.train import training_budget
-
     from encctl_gym.envs.config import resolve_params
 
     cfg = load_config("ars", "paper-example")

@@ -12,13 +12,12 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
+from encctl_gym import cli
 from encctl_gym.agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker, rollout
 from encctl_gym.agents.curves import load_learning_curve, plot_learning_curves, reference_designs
 from encctl_gym.agents.evaluate import budget_config
 from encctl_gym.agents.runs import read_run
 from encctl_gym.agents.sb3 import SB3Attacker, SB3VecEnv, load_attacker
-
-from encctl_gym import cli
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
 from encctl_gym.errors import ConfigError, ParameterError
@@ -221,8 +220,9 @@ def test_a_second_run_of_the_same_name_gets_a_new_directory_or_overwrites(ppo_ru
 
 
 def test_progress_bar_never_passes_its_total():
-    from encctl_gym.agents.callbacks import ProgressCallback
     from stable_baselines3 import PPO
+
+    from encctl_gym.agents.callbacks import ProgressCallback
 
     seen: list[tuple[int, int]] = []
 
@@ -355,8 +355,9 @@ def _copy_run(src: Path, dst: Path) -> Path:
 
 
 def test_the_normalisation_statistics_are_arrays_and_load_as_sb3_saved_them(ppo_run, tmp_path):
-    from encctl_gym.agents.sb3 import load_vecnormalize, save_vecnormalize
     from stable_baselines3.common.vec_env import VecNormalize
+
+    from encctl_gym.agents.sb3 import load_vecnormalize, save_vecnormalize
 
     run = read_run(ppo_run)
     with np.load(ppo_run / "vecnormalize.npz", allow_pickle=False) as z:  # plain arrays: loads without pickles
@@ -386,8 +387,9 @@ class _RunsCode:
 def test_an_old_run_with_a_pickle_is_refused_unless_the_caller_opts_in(ppo_run, tmp_path, capsys):
     import pickle
 
-    from encctl_gym.agents.sb3 import load_vecnormalize
     from stable_baselines3.common.vec_env import VecNormalize
+
+    from encctl_gym.agents.sb3 import load_vecnormalize
 
     old = _copy_run(ppo_run, tmp_path / "old")
     run = read_run(old)

@@ -12,13 +12,12 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
+from encctl_gym import cli
 from encctl_gym.agents import OptimalDesignAttacker, rollout
 from encctl_gym.agents.config import load_config, read_yaml
 from encctl_gym.agents.runs import read_run
 from encctl_gym.agents.sb3 import load_attacker
 from encctl_gym.agents.tune import OBJECTIVE_SEED, SEARCH_SPACES, objective_ratio, tune
-
-from encctl_gym import cli
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import EncctlError
 

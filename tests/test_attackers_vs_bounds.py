@@ -10,15 +10,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from encctl_gym.agents import GaussianAttacker, OptimalDesignAttacker, rollout
-from encctl_gym.agents.evaluate import budget_config
-from encctl_gym.experiments import compare as cmp
-from encctl_gym.experiments.compare.cli import QUICK_EPISODES
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from encctl_gym import cli
+from encctl_gym.agents import GaussianAttacker, OptimalDesignAttacker, rollout
+from encctl_gym.agents.evaluate import budget_config
 from encctl_gym.errors import ConfigError
+from encctl_gym.experiments import compare as cmp
+from encctl_gym.experiments.compare.cli import QUICK_EPISODES
 from encctl_gym.security.design import optimal_security_parameter, sample_size_for_rate
 
 
@@ -305,6 +305,7 @@ def test_the_kernels_are_warmed_before_the_progress_bar_starts(monkeypatch):
     """The bar's rate, and so its ETA, must not include compile time: one short episode of every
     setting is played before the bar is made, and the results do not depend on it."""
     import tqdm
+
     from encctl_gym.experiments.compare import protocol
 
     events: list[str] = []

@@ -10,7 +10,6 @@ import random
 import mpmath
 import numpy as np
 import pytest
-from encctl_gym.experiments import deciphering_time, reproduce
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -20,6 +19,7 @@ from encctl_gym.cryptanalysis.index_calculus import choose_bound, cost_model, re
 from encctl_gym.cryptanalysis.linalg import solve_mod_prime
 from encctl_gym.cryptanalysis.smoothness import FactorBase, dickman_rho, primes_up_to, rational_reconstruction
 from encctl_gym.errors import ParameterError
+from encctl_gym.experiments import deciphering_time, reproduce
 
 
 # ----------------------------------------------------------------------------- crack
@@ -481,8 +481,9 @@ def test_lattice_sieve_pairs_satisfy_the_congruence() -> None:
 
 # ----------------------------------------------------------------------------- L_p[1/2, c] fit, large sizes
 def test_lp_half_fit_against_scipy_linregress() -> None:
-    from encctl_gym.experiments.deciphering_models import fit_lp_half, lp_half_exponent
     from scipy import stats
+
+    from encctl_gym.experiments.deciphering_models import fit_lp_half, lp_half_exponent
 
     bits = [64, 72, 80, 88, 96, 112, 128]
     x = np.array([math.sqrt(b * math.log(2) * math.log(b * math.log(2))) for b in bits])

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from encctl_gym.experiments import design_example, fig1_variance_ratio, fig2_gramian, reproduce
-from encctl_gym.experiments.common import COLUMNS, QUICK, GridConfig, Table, read_csv
 
 from encctl_gym import cli
+from encctl_gym.experiments import design_example, fig1_variance_ratio, fig2_gramian, reproduce
+from encctl_gym.experiments.common import COLUMNS, QUICK, GridConfig, Table, read_csv
 from encctl_gym.security.complexity import input_upper_bound
 
 REPO = Path(__file__).resolve().parents[1]

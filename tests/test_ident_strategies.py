@@ -7,11 +7,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
+from encctl_gym.errors import ParameterError
 from encctl_gym.experiments import identification_strategies as strat
 from encctl_gym.experiments import reproduce
 from encctl_gym.experiments.compare.settings import make_setting
-
-from encctl_gym.errors import ParameterError
 
 
 def test_table_sizes_and_grid_reach_n_star_of_the_design_example() -> None:

@@ -12,11 +12,11 @@ import pytest
 
 pytest.importorskip("pettingzoo")
 
-from encctl_gym.agents.evaluate import budget_config, env_config  # noqa: E402
-from encctl_gym.agents.game import defender_action  # noqa: E402
 from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
 
 import encctl_gym  # noqa: E402,F401
+from encctl_gym.agents.evaluate import budget_config, env_config  # noqa: E402
+from encctl_gym.agents.game import defender_action  # noqa: E402
 from encctl_gym.errors import ParameterError  # noqa: E402
 from encctl_gym.loop.backend import lqr_gain  # noqa: E402
 from encctl_gym.loop.defenses import audit_tolerance  # noqa: E402

@@ -76,10 +76,9 @@ def test_register_refuses_duplicates_and_nameless_entries_and_decorates() -> Non
 
 def test_every_registry_of_the_package_is_one_registry() -> None:
     from encctl_gym.agents.features import FEATURES
-    from encctl_gym.experiments.compare.attackers import ATTACKERS
-
     from encctl_gym.cryptanalysis import BREAKERS
     from encctl_gym.envs.rewards import REWARDS
+    from encctl_gym.experiments.compare.attackers import ATTACKERS
     from encctl_gym.ident import ESTIMATORS
     from encctl_gym.presets import PRESETS
     from encctl_gym.security.cost_models import DECIPHERING_MODELS

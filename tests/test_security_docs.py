@@ -8,6 +8,7 @@ import re
 from pathlib import Path
 
 import pytest
+
 from encctl_gym.experiments import design_example
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -17,11 +17,11 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
+
+from encctl_gym._validation import format_value
 from encctl_gym.agents import Attacker, ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker, PRBSAttacker
 from encctl_gym.agents.evaluate import budget_config
 from encctl_gym.agents.runs import RUN_FILE, RunInfo
-
-from encctl_gym._validation import format_value
 from encctl_gym.envs.config import AttackParams, resolve_params
 from encctl_gym.errors import ConfigError, EncctlError
 from encctl_gym.registry import Registry

@@ -23,9 +23,8 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from encctl_gym.agents.runs import MODEL_FILES, check_output_dir, find_runs
-
 from encctl_gym._validation import format_value
+from encctl_gym.agents.runs import MODEL_FILES, check_output_dir, find_runs
 from encctl_gym.errors import ConfigError
 
 from .attackers import ATTACKERS, left_out

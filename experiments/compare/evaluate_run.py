@@ -35,7 +35,6 @@ from typing import Any
 from encctl_gym.agents import Attacker
 from encctl_gym.agents.runs import MODEL_FILES, RunInfo, check_output_dir, read_run
 from encctl_gym.agents.sb3 import load_attacker  # the [rl] extra: without it the CLI says which extra to install
-
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ConfigError
 
@@ -62,7 +61,6 @@ def resolution_lines(result: Result, learned: Sequence[str], *, target: float = 
     interval), to the Gaussian attack, and ``E[eps] / gamma_opt(N)`` (the median where the mean
     is not reliable), each by :func:`agents.resolution.resolution_line`."""
     from encctl_gym.agents.resolution import median_resolution, paired_resolution, reference_resolution, resolution_line
-
     from encctl_gym.ident.tails import error_tail_exponent
 
     out = []

@@ -28,11 +28,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from encctl_gym._validation import format_value
 from encctl_gym.agents import Attacker, GaussianAttacker, rollout
 from encctl_gym.agents.evaluate import budget_config, elgamal_config
 from encctl_gym.agents.runs import RunInfo, read_run
-
-from encctl_gym._validation import format_value
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.resources import check_memory
 from encctl_gym.sim.montecarlo import log_grid

@@ -16,9 +16,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from encctl_gym.agents.evaluate import budget_config
 
 from encctl_gym._validation import format_value
+from encctl_gym.agents.evaluate import budget_config
 from encctl_gym.envs.config import AttackParams, resolve_params
 from encctl_gym.errors import ConfigError
 from encctl_gym.security.attack_design import AttackDesign, gaussian_attack_design, optimal_attack_design
@@ -133,7 +133,6 @@ def system_entry(entry: str) -> tuple[str, dict[str, Any] | None]:
     from pathlib import Path
 
     from encctl_gym.agents.config import plant_config
-
     from encctl_gym.envs.config import completion_preset
     from encctl_gym.plant_file import SUFFIXES
     from encctl_gym.presets import PRESETS, preset_names
