@@ -321,7 +321,7 @@ def test_the_generic_model_is_unchanged_by_rotation():
 
 @pytest.mark.slow
 def test_the_rotation_table_counts_one_precomputation_per_group():
-    from encctl_gym.experiments.defenses import format_rotation, rotation_rows
+    from encctl_gym.experiments.defenses_rotation import format_rotation, rotation_rows
 
     rows = rotation_rows(samples=12, seed=1)
     ks = [r["k_star_precomputation"] for r in rows["design"]]
