@@ -14,11 +14,12 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import as_finite_array, check_int, check_nonnegative
-from ..errors import ParameterError, ShapeError
+from .._validation import check_int, check_nonnegative
+from ..errors import ParameterError
 from ..ident.grid import identification_errors
 from ..ident.least_squares import prefix_estimates
 from ..ident.subspace import arx, markov_error, moesp, n4sid
+from ..plant import check_output_matrix, observable_order
 from .plant import LinearPlant, simulate_gaussian_attack
 
 __all__ = ["OUTPUT_ESTIMATORS", "check_output_matrix", "output_attack_errors"]
@@ -36,24 +37,6 @@ OUTPUT_ESTIMATORS = {
     "moesp": lambda u, y, order: moesp(u, y, order=order),
     "arx": _arx,
 }
-
-
-def check_output_matrix(C: Any, n: int) -> np.ndarray:
-    """``C`` as a ``(p, n)`` float matrix; refuses another width."""
-    C = as_finite_array("C", C, ndim=2)
-    if C.shape[1] != n or C.shape[0] < 1:
-        raise ShapeError(f"C must have shape (p, {n}) with p >= 1, got {C.shape}")
-    return C
-
-
-def _observable_order(A: np.ndarray, C: np.ndarray) -> int:
-    """The rank of the observability matrix ``[C; C A; ...; C A^{n-1}]``."""
-    n = A.shape[0]
-    blocks, X = [], C
-    for _ in range(n):
-        blocks.append(X)
-        X = X @ A
-    return int(np.linalg.matrix_rank(np.vstack(blocks)))
 
 
 def output_attack_errors(
@@ -115,7 +98,7 @@ def output_attack_errors(
         raise ParameterError("sample_sizes must be a strictly increasing 1-D sequence")
     grid = np.array([check_int("sample size", int(v), minimum=2) for v in grid])
     runs = check_int("runs", runs, minimum=1)
-    observable = _observable_order(plant.A, C)
+    observable = observable_order(plant.A, C)
     order = observable if order is None else check_int("order", order, minimum=1)
     if order > observable:
         raise ParameterError(
