@@ -127,6 +127,16 @@ def default_config() -> dict[str, Any]:
     ``defender``                  the plant side's policy (:mod:`encctl_gym.loop.defender`): a
                                   name of ``DEFENDERS`` (``"fixed"``: the paper's fixed defender)
                                   or an object implementing ``DefenderPolicy``
+    ``observe``                   ``"state"`` (the paper's: the plant sends ``x``) or
+                                  ``"output"``: the plant sends ``y = C x + v``, the loop runs
+                                  on outputs and the attacker deciphers outputs only
+                                  (:mod:`encctl_gym.envs.output_episode`)
+    ``C``, ``sigma_v2``           sensors and measurement noise of ``observe="output"``
+                                  (preset's, else ``C = I`` and ``sigma_v2 = 0``); ``(A, C)``
+                                  observable
+    ``controller``                the loop's controller on outputs
+                                  (:mod:`encctl_gym.loop.output_feedback`): ``"static"``
+                                  (``u = Phi y``) or ``"lqg"`` (observer-based, dynamic)
     ============================  ==============================================================
     """
     return {
@@ -162,6 +172,10 @@ def default_config() -> dict[str, Any]:
         "gamma_opt": True,
         "crypto_seed": None,
         "defender": "fixed",
+        "observe": "state",
+        "C": None,
+        "sigma_v2": None,
+        "controller": "static",
     }
 
 
@@ -210,6 +224,15 @@ class AttackParams:
     sources: dict[str, str] = field(default_factory=dict)  # where A, B, the variances and design values came from
     defender: Any = "fixed"  # the defender policy specification (a name or a policy object), checked
     horizon_capped: bool = False  # no max_samples and a budget beyond MAX_DEFAULT_HORIZON: N is that cap
+    observe: str = "state"  # "state" (x is sent) or "output" (y = C x + v is sent: envs.output_episode)
+    C: np.ndarray | None = None  # the sensors of observe="output" (None: the state is sent)
+    sigma_v2: float = 0.0  # measurement noise variance of observe="output"
+    controller: str = "static"  # the loop's controller on outputs (loop.output_feedback.CONTROLLERS)
+
+    @property
+    def observed_dim(self) -> int:
+        """Length of what the plant sends and the attacker deciphers: ``p`` for outputs, else ``n``."""
+        return self.n if self.C is None else int(self.C.shape[0])
 
     def warn_if_capped(self) -> None:
         """Warn (once per environment, when it is made) that the attack length is the default cap
@@ -505,6 +528,9 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         crypto_seed = check_int("crypto_seed", crypto_seed, minimum=0)
     defender = cfg["defender"]
     make_defender(defender)  # an unknown name or an object that is no policy fails here
+    from .output_episode import resolve_output
+
+    output = resolve_output(cfg, preset, A, B, estimator=estimator, reward=reward, defender=defender)
     return AttackParams(
         A=A,
         B=B,
@@ -546,4 +572,5 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         sources=sources,
         defender=defender,
         horizon_capped=max_samples is None and horizon < budget,
+        **output,
     )

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from .backend import lqr_gain
+from .output_feedback import controller_matrix
 
 __all__ = ["ElGamalLoop", "party_random_sources"]
 
@@ -84,11 +84,11 @@ class ElGamalLoop:
 
         self.params = params
         self.group = group
-        self.n, self.m = params.n, params.m
         self.scheme = params.scheme
         self._scheme = get_scheme(params.scheme)
         self.encoder = Encoder(group, float(params.delta))
-        self.Phi = -lqr_gain(params.A, params.B)
+        self.Phi = controller_matrix(params)  # -K_lqr on x, or the output controller on [x_c; y]
+        self.n, self.m = self.Phi.shape[1], params.m  # n: the controller's input xi (x, y or [x_c; y])
         #: each party's random source (privileged: who holds which randomness), see :func:`party_random_sources`
         self.random_sources = party_random_sources(params.crypto_seed)
         from ..attacks.decipherer import make_decipherer
