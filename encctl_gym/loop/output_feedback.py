@@ -110,21 +110,24 @@ def _lq_cost(A: np.ndarray, B: np.ndarray, C: np.ndarray, F: np.ndarray) -> tupl
     return float(np.trace(P)), P, Acl
 
 
-def static_output_feedback(A: Any, B: Any, C: Any, *, max_iter: int = 2000, tol: float = 1e-9) -> np.ndarray:
+def static_output_feedback(A: Any, B: Any, C: Any, *, max_iter: int = 500, tol: float = 1e-9) -> np.ndarray:
     """The LQ-optimal stabilising static output feedback ``u = Phi y`` (module docstring).
 
     Minimises ``J(Phi) = tr P`` with ``P = A_cl^T P A_cl + I + C^T Phi^T Phi C``,
-    ``A_cl = A + B Phi C``; the gradient is ``2 (Phi C + B^T P A_cl) L C^T`` with
-    ``L = A_cl L A_cl^T + I``. A step is accepted when the closed loop stays stable and the
-    cost decreases by Armijo's rule; the descent stops when the gradient's norm falls below
-    ``tol (1 + ||Phi||)`` or the step below 1e-14.
+    ``A_cl = A + B Phi C``. Its gradient is ``2 [(I + B^T P B) Phi C L C^T + B^T P A L C^T]`` with
+    ``L = A_cl L A_cl^T + I``; each iteration moves towards the gain that zeroes it with ``P`` and
+    ``L`` held (Moerder and Calise's iteration, ``Phi_+ = -(I + B^T P B)^{-1} B^T P A L C^T (C L
+    C^T)^{-1}``), with a step halved until the closed loop stays stable and the cost decreases,
+    and falls back to the negative gradient where that direction does not descend. It stops when
+    the gradient's norm falls below ``tol (1 + ||Phi||)``, no step decreases the cost, or after
+    ``max_iter`` iterations.
 
     Parameters
     ----------
     A, B, C : array_like
         Plant ``(n, n)``, ``(n, m)`` and sensors ``(p, n)``.
     max_iter : int
-        Largest number of gradient steps.
+        Largest number of iterations.
     tol : float
         Relative stopping tolerance on the gradient.
 
@@ -139,7 +142,8 @@ def static_output_feedback(A: Any, B: Any, C: Any, *, max_iter: int = 2000, tol:
     """
     A, B, C = (np.asarray(M, dtype=float) for M in (A, B, C))
     max_iter = check_int("max_iter", max_iter, minimum=0)
-    start = [-lqr_gain(A, B) @ np.linalg.pinv(C), np.zeros((B.shape[1], C.shape[0]))]
+    n, m = A.shape[0], B.shape[1]
+    start = [-lqr_gain(A, B) @ np.linalg.pinv(C), np.zeros((m, C.shape[0]))]
     scored = [(cost, F) for F in start if (cost := _lq_cost(A, B, C, F)) is not None]
     if not scored:
         raise SolverError(
@@ -147,22 +151,25 @@ def static_output_feedback(A: Any, B: Any, C: Any, *, max_iter: int = 2000, tol:
             f"(spectral radius of A = {spectral_radius(A):.4g}); the plant may need a dynamic controller (controller='lqg')"
         )
     (J, P, Acl), F = min(scored, key=lambda s: s[0][0])
-    step = 1.0
     for _ in range(max_iter):
-        Lc = scipy.linalg.solve_discrete_lyapunov(Acl, np.eye(A.shape[0]))
-        grad = 2.0 * (F @ C + B.T @ P @ Acl) @ Lc @ C.T
-        g2 = float(np.sum(grad**2))
-        if np.sqrt(g2) <= tol * (1.0 + float(np.linalg.norm(F))):
+        Lc = scipy.linalg.solve_discrete_lyapunov(Acl, np.eye(n))
+        H = np.eye(m) + B.T @ P @ B
+        grad = 2.0 * (H @ F @ C + B.T @ P @ A) @ Lc @ C.T
+        if np.linalg.norm(grad) <= tol * (1.0 + float(np.linalg.norm(F))):
             break
-        while step > 1e-14:
-            trial = F - step * grad
-            res = _lq_cost(A, B, C, trial)
-            if res is not None and res[0] <= J - 1e-4 * step * g2:
-                F, (J, P, Acl) = trial, res
-                step *= 2.0
+        target = -np.linalg.solve(H, B.T @ P @ A @ Lc @ C.T) @ np.linalg.pinv(C @ Lc @ C.T)
+        moved = False
+        for direction in (target - F, -grad / max(float(np.linalg.norm(grad)), 1e-300)):
+            step = 1.0
+            while step > 1e-12:
+                res = _lq_cost(A, B, C, F + step * direction)
+                if res is not None and res[0] < J:
+                    F, (J, P, Acl), moved = F + step * direction, res, True
+                    break
+                step *= 0.5
+            if moved:
                 break
-            step *= 0.5
-        else:
+        if not moved:
             break
     return F
 
@@ -191,6 +198,9 @@ def lqg_controller(A: Any, B: Any, C: Any, *, sigma_w2: float, sigma_v2: float) 
     return OutputController(A - B @ K - L @ C, L, -K, np.zeros((B.shape[1], p)), "lqg")
 
 
+_CONTROLLER_CACHE: dict[tuple[Any, ...], OutputController] = {}
+
+
 def loop_controller(params: Any) -> OutputController:
     """The controller of the loop of ``params`` (the one function both backends take it from).
 
@@ -202,11 +212,21 @@ def loop_controller(params: Any) -> OutputController:
     if C is None:
         return OutputController.static(-lqr_gain(params.A, params.B), kind="state")
     kind = getattr(params, "controller", "static")
+    sv = float(getattr(params, "sigma_v2", 0.0))
+    A, B, C = (np.ascontiguousarray(M, dtype=float) for M in (params.A, params.B, C))
+    key = (kind, A.shape, B.shape, C.shape, A.tobytes(), B.tobytes(), C.tobytes(), float(params.sigma_w2), sv)
+    if key in _CONTROLLER_CACHE:  # the backend and the episode design the same controller once
+        return _CONTROLLER_CACHE[key]
     if kind == "static":
-        return OutputController.static(static_output_feedback(params.A, params.B, C))
-    if kind == "lqg":
-        return lqg_controller(params.A, params.B, C, sigma_w2=params.sigma_w2, sigma_v2=getattr(params, "sigma_v2", 0.0))
-    raise ParameterError(f"unknown controller {format_value(kind)}; choose one of {', '.join(CONTROLLERS)}")
+        ctrl = OutputController.static(static_output_feedback(A, B, C))
+    elif kind == "lqg":
+        ctrl = lqg_controller(A, B, C, sigma_w2=params.sigma_w2, sigma_v2=sv)
+    else:
+        raise ParameterError(f"unknown controller {format_value(kind)}; choose one of {', '.join(CONTROLLERS)}")
+    if len(_CONTROLLER_CACHE) > 64:
+        _CONTROLLER_CACHE.clear()
+    _CONTROLLER_CACHE[key] = ctrl
+    return ctrl
 
 
 def controller_matrix(params: Any) -> np.ndarray:
