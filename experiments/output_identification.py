@@ -5,7 +5,11 @@ For the design example (preset ``paper-example``) and Figure 1 (c) (``fig1-c``),
 Gaussian attack is measured through ``y = C x + v`` with ``C = I`` (every state), ``C = [I 0]``
 (half the states) and one output ``C = [1 1 1 1]``, each with ``sigma_v2 = 0`` and
 ``sigma_v2 = sigma_w2``, and identified by N4SID, PO-MOESP and ARX
-(:mod:`encctl_gym.ident.subspace`). Every estimate is scored by the basis-free Markov-parameter
+(:mod:`encctl_gym.ident.subspace`). Two more open-loop attackers, which need no state either
+(:data:`~encctl_gym.sim.output.OUTPUT_ATTACKS`), are identified by N4SID and ARX: random binary
+inputs (PRBS) and the A-optimal open-loop attack design (``optimal-ol``, designed for the state
+case with the true plant: where it applies, an oracle). The closed-loop optimal design needs the
+state and does not apply. Every estimate is scored by the basis-free Markov-parameter
 error (:func:`~encctl_gym.ident.subspace.markov_error`); least squares on the states gives the
 reference, in the same error.
 
@@ -37,11 +41,15 @@ from encctl_gym.plotting import legend_below, save_figure
 from encctl_gym.presets import get_preset
 from encctl_gym.security.design import design_security_parameter
 from encctl_gym.security.empirical import empirical_design, fit_empirical_complexity
-from encctl_gym.sim.output import OUTPUT_ESTIMATORS, output_attack_errors
+from encctl_gym.sim.output import OUTPUT_ATTACKS, OUTPUT_ESTIMATORS, output_attack_errors
 from encctl_gym.sim.plant import LinearPlant
 
 SYSTEMS = ("paper-example", "fig1-c")
 OUTPUTS = {"C = I": np.eye(4), "C = [I 0]": np.eye(4)[:2], "one output": np.ones((1, 4))}
+#: The estimators each attack is identified by: every one for the paper's Gaussian attack, the
+#: cheapest subspace method and the baseline for the others.
+ESTIMATORS_OF = {"gaussian": tuple(OUTPUT_ESTIMATORS), "prbs": ("n4sid", "arx"), "optimal-ol": ("n4sid", "arx")}
+assert set(ESTIMATORS_OF) == set(OUTPUT_ATTACKS)
 
 
 def run(runs: int, points: int, n_max: int | None, seed: int) -> list[dict[str, Any]]:
@@ -60,21 +68,27 @@ def run(runs: int, points: int, n_max: int | None, seed: int) -> list[dict[str, 
         target = float(ls_fit(paper.N_star))
         base = empirical_design(ls_fit, p.threat(), gamma_c=target)
         rows.append(
-            _row(system, "states (least squares)", 0.0, "ls", grid, ref["state_ls_markov"], ls_fit, base, paper.N_star, target)
-        )
+            _row(
+                system, "states (least squares)", 0.0, "gaussian", "ls", grid, ref["state_ls_markov"], ls_fit, base,
+                paper.N_star, target,
+            )
+        )  # fmt: skip
         for label, C in OUTPUTS.items():
             for sv in (0.0, p.sigma_w2):
-                for est in OUTPUT_ESTIMATORS:
-                    out = output_attack_errors(
-                        plant, C, sample_sizes=grid, runs=runs, sigma_u2=p.sigma_u2, sigma_v2=sv, seed=seed, estimator=est
-                    )
-                    fit = fit_empirical_complexity(grid, out["markov"])
-                    d: Any
-                    try:
-                        d = empirical_design(fit, p.threat(), gamma_c=target)
-                    except EncctlError as exc:  # a rate that does not decrease: reported, not designed
-                        d = exc
-                    rows.append(_row(system, label, sv, est, grid, out["markov"], fit, d, paper.N_star, target))
+                for attack, estimators in ESTIMATORS_OF.items():
+                    for est in estimators:
+                        out = output_attack_errors(
+                            plant, C, sample_sizes=grid, runs=runs, sigma_u2=p.sigma_u2, sigma_v2=sv, seed=seed,
+                            estimator=est, attack=attack,
+                        )  # fmt: skip
+                        fit = fit_empirical_complexity(grid, out["markov"])
+                        d: Any
+                        try:
+                            d = empirical_design(fit, p.threat(), gamma_c=target)
+                        except EncctlError as exc:  # a rate that does not decrease: reported, not designed
+                            d = exc
+                        rows.append(_row(system, label, sv, attack, est, grid, out["markov"], fit, d, paper.N_star, target))
+                        print(f"  {system}, {label}, sigma_v2 = {sv:g}, {attack}, {est}: a = {fit.a:.3f}", file=sys.stderr)
     return rows
 
 
@@ -82,6 +96,7 @@ def _row(
     system: str,
     output: str,
     sigma_v2: float,
+    attack: str,
     estimator: str,
     grid: np.ndarray,
     errors: np.ndarray,
@@ -94,6 +109,7 @@ def _row(
         "system": system,
         "output": output,
         "sigma_v2": sigma_v2,
+        "attack": attack,
         "estimator": estimator,
         "runs": errors.shape[0],
         "N": grid.tolist(),
@@ -126,8 +142,8 @@ def _row(
 def format_table(rows: list[dict[str, Any]]) -> str:
     """The markdown table of the rows."""
     head = (
-        "| system | measured | sigma_v2 | estimator | rate a [95 %] | N* [95 %] | k* (paper model) [95 %] |\n"
-        "|---|---|---|---|---|---|---|"
+        "| system | measured | sigma_v2 | attack | estimator | rate a [95 %] | N* [95 %] | k* (paper model) [95 %] |\n"
+        "|---|---|---|---|---|---|---|---|"
     )
     lines = [head]
     for r in rows:
@@ -138,7 +154,7 @@ def format_table(rows: list[dict[str, Any]]) -> str:
             ns = f"{r['N_star']} [{r['N_star_low']}, {r['N_star_high']}]{ext}"
             ks = f"{r['k_star']} [{r['k_star_low']}, {r['k_star_high']}]"
         lines.append(
-            f"| {r['system']} | {r['output']} | {r['sigma_v2']:g} | {r['estimator']} | "
+            f"| {r['system']} | {r['output']} | {r['sigma_v2']:g} | {r['attack']} | {r['estimator']} | "
             f"{r['a']:.3f} [{r['a_low']:.3f}, {r['a_high']:.3f}] | {ns} | {ks} |"
         )
     return "\n".join(lines)
@@ -180,7 +196,7 @@ def write(rows: list[dict[str, Any]], out: Path) -> list[Path]:
             ax = axes[i, j]
             ax.plot(ref["N"], ref["mean"], color="k", lw=1.6, label="states, least squares")
             for r in rows:
-                if r["system"] == system and r["output"] == label:
+                if r["system"] == system and r["output"] == label and r["attack"] == "gaussian":
                     ax.plot(
                         r["N"],
                         r["mean"],
@@ -189,6 +205,23 @@ def write(rows: list[dict[str, Any]], out: Path) -> list[Path]:
                         marker="o",
                         ms=2.5,
                         label=f"{r['estimator']}, sigma_v2 = {r['sigma_v2']:g}",
+                    )
+            for r in rows:  # the optimal open-loop attack, N4SID, noise-free sensors
+                if (r["system"], r["output"], r["attack"], r["estimator"], r["sigma_v2"]) == (
+                    system,
+                    label,
+                    "optimal-ol",
+                    "n4sid",
+                    0,
+                ):
+                    ax.plot(
+                        r["N"],
+                        r["mean"],
+                        color="tab:purple",
+                        ls="-.",
+                        marker="s",
+                        ms=2.5,
+                        label="n4sid, optimal-ol attack, sigma_v2 = 0",
                     )
             ax.axhline(ref["target"], color="0.5", lw=0.8, ls=":", label="target (states at the paper's N*)")
             ax.set(xscale="log", yscale="log", title=f"{system}: {label}")
