@@ -90,3 +90,17 @@ def test_design_command_prints_the_output_design_beside_the_state_design(capsys,
     assert main(["design", str(f), "--estimator", "nope"]) == 2
     assert main(["design", str(f), "--runs", "3"]) == 2
     assert "only applies with --estimator" in capsys.readouterr().err
+
+
+def test_output_attacks_have_the_gaussian_attacks_power():
+    from encctl_gym.sim.output import attack_inputs
+    from encctl_gym.sim.plant import LinearPlant
+
+    p = get_preset("small")
+    plant = LinearPlant(p.A, p.B, sigma_w2=p.sigma_w2)
+    u = attack_inputs(plant, "prbs", N=500, runs=4, sigma_u2=2.0, seed=1)
+    np.testing.assert_array_equal(np.abs(u), np.sqrt(2.0))  # +-sigma_u: power sigma_u2 exactly
+    u = attack_inputs(plant, "optimal-ol", N=4000, runs=8, sigma_u2=2.0, seed=1)
+    assert np.mean(u**2) == pytest.approx(2.0, rel=0.05)  # the design's power constraint, stationary from t = 0
+    with pytest.raises(ParameterError, match="unknown attack"):
+        attack_inputs(plant, "chirp", N=10, runs=1, sigma_u2=1.0, seed=0)
