@@ -50,10 +50,11 @@ OUTPUTS = {"C = I": np.eye(4), "C = [I 0]": np.eye(4)[:2], "one output": np.ones
 #: cheapest subspace method and the baseline for the others.
 ESTIMATORS_OF = {"gaussian": tuple(OUTPUT_ESTIMATORS), "prbs": ("n4sid", "arx"), "optimal-ol": ("n4sid", "arx")}
 assert set(ESTIMATORS_OF) == set(OUTPUT_ATTACKS)
+ATTACK_COLORS = {"prbs": "tab:red", "optimal-ol": "tab:purple"}
 
 
-def run(runs: int, points: int, n_max: int | None, seed: int) -> list[dict[str, Any]]:
-    """Every case of the module docstring: one row each (the numbers of the table and figure)."""
+def run(runs: int, points: int, n_max: int | None, seed: int, attacks: tuple[str, ...] = OUTPUT_ATTACKS) -> list[dict[str, Any]]:
+    """Every case of the module docstring for ``attacks``: one row each (the numbers of the table and figure)."""
     rows: list[dict[str, Any]] = []
     for system in SYSTEMS:
         p = get_preset(system)
@@ -75,8 +76,8 @@ def run(runs: int, points: int, n_max: int | None, seed: int) -> list[dict[str, 
         )  # fmt: skip
         for label, C in OUTPUTS.items():
             for sv in (0.0, p.sigma_w2):
-                for attack, estimators in ESTIMATORS_OF.items():
-                    for est in estimators:
+                for attack in attacks:
+                    for est in ESTIMATORS_OF[attack]:
                         out = output_attack_errors(
                             plant, C, sample_sizes=grid, runs=runs, sigma_u2=p.sigma_u2, sigma_v2=sv, seed=seed,
                             estimator=est, attack=attack,
@@ -160,7 +161,7 @@ def format_table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
-def write(rows: list[dict[str, Any]], out: Path) -> list[Path]:
+def write(rows: list[dict[str, Any]], out: Path, command: str = "python -m experiments.output_identification") -> list[Path]:
     """CSV, markdown and figure of the rows into ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     fields = [k for k in rows[0] if k not in ("N", "median", "mean")]
@@ -175,7 +176,7 @@ def write(rows: list[dict[str, Any]], out: Path) -> list[Path]:
             )
     md = out / "output_identification.md"
     md.write_text(
-        "# Identification from outputs\n\nCommand: `python -m experiments.output_identification`"
+        f"# Identification from outputs\n\nCommand: `{command}`"
         f" ({rows[0]['runs']} runs per case). Target: the state least-squares Markov error at the paper's N*.\n\n"
         + format_table(rows)
         + "\n"
@@ -279,6 +280,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--quick", action="store_true", help="4 runs, 4 points up to N = 2000")
     parser.add_argument("--out", type=Path, default=Path("results/output_identification"))
+    parser.add_argument(
+        "--attacks",
+        default=",".join(OUTPUT_ATTACKS),
+        help=f"comma-separated attacks to run (default all: {','.join(OUTPUT_ATTACKS)})",
+    )
     parser.add_argument("--sic-check", action="store_true", help="only the check of eq:sic against the exact mean (sic_check.md)")
     args = parser.parse_args(argv)
     if args.sic_check:
@@ -288,12 +294,20 @@ def main(argv: list[str] | None = None) -> int:
         print(text + f"  wrote {args.out / 'sic_check.md'}")
         return 0
     runs, points, n_max = (4, 4, 2000) if args.quick else (args.runs, args.points, None)
+    attacks = tuple(a.strip() for a in args.attacks.split(","))
+    if not attacks or any(a not in OUTPUT_ATTACKS for a in attacks):
+        print(
+            f"output_identification: --attacks must name some of {', '.join(OUTPUT_ATTACKS)}, got {args.attacks!r}",
+            file=sys.stderr,
+        )
+        return 2
     if runs < 2 or points < 3:  # an interval needs two runs, a fitted rate three sizes
         print(f"output_identification: --runs must be >= 2 and --points >= 3, got {runs} and {points}", file=sys.stderr)
         return 2
     try:
-        rows = run(runs, points, n_max, args.seed)
-        paths = write(rows, args.out)
+        rows = run(runs, points, n_max, args.seed, attacks)
+        shown = " ".join(argv if argv is not None else sys.argv[1:])
+        paths = write(rows, args.out, f"python -m experiments.output_identification {shown}".strip())
     except EncctlError as exc:
         print(f"output_identification: {exc}", file=sys.stderr)
         return 2
