@@ -20,7 +20,8 @@ def:adversary, the same budget rules as :class:`~encctl_gym.envs.episode.Episode
 
 ``epsilon`` (``info``, privileged) is the **Markov-parameter error**
 (:func:`~encctl_gym.ident.subspace.markov_error`, ``L = MARKOV_LENGTH``) of the ARX estimate against
-the true ``(A, B, C, 0)``; the estimate ``0`` before the regressors have full rank (``epsilon = 1``).
+the true ``(A, B, C, 0)``; the estimate ``0`` (``epsilon = 1``) until the scaled Gram matrix of the
+regressors has a condition number below :data:`COND_LIMIT`.
 The reward ``log_error`` is its decrease, ``log epsilon_{k-1} - log epsilon_k``: the basis-free
 error replaces Definition def:error, which needs the state. ``gamma`` and ``gamma_opt`` stay
 those of the state-measured attack (eq:sic and the optimal design), as references.
@@ -55,6 +56,11 @@ __all__ = ["OBSERVE", "MARKOV_LENGTH", "OutputEpisode", "resolve_output"]
 OBSERVE: tuple[str, ...] = ("state", "output")
 #: ``L`` of the Markov-parameter error behind ``epsilon`` with outputs.
 MARKOV_LENGTH = 20
+#: A copy's ARX estimate is taken once the condition number of its regressors' Gram matrix,
+#: scaled to unit diagonal, is below this (as the state case's ``EpisodeSchedule.cond_limit``):
+#: inputs that barely excite the plant (an attacker forging zeros) give a Gram matrix of full
+#: rank whose solve is noise, with Markov errors of 1e60.
+COND_LIMIT = 1e10
 
 
 def resolve_output(
@@ -241,10 +247,11 @@ class OutputEpisode:
         return True
 
     def _estimate(self) -> None:
-        """``epsilon`` of the ARX least-squares estimate where its Gram matrix has full rank."""
+        """``epsilon`` of the ARX least-squares estimate where its scaled Gram matrix is well conditioned."""
         if self.delivered - self.lags < self._d:
             return
-        ok = np.linalg.matrix_rank(self.G) == self._d
+        scale = np.sqrt(np.maximum(np.einsum("kii->ki", self.G), np.finfo(float).tiny))
+        ok = np.linalg.cond(self.G / scale[:, :, None] / scale[:, None, :]) < COND_LIMIT
         if not ok.any():
             return
         theta = np.linalg.solve(self.G[ok], self.Cr[ok])  # (k, d, p): [a_1^T .. a_L^T, b_1^T .. b_L^T]
