@@ -207,23 +207,11 @@ def write(rows: list[dict[str, Any]], out: Path, command: str = "python -m exper
                         ms=2.5,
                         label=f"{r['estimator']}, sigma_v2 = {r['sigma_v2']:g}",
                     )
-            for r in rows:  # the optimal open-loop attack, N4SID, noise-free sensors
-                if (r["system"], r["output"], r["attack"], r["estimator"], r["sigma_v2"]) == (
-                    system,
-                    label,
-                    "optimal-ol",
-                    "n4sid",
-                    0,
-                ):
-                    ax.plot(
-                        r["N"],
-                        r["mean"],
-                        color="tab:purple",
-                        ls="-.",
-                        marker="s",
-                        ms=2.5,
-                        label="n4sid, optimal-ol attack, sigma_v2 = 0",
-                    )
+            for r in rows:  # the other attacks: N4SID on noise-free sensors
+                other = r["attack"] != "gaussian" and r["estimator"] == "n4sid" and r["sigma_v2"] == 0
+                if other and (r["system"], r["output"]) == (system, label):
+                    ax.plot(r["N"], r["mean"], color=ATTACK_COLORS[r["attack"]], ls="-.", marker="s", ms=2.5,
+                            label=f"n4sid, {r['attack']} attack, sigma_v2 = 0")  # fmt: skip
             ax.axhline(ref["target"], color="0.5", lw=0.8, ls=":", label="target (states at the paper's N*)")
             ax.set(xscale="log", yscale="log", title=f"{system}: {label}")
             ax.grid(True, which="major", alpha=0.3)
