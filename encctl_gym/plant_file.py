@@ -7,6 +7,10 @@ field        required  meaning
 ===========  ========  ============================================================
 ``A``        yes       n x n system matrix (Schur stable for a design)
 ``B``        yes       n x m input matrix (a flat list of n numbers is one column)
+``C``        no        p x n output matrix of ``y = C x + v`` (a flat list of n
+                       numbers is one output); ``(A, C)`` observable. Without it
+                       the state is measured
+``sigma_v2`` no        measurement noise variance of ``v`` (>= 0, default 0)
 ``sigma_u2`` no        attack input power per channel (variance, > 0)
 ``sigma_w2`` no        process noise variance (> 0)
 ``sigma_x2`` no        variance of x_0 (>= 0)
@@ -61,8 +65,10 @@ from .units import parse_duration
 
 __all__ = ["PlantSpec", "load_plant_file", "load_system", "PLANT_FIELDS", "MAX_FILE_BYTES", "MAX_YAML_NODES", "SUFFIXES"]
 
+#: The fields of the measurement ``y = C x + v`` (optional; without them the state is measured).
+OUTPUT_FIELDS: tuple[str, ...] = ("C", "sigma_v2")
 #: Every field a plant file may hold.
-PLANT_FIELDS: tuple[str, ...] = ("A", "B", *DESIGN_FIELDS)
+PLANT_FIELDS: tuple[str, ...] = ("A", "B", *OUTPUT_FIELDS, *DESIGN_FIELDS)
 #: Largest plant file read (bytes): room for matrices of about 1000 x 1000 in text.
 MAX_FILE_BYTES: int = 64 * 2**20
 #: Largest number of YAML nodes after alias expansion.
@@ -102,6 +108,11 @@ class PlantSpec:
     def B(self) -> np.ndarray:
         """Input matrix."""
         return self.preset.B
+
+    @property
+    def C(self) -> np.ndarray | None:
+        """Output matrix, or ``None`` when the state is measured."""
+        return self.preset.C
 
     def values(self) -> dict[str, float]:
         """The design values by :data:`~encctl_gym.presets.DESIGN_FIELDS`."""
@@ -332,6 +343,22 @@ def _design_value(key: str, value: Any) -> float:
     return check_positive(key, value)
 
 
+def _measurement(path: Path, data: Mapping[str, Any], A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray | None, float]:
+    """``C`` and ``sigma_v2`` of the file (``None`` and 0 when absent), checked as :class:`~encctl_gym.plant.Plant`
+    checks them (shape, observability, sign)."""
+    from .plant import Plant
+
+    C = _matrix(path, "C", data["C"]) if "C" in data else None
+    sigma_v2 = _scalar(path, "sigma_v2", data["sigma_v2"]) if "sigma_v2" in data else 0.0
+    if "sigma_v2" in data and C is None:
+        raise _fail(path, "sigma_v2 is the noise of the outputs y = C x + v: give C too")
+    try:
+        plant = Plant(A, B, stable=False, C=C, sigma_v2=sigma_v2)
+    except ParameterError as exc:
+        raise type(exc)(f"system file {str(path)!r}: {exc}") from None
+    return plant.C, plant.sigma_v2
+
+
 def load_plant_file(path: str | Path, *, defaults: Mapping[str, Any] | SystemPreset | None = None) -> PlantSpec:
     """Read a plant file (see the module table) into a :class:`PlantSpec`.
 
@@ -388,8 +415,9 @@ def load_plant_file(path: str | Path, *, defaults: Mapping[str, Any] | SystemPre
     missing = [key for key in DESIGN_FIELDS if key not in data and key not in base]
     if missing:
         raise _fail(p, f"{', '.join(missing)} {'is' if len(missing) == 1 else 'are'} neither in the file nor in the defaults")
+    C, sigma_v2 = _measurement(p, data, A, B)
     values: dict[str, float] = {}
-    from_file: list[str] = ["A", "B"]
+    from_file: list[str] = ["A", "B", *(k for k in OUTPUT_FIELDS if k in data)]
     from_defaults: list[str] = []
     for key in DESIGN_FIELDS:
         if key in data:
@@ -407,6 +435,8 @@ def load_plant_file(path: str | Path, *, defaults: Mapping[str, Any] | SystemPre
         description=f"plant from {p}",
         A=A,
         B=B,
+        C=C,
+        sigma_v2=sigma_v2,
         sigma_w2=values["sigma_w2"],
         sigma_u2=values["sigma_u2"],
         sigma_x2=values["sigma_x2"],

@@ -13,6 +13,7 @@ fig1-a ... fig1-i  Figure 1: A = 0.7071 I, B = I, sigma_w2 x sigma_u2 in {0.1, 1
 fig2-psi<v>        Figure 2: Psi_w = 2I, R_sigma = 100, Psi_u = v I, v in {2, 1, 0.5, 0.3, 0.2,
                    0.1}; A = I/sqrt(2) and B = b I with b = sqrt(v (1 - 1/2))
 small              n = m = 2 system for quick training runs (not from the paper), gamma_c = 1e-3
+small-output       ``small`` measured through ``C = [1 0]`` with ``sigma_v2 = 0.01`` (one output)
 =================  ==========================================================================
 
 The design example fixes only the ratio R_sigma = sigma_u2 / sigma_w2 = 100; its absolute
@@ -86,6 +87,9 @@ class SystemPreset:
     tau_c: float = PAPER_DESIGN_PARAMETERS["tau_c"]
     upsilon: float = PAPER_DESIGN_PARAMETERS["upsilon"]
     extra: dict = field(default_factory=dict)
+    #: output matrix of ``y = C x + v`` (``None``: the state is measured) and the variance of ``v``
+    C: np.ndarray | None = None
+    sigma_v2: float = 0.0
 
     @property
     def n(self) -> int:
@@ -100,10 +104,11 @@ class SystemPreset:
         return self.sigma_u2 / self.sigma_w2
 
     def plant(self) -> Any:
-        """The plant as the value object :class:`~encctl_gym.plant.Plant`."""
+        """The plant as the value object :class:`~encctl_gym.plant.Plant` (with ``C`` and
+        ``sigma_v2`` when the preset measures outputs)."""
         from .plant import Plant
 
-        return Plant(self.A, self.B)
+        return Plant(self.A, self.B, C=self.C, sigma_v2=self.sigma_v2)
 
     def threat(self, cost_model: Any = "paper") -> Any:
         """The preset's variances and design parameters as a
@@ -174,6 +179,17 @@ def _build() -> dict[str, SystemPreset]:
         sigma_w2=0.1,
         sigma_u2=1.0,
         gamma_c=1e-3,
+    )
+    presets["small-output"] = SystemPreset(
+        "small-output",
+        "the 'small' plant measured through its first state only (C = [1 0], sigma_v2 = 0.01)",
+        presets["small"].A,
+        presets["small"].B,
+        sigma_w2=0.1,
+        sigma_u2=1.0,
+        gamma_c=1e-3,
+        C=np.array([[1.0, 0.0]]),
+        sigma_v2=0.01,
     )
     return presets
 

@@ -5,7 +5,11 @@ For the design example (preset ``paper-example``) and Figure 1 (c) (``fig1-c``),
 Gaussian attack is measured through ``y = C x + v`` with ``C = I`` (every state), ``C = [I 0]``
 (half the states) and one output ``C = [1 1 1 1]``, each with ``sigma_v2 = 0`` and
 ``sigma_v2 = sigma_w2``, and identified by N4SID, PO-MOESP and ARX
-(:mod:`encctl_gym.ident.subspace`). Every estimate is scored by the basis-free Markov-parameter
+(:mod:`encctl_gym.ident.subspace`). Two more open-loop attackers, which need no state either
+(:data:`~encctl_gym.sim.output.OUTPUT_ATTACKS`), are identified by N4SID and ARX: random binary
+inputs (PRBS) and the A-optimal open-loop attack design (``optimal-ol``, designed for the state
+case with the true plant: where it applies, an oracle). The closed-loop optimal design needs the
+state and does not apply. Every estimate is scored by the basis-free Markov-parameter
 error (:func:`~encctl_gym.ident.subspace.markov_error`); least squares on the states gives the
 reference, in the same error.
 
@@ -37,15 +41,20 @@ from encctl_gym.plotting import legend_below, save_figure
 from encctl_gym.presets import get_preset
 from encctl_gym.security.design import design_security_parameter
 from encctl_gym.security.empirical import empirical_design, fit_empirical_complexity
-from encctl_gym.sim.output import OUTPUT_ESTIMATORS, output_attack_errors
+from encctl_gym.sim.output import OUTPUT_ATTACKS, OUTPUT_ESTIMATORS, output_attack_errors
 from encctl_gym.sim.plant import LinearPlant
 
 SYSTEMS = ("paper-example", "fig1-c")
 OUTPUTS = {"C = I": np.eye(4), "C = [I 0]": np.eye(4)[:2], "one output": np.ones((1, 4))}
+#: The estimators each attack is identified by: every one for the paper's Gaussian attack, the
+#: cheapest subspace method and the baseline for the others.
+ESTIMATORS_OF = {"gaussian": tuple(OUTPUT_ESTIMATORS), "prbs": ("n4sid", "arx"), "optimal-ol": ("n4sid", "arx")}
+assert set(ESTIMATORS_OF) == set(OUTPUT_ATTACKS)
+ATTACK_COLORS = {"prbs": "tab:red", "optimal-ol": "tab:purple"}
 
 
-def run(runs: int, points: int, n_max: int | None, seed: int) -> list[dict[str, Any]]:
-    """Every case of the module docstring: one row each (the numbers of the table and figure)."""
+def run(runs: int, points: int, n_max: int | None, seed: int, attacks: tuple[str, ...] = OUTPUT_ATTACKS) -> list[dict[str, Any]]:
+    """Every case of the module docstring for ``attacks``: one row each (the numbers of the table and figure)."""
     rows: list[dict[str, Any]] = []
     for system in SYSTEMS:
         p = get_preset(system)
@@ -60,21 +69,27 @@ def run(runs: int, points: int, n_max: int | None, seed: int) -> list[dict[str, 
         target = float(ls_fit(paper.N_star))
         base = empirical_design(ls_fit, p.threat(), gamma_c=target)
         rows.append(
-            _row(system, "states (least squares)", 0.0, "ls", grid, ref["state_ls_markov"], ls_fit, base, paper.N_star, target)
-        )
+            _row(
+                system, "states (least squares)", 0.0, "gaussian", "ls", grid, ref["state_ls_markov"], ls_fit, base,
+                paper.N_star, target,
+            )
+        )  # fmt: skip
         for label, C in OUTPUTS.items():
             for sv in (0.0, p.sigma_w2):
-                for est in OUTPUT_ESTIMATORS:
-                    out = output_attack_errors(
-                        plant, C, sample_sizes=grid, runs=runs, sigma_u2=p.sigma_u2, sigma_v2=sv, seed=seed, estimator=est
-                    )
-                    fit = fit_empirical_complexity(grid, out["markov"])
-                    d: Any
-                    try:
-                        d = empirical_design(fit, p.threat(), gamma_c=target)
-                    except EncctlError as exc:  # a rate that does not decrease: reported, not designed
-                        d = exc
-                    rows.append(_row(system, label, sv, est, grid, out["markov"], fit, d, paper.N_star, target))
+                for attack in attacks:
+                    for est in ESTIMATORS_OF[attack]:
+                        out = output_attack_errors(
+                            plant, C, sample_sizes=grid, runs=runs, sigma_u2=p.sigma_u2, sigma_v2=sv, seed=seed,
+                            estimator=est, attack=attack,
+                        )  # fmt: skip
+                        fit = fit_empirical_complexity(grid, out["markov"])
+                        d: Any
+                        try:
+                            d = empirical_design(fit, p.threat(), gamma_c=target)
+                        except EncctlError as exc:  # a rate that does not decrease: reported, not designed
+                            d = exc
+                        rows.append(_row(system, label, sv, attack, est, grid, out["markov"], fit, d, paper.N_star, target))
+                        print(f"  {system}, {label}, sigma_v2 = {sv:g}, {attack}, {est}: a = {fit.a:.3f}", file=sys.stderr)
     return rows
 
 
@@ -82,6 +97,7 @@ def _row(
     system: str,
     output: str,
     sigma_v2: float,
+    attack: str,
     estimator: str,
     grid: np.ndarray,
     errors: np.ndarray,
@@ -94,6 +110,7 @@ def _row(
         "system": system,
         "output": output,
         "sigma_v2": sigma_v2,
+        "attack": attack,
         "estimator": estimator,
         "runs": errors.shape[0],
         "N": grid.tolist(),
@@ -126,8 +143,8 @@ def _row(
 def format_table(rows: list[dict[str, Any]]) -> str:
     """The markdown table of the rows."""
     head = (
-        "| system | measured | sigma_v2 | estimator | rate a [95 %] | N* [95 %] | k* (paper model) [95 %] |\n"
-        "|---|---|---|---|---|---|---|"
+        "| system | measured | sigma_v2 | attack | estimator | rate a [95 %] | N* [95 %] | k* (paper model) [95 %] |\n"
+        "|---|---|---|---|---|---|---|---|"
     )
     lines = [head]
     for r in rows:
@@ -138,13 +155,15 @@ def format_table(rows: list[dict[str, Any]]) -> str:
             ns = f"{r['N_star']} [{r['N_star_low']}, {r['N_star_high']}]{ext}"
             ks = f"{r['k_star']} [{r['k_star_low']}, {r['k_star_high']}]"
         lines.append(
-            f"| {r['system']} | {r['output']} | {r['sigma_v2']:g} | {r['estimator']} | "
+            f"| {r['system']} | {r['output']} | {r['sigma_v2']:g} | {r['attack']} | {r['estimator']} | "
             f"{r['a']:.3f} [{r['a_low']:.3f}, {r['a_high']:.3f}] | {ns} | {ks} |"
         )
     return "\n".join(lines)
 
 
-def write(rows: list[dict[str, Any]], out: Path) -> list[Path]:
+def write(
+    rows: list[dict[str, Any]], out: Path, command: str = "python -m encctl_gym.experiments.output_identification"
+) -> list[Path]:
     """CSV, markdown and figure of the rows into ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     fields = [k for k in rows[0] if k not in ("N", "median", "mean")]
@@ -159,7 +178,7 @@ def write(rows: list[dict[str, Any]], out: Path) -> list[Path]:
             )
     md = out / "output_identification.md"
     md.write_text(
-        "# Identification from outputs\n\nCommand: `python -m encctl_gym.experiments.output_identification`"
+        f"# Identification from outputs\n\nCommand: `{command}`"
         f" ({rows[0]['runs']} runs per case). Target: the state least-squares Markov error at the paper's N*.\n\n"
         + format_table(rows)
         + "\n"
@@ -180,7 +199,7 @@ def write(rows: list[dict[str, Any]], out: Path) -> list[Path]:
             ax = axes[i, j]
             ax.plot(ref["N"], ref["mean"], color="k", lw=1.6, label="states, least squares")
             for r in rows:
-                if r["system"] == system and r["output"] == label:
+                if r["system"] == system and r["output"] == label and r["attack"] == "gaussian":
                     ax.plot(
                         r["N"],
                         r["mean"],
@@ -190,6 +209,11 @@ def write(rows: list[dict[str, Any]], out: Path) -> list[Path]:
                         ms=2.5,
                         label=f"{r['estimator']}, sigma_v2 = {r['sigma_v2']:g}",
                     )
+            for r in rows:  # the other attacks: N4SID on noise-free sensors
+                other = r["attack"] != "gaussian" and r["estimator"] == "n4sid" and r["sigma_v2"] == 0
+                if other and (r["system"], r["output"]) == (system, label):
+                    ax.plot(r["N"], r["mean"], color=ATTACK_COLORS[r["attack"]], ls="-.", marker="s", ms=2.5,
+                            label=f"n4sid, {r['attack']} attack, sigma_v2 = 0")  # fmt: skip
             ax.axhline(ref["target"], color="0.5", lw=0.8, ls=":", label="target (states at the paper's N*)")
             ax.set(xscale="log", yscale="log", title=f"{system}: {label}")
             ax.grid(True, which="major", alpha=0.3)
@@ -204,6 +228,41 @@ def write(rows: list[dict[str, Any]], out: Path) -> list[Path]:
     return [csv_path, md, png]
 
 
+def sic_check(runs: int = 200, seed: int = 1) -> str:
+    """eq:sic against the exact large-N mean error of least squares on the states (``C = I``, no
+    measurement noise): ``sigma_w2 tr(Sigma^-1) / ((n + m) N)`` with the stationary regressor
+    covariance ``Sigma``, and the Monte Carlo band; a markdown table of the ratios to the exact value."""
+    from encctl_gym.security.bayes_complexity import stationary_regressor_covariance
+    from encctl_gym.security.complexity import sic_from_traces
+    from encctl_gym.security.gramians import controllability_gramian, noise_gramian
+    from encctl_gym.sim.montecarlo import gaussian_attack_errors
+
+    grid = np.array([400, 800, 1600, 3200, 6400])
+    lines = [
+        f"# eq:sic against the exact large-N mean error\n\nCommand: `python -m encctl_gym.experiments.output_identification "
+        f"--sic-check` ({runs} Gaussian attacks, least squares on the states; 95 % bootstrap band). "
+        "Every column is a ratio to the exact value sigma_w2 tr(Sigma^-1) / ((n + m) N).\n",
+        "| system | N | band low | Monte Carlo mean | band high | eq:sic |",
+        "|---|---|---|---|---|---|",
+    ]
+    for system in ("small", "paper-example"):
+        p = get_preset(system)
+        errors = gaussian_attack_errors(
+            LinearPlant(p.A, p.B, sigma_w2=p.sigma_w2), sample_sizes=grid, runs=runs, sigma_u2=p.sigma_u2, seed=seed
+        )
+        fit = fit_empirical_complexity(grid, errors)
+        S = stationary_regressor_covariance(p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2)
+        exact = p.sigma_w2 * np.trace(np.linalg.inv(S)) / (p.n + p.m) / grid
+        tr_u, tr_w = np.trace(controllability_gramian(p.A, p.B)), np.trace(noise_gramian(p.A))
+        sic = np.asarray(sic_from_traces(grid, tr_u, tr_w, p.m, p.n, p.sigma_u2, p.sigma_w2, p.sigma_x2))
+        for g, N in enumerate(grid):
+            lines.append(
+                f"| {system} | {N} | {fit.low[g] / exact[g]:.3f} | {fit.mean[g] / exact[g]:.3f} | "
+                f"{fit.high[g] / exact[g]:.3f} | {sic[g] / exact[g]:.3f} |"
+            )
+    return "\n".join(lines) + "\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m encctl_gym.experiments.output_identification", description=__doc__.splitlines()[0]
@@ -213,14 +272,34 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--quick", action="store_true", help="4 runs, 4 points up to N = 2000")
     parser.add_argument("--out", type=Path, default=Path("results/output_identification"))
+    parser.add_argument(
+        "--attacks",
+        default=",".join(OUTPUT_ATTACKS),
+        help=f"comma-separated attacks to run (default all: {','.join(OUTPUT_ATTACKS)})",
+    )
+    parser.add_argument("--sic-check", action="store_true", help="only the check of eq:sic against the exact mean (sic_check.md)")
     args = parser.parse_args(argv)
+    if args.sic_check:
+        text = sic_check()
+        args.out.mkdir(parents=True, exist_ok=True)
+        (args.out / "sic_check.md").write_text(text)
+        print(text + f"  wrote {args.out / 'sic_check.md'}")
+        return 0
     runs, points, n_max = (4, 4, 2000) if args.quick else (args.runs, args.points, None)
+    attacks = tuple(a.strip() for a in args.attacks.split(","))
+    if not attacks or any(a not in OUTPUT_ATTACKS for a in attacks):
+        print(
+            f"output_identification: --attacks must name some of {', '.join(OUTPUT_ATTACKS)}, got {args.attacks!r}",
+            file=sys.stderr,
+        )
+        return 2
     if runs < 2 or points < 3:  # an interval needs two runs, a fitted rate three sizes
         print(f"output_identification: --runs must be >= 2 and --points >= 3, got {runs} and {points}", file=sys.stderr)
         return 2
     try:
-        rows = run(runs, points, n_max, args.seed)
-        paths = write(rows, args.out)
+        rows = run(runs, points, n_max, args.seed, attacks)
+        shown = " ".join(argv if argv is not None else sys.argv[1:])
+        paths = write(rows, args.out, f"python -m encctl_gym.experiments.output_identification {shown}".strip())
     except EncctlError as exc:
         print(f"output_identification: {exc}", file=sys.stderr)
         return 2

@@ -298,7 +298,7 @@ def test_large_plants_work_or_are_refused_with_a_reason(tmp_path: Path, capsys: 
 @pytest.mark.parametrize(
     "name,content,match",
     [
-        ("unknown.json", {"A": [[0.5]], "B": [[1]], "sigma_v2": 1}, "unknown field(s) ['sigma_v2']"),
+        ("unknown.json", {"A": [[0.5]], "B": [[1]], "sigma_z2": 1}, "unknown field(s) ['sigma_z2']"),
         ("bigint.json", {"A": [[10**400]], "B": [[1]]}, "beyond the float64 range"),
         ("bool.json", {"A": [[True]], "B": [[1]]}, "A must hold real numbers, got True"),
         ("str.json", {"A": [[0.5]], "B": [[1]], "sigma_u2": "ten"}, "sigma_u2 must be a number, got 'ten'"),

@@ -268,7 +268,7 @@ def test_plant_file_bounds(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> N
     assert MAX_YAML_NODES >= 2 * 1000 * 1000  # room for a 1000 x 1000 matrix written out
     with pytest.raises(ConfigError, match="must end in"):
         load_plant_file(_write(tmp_path, "p.txt", {}))
-    assert set(PLANT_FIELDS) == {"A", "B", "sigma_u2", "sigma_w2", "sigma_x2", "gamma_c", "tau_c", "upsilon"}
+    assert set(PLANT_FIELDS) == {"A", "B", "C", "sigma_v2", "sigma_u2", "sigma_w2", "sigma_x2", "gamma_c", "tau_c", "upsilon"}
 
 
 def test_every_plant_file_error_is_a_package_error(tmp_path: Path) -> None:

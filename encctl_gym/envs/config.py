@@ -149,6 +149,16 @@ def default_config() -> dict[str, Any]:
                                   and re-provisions the server (:mod:`encctl_gym.loop.rotation`);
                                   the attacker pays each group's precomputation
                                   (:mod:`encctl_gym.security.rotation`)
+    ``observe``                   ``"state"`` (the paper's: the plant sends ``x``) or
+                                  ``"output"``: the plant sends ``y = C x + v``, the loop runs
+                                  on outputs and the attacker deciphers outputs only
+                                  (:mod:`encctl_gym.envs.output_episode`)
+    ``C``, ``sigma_v2``           sensors and measurement noise of ``observe="output"``
+                                  (preset's, else ``C = I`` and ``sigma_v2 = 0``); ``(A, C)``
+                                  observable
+    ``controller``                the loop's controller on outputs
+                                  (:mod:`encctl_gym.loop.output_feedback`): ``"static"``
+                                  (``u = Phi y``) or ``"lqg"`` (observer-based, dynamic)
     ============================  ==============================================================
     """
     return {
@@ -186,6 +196,10 @@ def default_config() -> dict[str, Any]:
         "crypto_seed": None,
         "defender": "fixed",
         "rotate_group_every": None,
+        "observe": "state",
+        "C": None,
+        "sigma_v2": None,
+        "controller": "static",
     }
 
 
@@ -246,10 +260,15 @@ class AttackParams:
     breaker_precomputation: str | None = None  # a precomputation file the breaker loads (index calculus)
     cost_model: CostModel | None = None  # the built deciphering model (its GNFS correction); None: the named one's defaults
 
+    observe: str = "state"  # "state" (x is sent) or "output" (y = C x + v is sent: envs.output_episode)
+    C: np.ndarray | None = None  # the sensors of observe="output" (None: the state is sent)
+    sigma_v2: float = 0.0  # measurement noise variance of observe="output"
+    controller: str = "static"  # the loop's controller on outputs (loop.output_feedback.CONTROLLERS)
+
     @cached_property
     def plant(self) -> Plant:
-        """The plant ``(A, B)`` of eq:system as a value object."""
-        return Plant(self.A, self.B)
+        """The plant ``(A, B)`` of eq:system (with ``C`` and ``sigma_v2`` when outputs are sent) as a value object."""
+        return Plant(self.A, self.B) if self.C is None else Plant(self.A, self.B, C=self.C, sigma_v2=self.sigma_v2)
 
     @cached_property
     def threat(self) -> ThreatModel:
@@ -281,7 +300,14 @@ class AttackParams:
             defender=self.defender,
             rotate_group_every=self.rotate_group_every,
             breaker_precomputation=self.breaker_precomputation,
+            observe=self.observe,
+            controller=self.controller,
         )
+
+    @property
+    def observed_dim(self) -> int:
+        """Length of what the plant sends and the attacker deciphers: ``p`` for outputs, else ``n``."""
+        return self.n if self.C is None else int(self.C.shape[0])
 
     def warn_if_capped(self) -> None:
         """Warn (once per environment, when it is made) that the attack length is the default cap
@@ -609,6 +635,9 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         crypto_seed = check_int("crypto_seed", crypto_seed, minimum=0)
     defender = cfg["defender"]
     make_defender(defender)  # an unknown name or an object that is no policy fails here
+    from .output_episode import resolve_output
+
+    output = resolve_output(cfg, preset, A, B, estimator=estimator, reward=reward, defender=defender)
     return AttackParams(
         A=A,
         B=B,
@@ -653,4 +682,5 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         rotate_group_every=rotate_every,
         cost_model=model,
         breaker_precomputation=_breaker_file(cfg, breaker),
+        **output,
     )

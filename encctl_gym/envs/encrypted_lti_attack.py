@@ -205,7 +205,12 @@ class EncryptedLTIAttackEnv(gym.Env):
         self.action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
         self.observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
         self.design = attack_design_for(p) if p.gamma_opt else None
-        self._core = EpisodeCore(p, self._loop, self.design, schedule=schedule, defender=defender)
+        if p.observe == "output":  # the plant sends y = C x + v: the episode of envs.output_episode
+            from .output_episode import OutputEpisode
+
+            self._core: Any = OutputEpisode(p, self._loop, self.design)
+        else:
+            self._core = EpisodeCore(p, self._loop, self.design, schedule=schedule, defender=defender)
 
     @staticmethod
     def default_config() -> dict[str, Any]:

@@ -51,8 +51,9 @@ class ObservationLayout:
 
     @classmethod
     def of(cls, params: AttackParams) -> ObservationLayout:
-        """The layout of an environment's resolved parameters (:class:`~encctl_gym.envs.config.AttackParams`)."""
-        return cls(int(params.n), int(params.m), int(params.input_history))
+        """The layout of an environment's resolved parameters (:class:`~encctl_gym.envs.config.AttackParams`);
+        with ``observe="output"`` the "state" slice holds the ``p`` deciphered outputs."""
+        return cls(int(params.observed_dim), int(params.m), int(params.input_history))
 
     @property
     def dim(self) -> int:

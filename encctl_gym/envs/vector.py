@@ -83,6 +83,8 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
             raise ParameterError(
                 f"the vector environment batches the ideal backend only, got crypto={format_value(self.params.crypto)}"
             )
+        if self.params.observe != "state":
+            raise ParameterError("the vector environment runs observe='state'; use the single environment for observe='output'")
         if max_episode_steps is not None:
             raise ParameterError(
                 f"the attack length is set by tau_c or max_samples, not max_episode_steps (got {format_value(max_episode_steps)})"

@@ -41,6 +41,7 @@ from ..errors import ParameterError, ShapeError
 __all__ = [
     "SubspaceEstimate",
     "arx",
+    "arx_realisation",
     "block_hankel",
     "markov_error",
     "markov_parameters",
@@ -322,6 +323,18 @@ def arx(u: Any, y: Any, na: int = 2, nb: int = 2) -> SubspaceEstimate:
     regs = [y[:, q - k : N - k] for k in range(1, na + 1)] + [u[:, q - k : N - k] for k in range(1, nb + 1)]
     X = np.concatenate(regs, axis=2)  # (R, N - q, na p + nb m)
     theta = _batched_lstsq(X, y[:, q:])  # (R, na p + nb m, p)
+    A, B, C, D = arx_realisation(theta, na, nb, p, m)
+    return _estimate(A, B, C, D, np.zeros((R, 0)), p * q, q, "arx", single)
+
+
+def arx_realisation(theta: np.ndarray, na: int, nb: int, p: int, m: int) -> tuple[np.ndarray, ...]:
+    """``(A, B, C, D)`` of ARX coefficients in observer canonical form (block companion, order ``p max(na, nb)``).
+
+    ``theta`` of shape ``(R, na p + nb m, p)`` stacks ``a_1^T .. a_na^T`` then ``b_1^T .. b_nb^T``
+    (the least-squares solution of :func:`arx`, one column per output).
+    """
+    R = theta.shape[0]
+    q = max(na, nb)
     a = [theta[:, k * p : (k + 1) * p].transpose(0, 2, 1) for k in range(na)] + [np.zeros((R, p, p))] * (q - na)
     b = [theta[:, na * p + k * m : na * p + (k + 1) * m].transpose(0, 2, 1) for k in range(nb)] + [np.zeros((R, p, m))] * (q - nb)
     n = p * q
@@ -334,7 +347,7 @@ def arx(u: Any, y: Any, na: int = 2, nb: int = 2) -> SubspaceEstimate:
     C = np.zeros((R, p, n))
     C[:, :, :p] = np.eye(p)
     # y[t] = x_1[t] with x_1[t] = sum_k a_k y[t-k] + b_k u[t-k] realises the ARX model with D = 0
-    return _estimate(A, B, C, np.zeros((R, p, m)), np.zeros((R, 0)), n, q, "arx", single)
+    return A, B, C, np.zeros((R, p, m))
 
 
 def _batched_lstsq(X: np.ndarray, Y: np.ndarray) -> np.ndarray:

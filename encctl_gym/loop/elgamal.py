@@ -27,11 +27,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import ParameterError
-from .backend import lqr_gain
 from .scheme import EncryptionScheme, make_scheme
 
 if TYPE_CHECKING:
     from ..envs.config import AttackParams
+from .output_feedback import controller_matrix
 
 __all__ = ["ElGamalLoop", "party_random_sources"]
 
@@ -90,13 +90,13 @@ class ElGamalLoop:
 
         self.params = params
         self.group = group
-        self.n, self.m = params.n, params.m
         #: the scheme's object (:class:`~encctl_gym.loop.scheme.EncryptionScheme`)
         self.encryption: EncryptionScheme = make_scheme(params.scheme)
         #: the scheme's name
         self.scheme = self.encryption.name
         self.encoder = self.encryption.encoder(group, float(params.delta))
-        self.Phi = -lqr_gain(params.A, params.B)
+        self.Phi = controller_matrix(params)  # -K_lqr on x, or the output controller on [x_c; y]
+        self.n, self.m = self.Phi.shape[1], params.m  # n: the controller's input xi (x, y or [x_c; y])
         #: each party's random source (privileged: who holds which randomness), see :func:`party_random_sources`
         self.random_sources = party_random_sources(params.crypto_seed)
         #: how the adversary obtains the secret of each period's key (:mod:`encctl_gym.attacks.decipherer`)

@@ -17,7 +17,8 @@ import numpy as np
 
 from .._validation import format_value
 from ..errors import EncodingOverflowError, ResourceLimitError
-from .backend import lqr_gain, table_limit
+from .backend import table_limit
+from .output_feedback import controller_matrix
 from .quantize import OK, Quantization, collect_states, forge_inputs
 
 if TYPE_CHECKING:
@@ -53,8 +54,8 @@ class IdealLoop:
 
         self.delta = float(params.delta)
         self.x_bound = float(params.x_bound)
-        self.n, self.m = params.n, params.m
-        self.Phi = -lqr_gain(params.A, params.B)
+        self.Phi = controller_matrix(params)  # -K_lqr on x, or the output controller on [x_c; y]
+        self.n, self.m = self.Phi.shape[1], params.m  # n: the controller's input xi (x, y or [x_c; y])
         self._params = params
         self.use_group(group)
 

@@ -52,6 +52,10 @@ class LoopSpec:
         :mod:`encctl_gym.loop.rotation`).
     breaker_precomputation : str or None
         A precomputation file the breaker loads (the index calculus), checked against the group.
+    observe : str
+        What the plant sends: ``"state"`` (``x``) or ``"output"`` (``y = C x + v``).
+    controller : str
+        The loop's controller on outputs (:data:`encctl_gym.loop.output_feedback.CONTROLLERS`).
     """
 
     crypto: str
@@ -66,6 +70,8 @@ class LoopSpec:
     defender: Any = "fixed"
     rotate_group_every: int | None = None
     breaker_precomputation: str | None = None
+    observe: str = "state"
+    controller: str = "static"
 
     def encryption(self) -> EncryptionScheme:
         """The scheme object (:func:`~encctl_gym.loop.scheme.make_scheme`)."""

@@ -23,6 +23,12 @@ the paper's cost (2^lam per key, GNFS key length). Rows (c) and (d) solve an SDP
 as (n+m)^4.75; above ``--sdp-max-dim`` (default 48) they are skipped with the estimate, and the
 command refuses plants with n > 1000 before any solve.
 
+``--estimator n4sid`` (or ``moesp``, ``arx``) adds the empirical design of the plant measured through
+its outputs (the file's ``C`` and ``sigma_v2``; ``C = I`` without them) beside the state-measured
+one (:mod:`encctl_gym.security.output_design`): ``--runs`` simulated Gaussian attacks per ``N``
+(default 20) on ``--points`` sizes from ``N*/4`` to ``2 N*`` (default 6), seed ``--seed``; for the
+paper's N* = 13159 this takes minutes.
+
 ``--cost-model`` adds one row per deciphering-cost model (:mod:`encctl_gym.security.cost_models`)
 for the N* of ``--complexity``: the bits of work the adversary needs for N* samples at k*, k*,
 the paper's k* beside it, the cost of the first and of each further key, the bits the dynamic keys
@@ -123,6 +129,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="FILE",
         help="records file (layout of security/data/deciphering_records.json) for the precomputation model's per-key ratio",
     )
+    parser.add_argument(
+        "--estimator",
+        metavar="NAME",
+        help="add the empirical design from outputs y = C x + v with this identification method: n4sid, moesp or arx",
+    )
+    parser.add_argument("--runs", metavar="R", help="with --estimator: simulated attacks per N (default 20)")
+    parser.add_argument("--points", metavar="P", help="with --estimator: attack lengths on the log grid (default 6)")
+    parser.add_argument("--seed", metavar="S", help="with --estimator: seed of the simulated attacks (default 0)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
 
 
@@ -278,15 +292,18 @@ def run(args: argparse.Namespace, defenses: Callable[..., DefenseDesign] | None 
     base: dict[str, Any] = dict(DEFAULTS)
     sources: dict[str, str] = {}
     sources_line = None
+    C, sigma_v2 = None, 0.0  # the sensors of --estimator (a plant file's or preset's)
     if args.preset:
         preset = get_preset(args.preset)
         A, B = preset.A, preset.B
+        C, sigma_v2 = preset.C, preset.sigma_v2
         title = f"preset {args.preset}, {preset.description}"
         base.update({key: getattr(preset, key) for key in DESIGN_FIELDS})
         sources = {key: "preset" for key in DESIGN_FIELDS}
     elif args.system_file:
         spec = load_plant_file(args.system_file, defaults=DEFAULTS)
         A, B = spec.A, spec.B
+        C, sigma_v2 = spec.C, spec.preset.sigma_v2
         title = str(args.system_file)
         base.update(spec.values())
         sources = {key: ("file" if key in spec.from_file else "default") for key in DESIGN_FIELDS}
@@ -346,6 +363,9 @@ def run(args: argparse.Namespace, defenses: Callable[..., DefenseDesign] | None 
             calibration=records,
             **defense,
         )
+    output = _output_design(args, A, B, C, sigma_v2, threat)
+    if output is not None:
+        res["output_design"] = output.to_dict()
     if args.json:
         if "defenses" in res:
             res["defenses"] = res["defenses"].to_dict()
@@ -357,7 +377,32 @@ def run(args: argparse.Namespace, defenses: Callable[..., DefenseDesign] | None 
         if "defenses" in res:
             text += "\n" + "\n".join(defense_cli.format_defenses(res["defenses"]))
         print(text)
+        if output is not None:
+            from .output_design import format_output_design
+
+            print()
+            print(format_output_design(output))
     return 0
+
+
+def _output_design(args: argparse.Namespace, A: Any, B: Any, C: Any, sigma_v2: float, threat: ThreatModel) -> Any:
+    """The empirical design of ``--estimator`` (None without it); its options only apply with it."""
+    given = [opt for opt in ("runs", "points", "seed") if getattr(args, opt) is not None]
+    if args.estimator is None:
+        if given:
+            raise ConfigError(f"{', '.join('--' + g for g in given)} only applies with --estimator")
+        return None
+    from ..plant import Plant
+    from .output_design import output_design
+
+    def opt(name: str, default: int, minimum: int) -> int:
+        raw = getattr(args, name)
+        return default if raw is None else check_int(name, parse_number(name, raw), minimum)
+
+    plant = Plant(A, B, C=np.eye(A.shape[0]) if C is None else C, sigma_v2=sigma_v2)
+    return output_design(
+        plant, threat, estimator=args.estimator, runs=opt("runs", 20, 2), points=opt("points", 6, 3), seed=opt("seed", 0, 0)
+    )
 
 
 def _sanitize(obj: Any) -> Any:

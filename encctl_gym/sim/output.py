@@ -14,14 +14,15 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import as_finite_array, check_int, check_nonnegative
-from ..errors import ParameterError, ShapeError
+from .._validation import check_int, check_nonnegative
+from ..errors import ParameterError
 from ..ident.grid import identification_errors
 from ..ident.least_squares import prefix_estimates
 from ..ident.subspace import arx, markov_error, moesp, n4sid
-from .plant import LinearPlant, simulate_gaussian_attack
+from ..plant import check_output_matrix, observable_order
+from .plant import LinearPlant, simulate, simulate_gaussian_attack
 
-__all__ = ["OUTPUT_ESTIMATORS", "check_output_matrix", "output_attack_errors"]
+__all__ = ["OUTPUT_ATTACKS", "OUTPUT_ESTIMATORS", "attack_inputs", "check_output_matrix", "output_attack_errors"]
 
 
 def _arx(u: np.ndarray, y: np.ndarray, order: int) -> Any:
@@ -38,22 +39,36 @@ OUTPUT_ESTIMATORS = {
 }
 
 
-def check_output_matrix(C: Any, n: int) -> np.ndarray:
-    """``C`` as a ``(p, n)`` float matrix; refuses another width."""
-    C = as_finite_array("C", C, ndim=2)
-    if C.shape[1] != n or C.shape[0] < 1:
-        raise ShapeError(f"C must have shape (p, {n}) with p >= 1, got {C.shape}")
-    return C
+#: The open-loop attacks whose inputs need no state (the attacker of ``y = C x + v`` has none):
+#: ``"gaussian"`` (i.i.d. ``N(0, sigma_u2 I)``, Theorem thm:sic), ``"prbs"`` (random binary
+#: ``+-sigma_u`` per channel and step) and ``"optimal-ol"`` (the A-optimal open-loop design of
+#: :mod:`encctl_gym.security.attack_design`, ``u = K x_u + v`` on the state ``x_u`` the attacker
+#: simulates from its own inputs; designed for Definition def:error, with the true ``(A, B)``).
+OUTPUT_ATTACKS: tuple[str, ...] = ("gaussian", "prbs", "optimal-ol")
 
 
-def _observable_order(A: np.ndarray, C: np.ndarray) -> int:
-    """The rank of the observability matrix ``[C; C A; ...; C A^{n-1}]``."""
-    n = A.shape[0]
-    blocks, X = [], C
-    for _ in range(n):
-        blocks.append(X)
-        X = X @ A
-    return int(np.linalg.matrix_rank(np.vstack(blocks)))
+def attack_inputs(plant: LinearPlant, attack: str, *, N: int, runs: int, sigma_u2: float, seed: Any) -> np.ndarray:
+    """The inputs ``(runs, N, m)`` of an open-loop attack of :data:`OUTPUT_ATTACKS` other than
+    ``"gaussian"`` (which :func:`~encctl_gym.sim.plant.simulate_gaussian_attack` draws), each of
+    average power ``sigma_u2`` per channel."""
+    rng = np.random.default_rng(seed)
+    m, n = plant.m, plant.n
+    if attack == "prbs":
+        return np.sqrt(sigma_u2) * (2.0 * rng.integers(0, 2, size=(runs, N, m)) - 1.0)
+    if attack == "optimal-ol":
+        from ..security.attack_design import optimal_attack_design
+
+        d = optimal_attack_design(plant.A, plant.B, sigma_u2=sigma_u2, sigma_w2=plant.sigma_w2, feedback=False)
+        Lv = np.linalg.cholesky(d.V + 1e-15 * np.eye(m))
+        S = d.input_state_cov if d.input_state_cov is not None else np.zeros((n, n))
+        w, V = np.linalg.eigh(S)
+        x = rng.standard_normal((runs, n)) @ (V * np.sqrt(np.maximum(w, 0.0))).T  # x_u ~ N(0, S_u): stationary
+        u = np.empty((runs, N, m))
+        for t in range(N):
+            u[:, t] = x @ d.K.T + rng.standard_normal((runs, m)) @ Lv.T
+            x = x @ plant.A.T + u[:, t] @ plant.B.T
+        return u
+    raise ParameterError(f"unknown attack {attack!r}; choose one of {', '.join(OUTPUT_ATTACKS)}")
 
 
 def output_attack_errors(
@@ -68,8 +83,9 @@ def output_attack_errors(
     estimator: str = "n4sid",
     order: int | None = None,
     markov_length: int = 20,
+    attack: str = "gaussian",
 ) -> dict[str, np.ndarray]:
-    """Errors of ``runs`` Gaussian attacks identified from outputs, on a grid of sample sizes.
+    """Errors of ``runs`` attacks identified from outputs, on a grid of sample sizes.
 
     Parameters
     ----------
@@ -92,6 +108,9 @@ def output_attack_errors(
         The state dimension to fit; default the observable order of ``(A, C)``.
     markov_length : int
         ``L`` of :func:`~encctl_gym.ident.subspace.markov_error`.
+    attack : str
+        The attack's inputs (:data:`OUTPUT_ATTACKS`; default the paper's Gaussian attack, whose
+        trajectories are :func:`~encctl_gym.sim.plant.simulate_gaussian_attack`'s).
 
     Returns
     -------
@@ -115,7 +134,7 @@ def output_attack_errors(
         raise ParameterError("sample_sizes must be a strictly increasing 1-D sequence")
     grid = np.array([check_int("sample size", int(v), minimum=2) for v in grid])
     runs = check_int("runs", runs, minimum=1)
-    observable = _observable_order(plant.A, C)
+    observable = observable_order(plant.A, C)
     order = observable if order is None else check_int("order", order, minimum=1)
     if order > observable:
         raise ParameterError(
@@ -123,7 +142,12 @@ def output_attack_errors(
         )
     ss = np.random.SeedSequence(seed) if not isinstance(seed, np.random.SeedSequence) else seed
     traj_seed, noise_seed = ss.spawn(2)
-    sim = simulate_gaussian_attack(plant, N=int(grid[-1]), runs=runs, sigma_u2=sigma_u2, seed=traj_seed)
+    if attack == "gaussian":
+        sim = simulate_gaussian_attack(plant, N=int(grid[-1]), runs=runs, sigma_u2=sigma_u2, seed=traj_seed)
+    else:
+        input_seed, plant_seed = traj_seed.spawn(2)
+        u = attack_inputs(plant, attack, N=int(grid[-1]), runs=runs, sigma_u2=sigma_u2, seed=input_seed)
+        sim = simulate(plant, u, plant_seed)
     rng = np.random.default_rng(noise_seed)
     y = sim.states @ C.T + np.sqrt(sv) * rng.normal(size=(runs, sim.N, C.shape[0]))
     true = (plant.A, plant.B, C, np.zeros((C.shape[0], plant.m)))
