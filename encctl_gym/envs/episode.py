@@ -39,7 +39,7 @@ same with or without it (tested).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from concurrent.futures import Future
 from typing import Any
 
@@ -55,6 +55,7 @@ from ..loop.provisioning import RotationRecord
 from ..loop.rotation import check_new_group, defender_for, move_loop, rotation_info
 from . import _kernels as kern
 from .config import AttackParams
+from .episode_work import HelperWork
 from .helper import HelperThread
 from .layout import ObservationLayout, info_dict
 from .rewards import REWARDS
@@ -72,7 +73,7 @@ def attack_design_for(p: AttackParams) -> Any:
     return optimal_attack_design(p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, feedback=p.decipher_delay == 0)
 
 
-class EpisodeCore:
+class EpisodeCore(HelperWork):
     """State and dynamics of K attack episodes stepped in lockstep.
 
     Parameters
@@ -219,29 +220,6 @@ class EpisodeCore:
         self._rngs: list[np.random.Generator] = []
         self.history: list[tuple[int, float]] = []  # (N delivered, epsilon) of copy 0, for render
 
-    # ----------------------------------------------------------------- helper thread
-    def _run(self, fn: Callable[..., Any], *args: Any) -> Future | None:
-        """``fn(*args)`` on the helper thread (returns its future) or, without one, now."""
-        if self.helper is not None:
-            return self.helper.submit(fn, *args)
-        fn(*args)
-        return None
-
-    def _wait_noise(self) -> None:
-        if self._noise_future is not None:
-            future, self._noise_future = self._noise_future, None
-            future.result()  # re-raises what the helper raised
-
-    def _wait_gram(self) -> None:
-        if self._gram_future is not None:
-            future, self._gram_future = self._gram_future, None
-            future.result()
-
-    def wait(self) -> None:
-        """Wait for the helper thread's work on this episode (noise drawn ahead, Gram catch-up)."""
-        self._wait_noise()
-        self._wait_gram()
-
     def close(self) -> None:
         """The helper's work finished, and the defender's own resources released (its optional
         ``close``, e.g. the rotating defender's group pool)."""
@@ -267,42 +245,6 @@ class EpisodeCore:
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
         self.G, self.C = self._gram_views()
-
-    # ----------------------------------------------------------------- randomness
-    def _fill_noise(self, dst: np.ndarray, chunk: int) -> None:
-        """Noise chunk ``chunk`` (``schedule.chunk`` periods) of every copy, into ``dst`` (C, K, n):
-        drawn from each copy's generator (chunks are drawn in order), or read from the noise
-        given to :meth:`reset`."""
-        if self._given_noise is not None:
-            C = dst.shape[0]
-            part = self._given_noise[:, chunk * C : (chunk + 1) * C]
-            dst[: part.shape[1]] = part.transpose(1, 0, 2)
-            dst[part.shape[1] :] = 0.0  # past the episode's last period: never read
-            return
-        for i, rng in enumerate(self._rngs):
-            rng.standard_normal(out=self._noise_draws[i])
-        kern.interleave_noise(self._noise_draws, self._sw, dst)
-
-    def _take_chunk(self) -> None:
-        """Take the next noise chunk into use (the one drawn ahead, else draw it now), then draw
-        the one after it ahead if the episode will reach it."""
-        if self._noise_ahead:
-            self._wait_noise()
-            self._noise, self._noise_next = self._noise_next, self._noise
-        else:
-            self._fill_noise(self._noise, self._chunks)
-        self._chunks += 1
-        self._noise_pos = 0
-        self._noise_ahead = self._chunks * self.schedule.chunk < self._periods
-        if self._noise_ahead:
-            self._noise_future = self._run(self._fill_noise, self._noise_next, self._chunks)
-
-    def _draw_noise(self) -> np.ndarray:
-        if self._noise_pos >= self.schedule.chunk:
-            self._take_chunk()
-        w = self._noise[self._noise_pos]
-        self._noise_pos += 1
-        return w
 
     # ----------------------------------------------------------------- reset
     def _given(self, name: str, value: Any, shape: tuple[int, ...]) -> np.ndarray:
@@ -406,27 +348,6 @@ class EpisodeCore:
             self._time_frac[self.collected + 1] = spent / self.p.tau_c
             self._time_list[self.collected + 1] = spent
         self.collected += 1
-
-    def _sync_gram(self, upto: int) -> None:
-        """Bring G and C up to the columns j < ``upto`` (the fused step leaves them behind)."""
-        self._wait_gram()
-        if upto > self._gram_upto:
-            kern.add_gram(self._dims, self.X, self.U, self._gram_upto, upto, self._GC, self._gram_scratch)
-            self._gram_upto = upto
-
-    def _gram_behind(self, upto: int) -> None:
-        """Hand the Gram catch-up of the columns j < ``upto`` to the helper thread, unless it
-        is still busy with the previous one. The columns are final: rows of X and U only ever
-        get written once, ahead of the columns that read them."""
-        assert self.helper is not None
-        if self._gram_future is not None:
-            if not self._gram_future.done():
-                return
-            self._wait_gram()
-        first, self._gram_upto = self._gram_upto, upto
-        self._gram_future = self.helper.submit(
-            kern.add_gram, self._dims, self.X, self.U, first, upto, self._GC, self._gram_scratch
-        )
 
     def _overflow(self) -> None:
         raise EncodingOverflowError(
