@@ -31,6 +31,7 @@ from ..errors import BudgetError, ConfigError, ParameterError
 from ..ident.registry import make_estimator
 from ..loop import BACKENDS as _LOOP_BACKENDS
 from ..loop.defender import make_defender
+from ..loop.detection import check_audit_rate
 from ..loop.scheme import SCHEMES, make_scheme
 from ..loop.spec import LoopSpec
 from ..plant import Plant
@@ -122,6 +123,8 @@ class AttackParams:
     defender: Any = "fixed"  # the defender policy specification (a name or a policy object), checked
     horizon_capped: bool = False  # no max_samples and a budget beyond MAX_DEFAULT_HORIZON: N is that cap
     rotate_group_every: int | None = None  # K: a fresh group every K attack steps (None: one group)
+    audit_probability: float | None = None  # p: audits per step added to the defender (None: none)
+    defense_noise_sigma2: float | None = None  # sigma_d2: input noise added to the defender (None: none)
     breaker_precomputation: str | None = None  # a precomputation file the breaker loads (index calculus)
     cost_model: CostModel | None = None  # the built deciphering model (its GNFS correction); None: the named one's defaults
 
@@ -500,6 +503,12 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         crypto_seed = check_int("crypto_seed", crypto_seed, minimum=0)
     defender = cfg["defender"]
     make_defender(defender)  # an unknown name or an object that is no policy fails here
+    audit_p = cfg["audit_probability"]
+    if audit_p is not None:
+        audit_p = check_audit_rate(audit_p, "audit_probability")
+    noise_d2 = cfg["defense_noise_sigma2"]
+    if noise_d2 is not None:
+        noise_d2 = check_nonnegative("defense_noise_sigma2", noise_d2)
     from .output_episode import resolve_output
 
     output = resolve_output(cfg, preset, A, B, estimator=estimator, reward=reward, defender=defender)
@@ -545,6 +554,8 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         defender=defender,
         horizon_capped=max_samples is None and horizon < budget,
         rotate_group_every=rotate_every,
+        audit_probability=audit_p,
+        defense_noise_sigma2=noise_d2,
         cost_model=model,
         breaker_precomputation=_breaker_file(cfg, breaker),
         **output,

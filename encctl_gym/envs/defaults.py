@@ -89,6 +89,14 @@ def default_config() -> dict[str, Any]:
     ``defender``                  the plant side's policy (:mod:`encctl_gym.loop.defender`): a
                                   name of ``DEFENDERS`` (``"fixed"``: the paper's fixed defender)
                                   or an object implementing ``DefenderPolicy``
+    ``audit_probability``         ``None`` or ``p`` in [0, 1]: the plant side audits the decoded
+                                  input against its own ``Phi x`` with probability ``p`` per
+                                  step (:class:`~encctl_gym.loop.defenses.AuditDefender`, added
+                                  to ``defender``)
+    ``defense_noise_sigma2``      ``None`` or ``sigma_d2 >= 0``: the plant side adds
+                                  ``N(0, sigma_d2 I)`` to its input every step
+                                  (:class:`~encctl_gym.loop.defenses.NoiseDefender`, added to
+                                  ``defender``)
     ``rotate_group_every``        ``None`` (one group) or ``K >= 1``: every K attack steps the
                                   plant side moves to a fresh safe-prime group of the same size
                                   and re-provisions the server (:mod:`encctl_gym.loop.rotation`);
@@ -140,6 +148,8 @@ def default_config() -> dict[str, Any]:
         "gamma_opt": True,
         "crypto_seed": None,
         "defender": "fixed",
+        "audit_probability": None,
+        "defense_noise_sigma2": None,
         "rotate_group_every": None,
         "observe": "state",
         "C": None,

@@ -106,6 +106,11 @@ def resolve_output(
         raise ParameterError(f"with observe='output' the reward is 'log_error' (of the Markov-parameter error), got {reward!r}")
     if not (isinstance(defender, str) and defender == "fixed"):
         raise ParameterError(f"with observe='output' only the fixed defender is available, got {format_value(defender)}")
+    for key in ("audit_probability", "defense_noise_sigma2", "rotate_group_every"):
+        if cfg.get(key) is not None:
+            raise ParameterError(
+                f"with observe='output' only the fixed defender is available, got {key} = {format_value(cfg[key])}"
+            )
     return {"observe": "output", "C": plant.C, "sigma_v2": plant.sigma_v2, "controller": controller}
 
 

@@ -231,3 +231,81 @@ class CusumDefender(_InnovationDefender):
 
 
 DEFENDERS.update({"noise": NoiseDefender, "audit": AuditDefender, "chi2": DetectorDefender, "cusum": CusumDefender})
+
+
+class CombinedDefender:
+    """Several policies at once (registry name ``"all"``: ``{"name": "all", "policies": [...]}``;
+    the config keys ``audit_probability`` and ``defense_noise_sigma2`` add theirs this way).
+
+    The loop's group is the first policy's; every policy sees every step. The actions merge: the
+    input noises add up, the attack ends if any policy ends it, and at most one policy may move the
+    loop to a new group. The first policy draws from the defender's own streams, each further one
+    from streams spawned from them (``DefenderStreams``), so the policies' draws are independent
+    and a combination of one policy draws exactly what that policy draws alone.
+
+    Parameters
+    ----------
+    policies : sequence
+        Policies or their specifications (names, mappings, objects), at least one.
+    """
+
+    name = "all"
+
+    def __init__(self, policies: Sequence[Any] = ()) -> None:
+        from .defender import make_defender
+
+        if isinstance(policies, (str, bytes)) or not isinstance(policies, Sequence) or len(policies) == 0:
+            raise ParameterError(f"policies must be a non-empty list of defender policies, got {policies!r}")
+        self.policies = [make_defender(p) for p in policies]
+        self.rotates = any(getattr(p, "rotates", False) for p in self.policies)
+
+    def group(self, params: AttackParams) -> Any:
+        groups = [p.group(params) for p in self.policies]
+        return groups[0]
+
+    def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
+        from .defender import DefenderStreams
+
+        for i, p in enumerate(self.policies):
+            p.reset(K, n, m, rngs if i == 0 else DefenderStreams(rngs))
+
+    def act(self, view: PlantView) -> DefenderAction | None:
+        from .defender import check_defender_action
+
+        actions = [p.act(view) for p in self.policies]
+        taken = [a for a in actions if a is not None]
+        if not taken:
+            return None
+        noise: np.ndarray | None = None
+        end = False
+        new_group = None
+        for a in taken:
+            if a.input_noise is not None:
+                d, _ = check_defender_action(
+                    DefenderAction(input_noise=a.input_noise), view.state.shape[0], view.last_input.shape[-1]
+                )
+                noise = d if noise is None else noise + d
+            end = end or a.end
+            if a.new_group is not None:
+                if new_group is not None:
+                    raise ParameterError("two combined defender policies moved the loop to a new group in one step")
+                new_group = a.new_group
+        return DefenderAction(input_noise=noise, end=end, new_group=new_group)
+
+    def on_new_group(self, group: Any) -> None:
+        for p in self.policies:
+            hook = getattr(p, "on_new_group", None)
+            if hook is not None:
+                hook(group)
+
+    def close(self) -> None:
+        for p in self.policies:
+            close = getattr(p, "close", None)
+            if close is not None:
+                close()
+
+    def __repr__(self) -> str:
+        return f"CombinedDefender({self.policies!r})"
+
+
+DEFENDERS.update({"all": CombinedDefender})

@@ -263,15 +263,30 @@ DEFENDERS["rotate"] = RotatingDefender
 
 
 def defender_for(params: Any) -> DefenderPolicy:
-    """The defender of an environment's parameters: the policy ``params.defender`` names, wrapped
-    in a :class:`RotatingDefender` when ``params.rotate_group_every`` is set.
+    """The defender of an environment's parameters: the policy ``params.defender`` names, with an
+    :class:`~encctl_gym.loop.defenses.AuditDefender` for ``params.audit_probability`` and a
+    :class:`~encctl_gym.loop.defenses.NoiseDefender` for ``params.defense_noise_sigma2`` added
+    (a :class:`~encctl_gym.loop.defenses.CombinedDefender` when there is more than one), wrapped in
+    a :class:`RotatingDefender` when ``params.rotate_group_every`` is set.
 
     Raises
     ------
     ParameterError
         For ``rotate_group_every`` together with a defender that rotates already.
     """
+    from .defenses import AuditDefender, CombinedDefender, NoiseDefender
+
     policy = make_defender(params.defender)
+    levers: list[DefenderPolicy] = []
+    audit_p = getattr(params, "audit_probability", None)
+    if audit_p is not None:
+        levers.append(AuditDefender(rate=audit_p))
+    noise_d2 = getattr(params, "defense_noise_sigma2", None)
+    if noise_d2 is not None:
+        levers.append(NoiseDefender(sigma_d2=noise_d2))
+    if levers:
+        keep = [] if getattr(policy, "name", None) == "fixed" else [policy]
+        policy = levers[0] if len(keep + levers) == 1 else CombinedDefender(keep + levers)
     every = getattr(params, "rotate_group_every", None)
     if every is None:
         return policy

@@ -97,6 +97,11 @@ class EncryptedControlGame(ParallelEnv):
             raise ParameterError(
                 f"the game's defender is its 'defender' agent; leave the configuration's defender at 'fixed', got {format_value(p.defender)}"
             )
+        for key in ("audit_probability", "defense_noise_sigma2"):
+            if getattr(p, key) is not None:
+                raise ParameterError(
+                    f"{key} = {format_value(getattr(p, key))} acts outside the game's defender; leave it None and use the game's levers"
+                )
         if p.rotate_group_every is not None:
             raise ParameterError(
                 f"rotate_group_every = {p.rotate_group_every} rotates outside the game's defender; leave it None and use the rotate lever"
