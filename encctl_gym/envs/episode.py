@@ -200,6 +200,7 @@ class EpisodeCore(HelperWork):
         self.stepper: StepStrategy = choose_step(self, q, fused, parallel)
         # the other party: the plant side's decisions, each step, on what the plant knows
         self.defender = defender_for(p) if defender is None else make_defender(defender)
+        self._rotates = bool(getattr(self.defender, "rotates", False))  # the info carries the rotation fields
         self.plant_view = PlantView(s.x, s.U, self._attack_step)
         self.stopped = False  # the defender ended the attack
         #: the group rotations of the episode (loop.rotation): every episode starts on the loop's first group
@@ -541,8 +542,9 @@ class EpisodeCore(HelperWork):
     def info_arrays(self) -> dict[str, np.ndarray]:
         """Info of every copy as new arrays of shape (K,) (:func:`~encctl_gym.envs.layout.info_dict`)."""
         info = info_dict(self.eps.copy(), self.state.energy.copy(), self._shared_info(), self.has_gamma_opt, self.K, self.stopped)
-        for key, value in self._rotation_info().items():
-            info[key] = np.full(self.K, value)
+        if self._rotates or self.rotation.rotations:
+            for key, value in self._rotation_info().items():
+                info[key] = np.full(self.K, value)
         return info
 
     def _rotation_info(self) -> dict[str, Any]:
@@ -557,5 +559,6 @@ class EpisodeCore(HelperWork):
         info = info_dict(
             float(self.eps[0]), float(self.state.energy[0]), self._shared_info(), self.has_gamma_opt, detected=self.stopped
         )
-        info.update(self._rotation_info())
+        if self._rotates or self.rotation.rotations:  # the rotation fields (none otherwise: no cost per step)
+            info.update(self._rotation_info())
         return info
