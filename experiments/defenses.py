@@ -23,7 +23,7 @@ Figure 1 (c) (``fig1-c``):
   the final error over ``gamma_c`` (medians and quartiles), the defender's own wall time per step
   (its ``act``, timed), and the whole step's time against the undefended loop's.
 * **Through real ElGamal** (``--elgamal``): every measured defender at a 64-bit key with the
-  index-calculus breaker, real breaks, against the Gaussian and AR(1) attackers on short attacks,
+  index-calculus breaker, real breaks, against the Gaussian, AR(1) and optimal-design attackers,
   beside the same attacks on the ideal backend (:mod:`encctl_gym.experiments.defenses_elgamal`).
 * **A learned attacker** (``--ars RUN_DIR``): a trained ARS run, trained without any defence,
   against every measured defender: rows of the measured table (design example, ``defenses_ars.md``).

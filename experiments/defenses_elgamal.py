@@ -5,9 +5,9 @@
   :data:`~encctl_gym.experiments.defenses.MEASURED_DEFENDERS` through ``crypto="elgamal"`` at a
   64-bit key with the index-calculus breaker (every key the attacker pays for is broken for real,
   def:adversary; the states are decrypted with the recovered exponents only), against the
-  Gaussian and AR(1) attackers on short attacks (``max_samples``). The same attacks (same seeds,
-  same cap) run on the ideal backend next to it, so the two backends can be compared episode by
-  episode. Per row: the detection rate (Wilson 95 % interval), the detection delay, the samples
+  Gaussian, AR(1) and optimal-design attackers on short attacks (``max_samples``). The same
+  attacks (same seeds, same cap) run on the ideal backend next to it, so the two backends can be
+  compared episode by episode. Per row: the detection rate (Wilson 95 % interval), the detection delay, the samples
   collected, the final error over ``gamma_c``, the breaker's precomputations charged (one per group
   and episode) and their seconds, the keys broken and the seconds per key, and the defender's own
   time per step against the undefended ElGamal step.
@@ -31,7 +31,7 @@ __all__ = ["ELGAMAL_ATTACKERS", "elgamal_rows", "format_elgamal", "ars_rows"]
 ENV_ID = "encctl_gym/EncryptedLTIAttack-v0"
 
 #: The attackers of the ElGamal rows (names of :func:`~encctl_gym.experiments.defenses._attackers`).
-ELGAMAL_ATTACKERS: tuple[str, ...] = ("gaussian", "ar1")
+ELGAMAL_ATTACKERS: tuple[str, ...] = ("gaussian", "ar1", "optimal")
 
 
 class _BreakTally:
@@ -40,7 +40,8 @@ class _BreakTally:
     episode started since the tally was installed."""
 
     def __init__(self, loop: Any) -> None:
-        self.inner, self.loop, self.episodes = loop.decipherer, loop, []
+        self.inner, self.loop = loop.decipherer, loop
+        self.episodes: list[list[tuple[str, Any]]] = []
         loop.decipherer = self
 
     def __getattr__(self, name: str) -> Any:
@@ -106,7 +107,7 @@ def elgamal_rows(
         One row per defender and attacker: ``elgamal`` (the measured table's row,
         :func:`~encctl_gym.experiments.defenses.measured_row`), ``ideal`` (the same on the ideal
         backend), ``same_as_ideal`` (episodes whose detection and samples collected agree on
-        both backends), ``precomputations`` (charged, summed over episodes), ``precomputation_seconds``
+        both backends), ``samples_total`` (collected, summed over the ElGamal episodes), ``precomputations`` (charged, summed over episodes), ``precomputation_seconds``
         (their seconds), ``keys`` (broken, summed), ``seconds_per_key``, ``breaker_seconds``.
     """
     import gymnasium as gym
@@ -145,7 +146,8 @@ def elgamal_rows(
         for name in attackers:
             (ideal, ideal_eps), (elg, elg_eps) = runs[name]["ideal"], runs[name]["elgamal"]
             same = sum(a["detected"] == b["detected"] and a["samples"] == b["samples"] for a, b in zip(ideal_eps, elg_eps))
-            rows.append({"elgamal": elg, "ideal": ideal, "same_as_ideal": same, **runs[name]["breaker"]})
+            total = sum(e["samples"] for e in elg_eps)
+            rows.append({"elgamal": elg, "ideal": ideal, "same_as_ideal": same, "samples_total": total, **runs[name]["breaker"]})
     return rows
 
 
@@ -172,11 +174,14 @@ def format_elgamal(rows: list[dict[str, Any]]) -> str:
     return "\n".join(out)
 
 
-def ars_rows(run_dir: str | Path, system: str = "paper-example", *, episodes: int = 5, seed: int = 0) -> list[dict[str, Any]]:
+def ars_rows(
+    run_dir: str | Path, system: str = "paper-example", *, episodes: int = 5, seed: int = 0, max_samples: int | None = None
+) -> list[dict[str, Any]]:
     """A learned attacker trained without any defence against every defender of
     :data:`~encctl_gym.experiments.defenses.MEASURED_DEFENDERS`: rows of the measured table
     (ideal backend, ``decipher_delay = 0``, the system's own ``tau_c``; the environment's
-    ``input_history`` is the run's, the observation layout its policy reads), attacker ``ars``.
+    ``input_history`` is the run's, the observation layout its policy reads), attacker ``ars``;
+    ``max_samples`` caps the attacks (``None``: the horizon ``tau_c`` buys).
 
     Raises
     ------
@@ -197,6 +202,8 @@ def ars_rows(run_dir: str | Path, system: str = "paper-example", *, episodes: in
         config: dict[str, Any] = {"preset": system, "decipher_delay": 0, "defender": _defender_spec(spec, p), "gamma_opt": False}
         if history is not None:
             config["input_history"] = history
+        if max_samples is not None:
+            config["max_samples"] = max_samples
         env = gym.make(ENV_ID, config=config)
         params = env.unwrapped.params  # type: ignore[attr-defined]
         att = load_attacker(run_dir, params=params, name="ars")
