@@ -22,14 +22,19 @@ Figure 1 (c) (``fig1-c``):
   (Wilson 95 % interval), the detection delay and the samples collected before the attack ends,
   the final error over ``gamma_c`` (medians and quartiles), the defender's own wall time per step
   (its ``act``, timed), and the whole step's time against the undefended loop's.
+* **Through real ElGamal** (``--elgamal``): every measured defender at a 64-bit key with the
+  index-calculus breaker, real breaks, against the Gaussian, AR(1) and optimal-design attackers,
+  beside the same attacks on the ideal backend (:mod:`encctl_gym.experiments.defenses_elgamal`).
+* **A learned attacker** (``--ars RUN_DIR``): a trained ARS run, trained without any defence,
+  against every measured defender: rows of the measured table (design example, ``defenses_ars.md``).
 * **Detection delay against input energy** (``--delays``): the chi-squared and CUSUM detectors
   against every attacker at attack powers ``sigma_u2 / sigma_w2`` in :data:`ENERGY_RATIOS`
   (``defenses_detection.md`` and the figure ``defenses_detection.png``).
 
-    python -m encctl_gym.experiments.defenses [--measure] [--delays] [--rotation] [--episodes 20] [--out results/defenses] [--figures figures]
+    python -m encctl_gym.experiments.defenses [--measure] [--ars RUN_DIR] [--delays] [--rotation] [--elgamal] [--episodes 20] [--out results/defenses] [--figures figures]
 
 Prints the tables and writes them as ``defenses_analytic.md`` (and ``defenses_measured.md``,
-``defenses_rotation.md``).
+``defenses_rotation.md``, ``defenses_elgamal.md``, ``defenses_ars.md``).
 """
 
 from __future__ import annotations
@@ -219,6 +224,38 @@ def _quartiles(values: list[float]) -> tuple[float, float, float]:
     return float(q[0]), float(q[1]), float(q[2])
 
 
+def measured_row(
+    system: str,
+    defender: str,
+    attacker: str,
+    eps: list[dict[str, Any]],
+    horizon: int,
+    gamma_c: float,
+    per_step: float,
+    defender_step: float,
+    base_step: float,
+) -> dict[str, Any]:
+    """One row of the measured table from the episodes of :func:`_episodes` (``base_step``: the
+    undefended loop's time per step against the same attacker)."""
+    hits = sum(e["detected"] for e in eps)
+    return {
+        "system": system,
+        "defender": defender,
+        "attacker": attacker,
+        "episodes": len(eps),
+        "detection_rate": hits / len(eps),
+        "detection_interval": wilson_interval(hits, len(eps)),
+        "samples": _quartiles([float(e["samples"]) for e in eps]),
+        "samples_median": float(np.median([e["samples"] for e in eps])),
+        "delay": _quartiles([float(e["samples"]) for e in eps if e["detected"]]),
+        "error_over_gamma_c": _quartiles([e["epsilon"] / gamma_c for e in eps]),
+        "horizon": horizon,
+        "seconds_per_step": per_step,
+        "defender_seconds_per_step": defender_step,
+        "time_ratio": per_step / base_step,
+    }
+
+
 def measure(system: str, episodes: int, seed: int) -> list[dict[str, Any]]:
     """Every defender against every attacker of the module docstring, ``episodes`` each."""
     import gymnasium as gym
@@ -236,25 +273,8 @@ def measure(system: str, episodes: int, seed: int) -> list[dict[str, Any]]:
             eps, per_step, defender_step = _episodes(env, att, episodes, seed)
             if label == "none":
                 base_time[name] = per_step
-            hits = sum(e["detected"] for e in eps)
-            delays = [float(e["samples"]) for e in eps if e["detected"]]
             rows.append(
-                {
-                    "system": system,
-                    "defender": label,
-                    "attacker": name,
-                    "episodes": episodes,
-                    "detection_rate": hits / episodes,
-                    "detection_interval": wilson_interval(hits, episodes),
-                    "samples": _quartiles([float(e["samples"]) for e in eps]),
-                    "samples_median": float(np.median([e["samples"] for e in eps])),
-                    "delay": _quartiles(delays),
-                    "error_over_gamma_c": _quartiles([e["epsilon"] / p.gamma_c for e in eps]),
-                    "horizon": params.horizon,
-                    "seconds_per_step": per_step,
-                    "defender_seconds_per_step": defender_step,
-                    "time_ratio": per_step / base_time[name],
-                }
+                measured_row(system, label, name, eps, params.horizon, p.gamma_c, per_step, defender_step, base_time[name])
             )
     return rows
 
@@ -407,18 +427,46 @@ def main(argv: list[str] | None = None) -> int:
         "--rotation", action="store_true", help="also the group-rotation tables (real ElGamal and a breaker at 64 bits)"
     )
     parser.add_argument("--rotation-samples", type=int, default=200, help="samples per rotation episode (default 200)")
+    parser.add_argument(
+        "--elgamal",
+        action="store_true",
+        help="also every defender through real ElGamal at 64 bits with the index-calculus breaker",
+    )
+    parser.add_argument("--elgamal-samples", type=int, default=200, help="samples per ElGamal attack (default 200)")
+    parser.add_argument(
+        "--elgamal-episodes", type=int, default=10, help="ElGamal episodes per defender and attacker (default 10)"
+    )
+    parser.add_argument(
+        "--ars",
+        type=Path,
+        metavar="RUN_DIR",
+        help="also a trained ARS run against every defender (design example, ideal backend)",
+    )
     args = parser.parse_args(argv)
     if args.episodes < 1:
         print(f"defenses: --episodes must be >= 1, got {args.episodes}", file=sys.stderr)
         return 2
+    if args.elgamal_episodes < 1 or args.elgamal_samples < 9:
+        print(
+            f"defenses: --elgamal-episodes must be >= 1 and --elgamal-samples >= 9 (n + m + 1), got "
+            f"{args.elgamal_episodes} and {args.elgamal_samples}",
+            file=sys.stderr,
+        )
+        return 2
     if args.rotation_samples < 9:
         print(f"defenses: --rotation-samples must be >= 9 (n + m + 1), got {args.rotation_samples}", file=sys.stderr)
         return 2
+    from encctl_gym.experiments.defenses_elgamal import ars_rows, elgamal_rows, format_elgamal  # it imports this module
+
     try:
         noise = noise_rows()
         text = format_tables(noise, audit_rows(noise))
         measured = [r for system in SYSTEMS for r in measure(system, args.episodes, args.seed)] if args.measure else []
+        ars = ars_rows(args.ars, "paper-example", episodes=args.episodes, seed=args.seed) if args.ars is not None else []
         rotation = rotation_rows(args.rotation_samples, args.seed) if args.rotation else None
+        elgamal = (
+            elgamal_rows(samples=args.elgamal_samples, episodes=args.elgamal_episodes, seed=args.seed) if args.elgamal else None
+        )
         delays = [r for system in SYSTEMS for r in detection_delays(system, args.episodes, args.seed)] if args.delays else []
     except EncctlError as exc:
         print(f"defenses: {exc}", file=sys.stderr)
@@ -435,7 +483,8 @@ def main(argv: list[str] | None = None) -> int:
         print(table)
         path = args.out / "defenses_measured.md"
         path.write_text(
-            f"# The defences measured in the environment\n\nCommand: `python -m encctl_gym.experiments.defenses --measure --episodes {args.episodes}`"
+            "# The defences measured in the environment\n\nCommand: `python -m encctl_gym.experiments.defenses --measure "
+            f"--episodes {args.episodes}`"
             f" (seed {args.seed}; decipher_delay = 0, ideal backend, each system's own tau_c)\n\n" + table + "\n"
         )
         print(f"  wrote {path}")
@@ -448,6 +497,27 @@ def main(argv: list[str] | None = None) -> int:
             f"--rotation-samples {args.rotation_samples}` (seed {args.seed}; the design: uncorrected GNFS, budget "
             "Upsilon tau_c of paper-example; measured: real ElGamal at 64 bits, index-calculus breaker, Gaussian "
             "attacker, one episode per K)\n\n" + table + "\n"
+        )
+        print(f"  wrote {path}")
+    if ars:
+        table = format_measured(ars)
+        print(table)
+        path = args.out / "defenses_ars.md"
+        path.write_text(
+            "# A learned attacker against the defences\n\nCommand: `python -m encctl_gym.experiments.defenses --ars "
+            f"{args.ars} --episodes {args.episodes}` (seed {args.seed}; the run trained without any defence; "
+            "decipher_delay = 0, ideal backend, the design example's own tau_c; rows of the measured table)\n\n" + table + "\n"
+        )
+        print(f"  wrote {path}")
+    if elgamal is not None:
+        table = format_elgamal(elgamal)
+        print(table)
+        path = args.out / "defenses_elgamal.md"
+        path.write_text(
+            "# The defences through real ElGamal\n\nCommand: `python -m encctl_gym.experiments.defenses --elgamal "
+            f"--elgamal-samples {args.elgamal_samples} --elgamal-episodes {args.elgamal_episodes}` (seed {args.seed}; "
+            "paper-example, decipher_delay = 0, crypto = elgamal, key_length = 64, breaker = index-calculus "
+            "(breaker_time_limit 60 s), crypto_seed = seed; the same attacks on the ideal backend beside them)\n\n" + table + "\n"
         )
         print(f"  wrote {path}")
     if delays:
