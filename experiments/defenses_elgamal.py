@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from encctl_gym.experiments.defenses import MEASURED_DEFENDERS, _attackers, _defender_spec, _episodes, _iqr, measured_row
+from encctl_gym.experiments.defenses_measured import MEASURED_DEFENDERS, _attackers, _defender_spec, _episodes, _iqr, measured_row
 from encctl_gym.presets import get_preset
 
 __all__ = ["ELGAMAL_ATTACKERS", "elgamal_rows", "format_elgamal", "ars_rows"]

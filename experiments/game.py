@@ -55,7 +55,7 @@ from encctl_gym.agents.game import (
 from encctl_gym.agents.game_training import Curve, alternate, train_side
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.experiments.common import _checked, ensure_out_dir, script_main
-from encctl_gym.experiments.compare.statistics import Z95
+from encctl_gym.experiments.compare.statistics import wilson_interval
 from encctl_gym.experiments.identification_strategies import replicate_interval
 from encctl_gym.multiagent import GameRules
 from encctl_gym.plotting import legend_below, save_figure
@@ -92,18 +92,15 @@ def static_players(params: Any) -> tuple[list[Player], list[Player]]:
     return defenders, attackers
 
 
-def wilson_interval(hits: np.ndarray) -> tuple[float, float, float]:
-    """A rate with its 95 % Wilson score interval (inside [0, 1] for any count)."""
-    k, n = float(np.sum(hits)), int(np.size(hits))
-    p, z = k / n, Z95
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return p, float(max(0.0, centre - half)), float(min(1.0, centre + half))
+def rate_interval(hits: np.ndarray) -> tuple[float, float, float]:
+    """A rate with its 95 % Wilson score interval (:func:`~encctl_gym.experiments.compare.statistics.wilson_interval`)."""
+    k, n = int(np.sum(hits)), int(np.size(hits))
+    return (k / n, *wilson_interval(k, n))
 
 
 def cell(outcome: Outcome) -> dict[str, tuple[float, float, float]]:
     """Mean and 95 % interval of every metric of one cell (t intervals; Wilson for the rate)."""
-    return {key: (wilson_interval if key == "detected" else replicate_interval)(getattr(outcome, key)) for key, _ in METRICS}
+    return {key: (rate_interval if key == "detected" else replicate_interval)(getattr(outcome, key)) for key, _ in METRICS}
 
 
 def _fmt(v: float) -> str:

@@ -326,3 +326,15 @@ def test_the_kernels_are_warmed_before_the_progress_bar_starts(monkeypatch):
     assert events[:2] == ["warm", "bar"], events
     plain = cmp.compute(["small"], progress=False, **kw)
     assert with_bar.security == plain.security
+
+
+def test_the_wilson_interval_against_its_closed_form():
+    from encctl_gym.experiments.compare.statistics import Z95, wilson_interval
+
+    z2 = Z95 * Z95
+    lo, hi = wilson_interval(0, 10)  # no success: [0, z^2 / (n + z^2)]
+    assert lo == 0.0 and abs(hi - z2 / (10 + z2)) < 1e-15
+    lo, hi = wilson_interval(5, 10)  # symmetric about 1/2, half-width z sqrt(n/4 + z^2/4) / (n + z^2)
+    half = Z95 * (10 / 4 + z2 / 4) ** 0.5 / (10 + z2)
+    assert abs(lo - (0.5 - half)) < 1e-15 and abs(hi - (0.5 + half)) < 1e-15
+    assert wilson_interval(0, 0) == (0.0, 1.0)

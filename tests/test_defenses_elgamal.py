@@ -6,8 +6,9 @@ from __future__ import annotations
 
 import pytest
 
-from encctl_gym.experiments.defenses import MEASURED_DEFENDERS, format_measured, main
+from encctl_gym.experiments.defenses import main
 from encctl_gym.experiments.defenses_elgamal import ars_rows, elgamal_rows, format_elgamal
+from encctl_gym.experiments.defenses_measured import MEASURED_DEFENDERS, format_measured
 
 
 @pytest.mark.slow

@@ -111,7 +111,7 @@ def test_bad_defender_options_are_refused(spec, match):
 
 
 def test_the_measured_defence_table_on_a_small_plant():
-    from encctl_gym.experiments.defenses import MEASURED_DEFENDERS, format_measured, measure
+    from encctl_gym.experiments.defenses_measured import MEASURED_DEFENDERS, format_measured, measure
 
     rows = measure("small", episodes=1, seed=0)
     assert len(rows) == 3 * len(MEASURED_DEFENDERS)

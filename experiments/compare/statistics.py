@@ -17,10 +17,22 @@ import numpy as np
 from encctl_gym.errors import ParameterError
 from encctl_gym.security.design import sample_size_for_rate
 
-__all__ = ["Z95", "mean_se", "PairedRatio", "paired_ratio", "fit_rate", "samples_to_reach"]
+__all__ = ["Z95", "wilson_interval", "mean_se", "PairedRatio", "paired_ratio", "fit_rate", "samples_to_reach"]
 
 #: z value of a two-sided 95 % normal interval.
 Z95 = 1.959963984540054
+
+
+def wilson_interval(successes: int, trials: int, z: float = Z95) -> tuple[float, float]:
+    """The Wilson score interval of a binomial proportion ``successes / trials`` (95 % by default),
+    inside [0, 1] for any count; ``(0, 1)`` for no trials."""
+    if trials == 0:
+        return (0.0, 1.0)
+    ph = successes / trials
+    den = 1 + z * z / trials
+    mid = (ph + z * z / (2 * trials)) / den
+    half = z * math.sqrt(ph * (1 - ph) / trials + z * z / (4 * trials * trials)) / den
+    return (float(max(0.0, mid - half)), float(min(1.0, mid + half)))
 
 
 def mean_se(eps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
