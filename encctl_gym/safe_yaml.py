@@ -81,7 +81,8 @@ def _where(stack: list[_Open], key: str) -> str:
 
 def _compose(loader: Any, what: str, max_nodes: int, max_depth: int, aliases: bool, limit_error: type[EncctlError]) -> Any:
     """The single document's root node (``None`` for an empty stream), every bound checked on
-    the way (module docstring); mirrors PyYAML's ``Composer`` without its recursion."""
+    the way (module docstring); mirrors PyYAML's ``Composer`` without its recursion (and without
+    its path resolvers, which the safe loader does not have)."""
     import yaml
 
     loader.get_event()  # StreamStartEvent
