@@ -42,9 +42,10 @@ key               meaning
 
 Every entry is checked (:func:`validate_config`): an unknown key, a value of the wrong type or
 outside its range is a one-line :class:`~encctl_gym.errors.ConfigError`, whether it comes from
-a file or from ``--set``. Files are read with YAML's safe loader, at most 1 MiB, without
-aliases (nested aliases can expand a small file into gigabytes) and nested at most
-:data:`MAX_CONFIG_DEPTH` levels. Step counts are at most :data:`MAX_STEPS` and seeds at most
+a file or from ``--set``. Files and ``--set`` values are read by the package's safe YAML reader
+(:mod:`encctl_gym.safe_yaml`): at most 1 MiB, without aliases (nested aliases can expand a small
+file into gigabytes), nested at most :data:`MAX_CONFIG_DEPTH` levels, no key given twice, and
+``1e-3`` is a number as in YAML 1.2. Step counts are at most :data:`MAX_STEPS` and seeds at most
 :data:`MAX_SEED`.
 """
 
@@ -55,12 +56,11 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-import yaml
-
-from encctl_gym._validation import check_int, check_nonnegative, check_positive, format_value, read_bounded
+from encctl_gym._validation import check_int, check_nonnegative, check_positive, format_value
 from encctl_gym.envs.config import completion_preset, resolve_params
 from encctl_gym.envs.config import default_config as env_default_config
 from encctl_gym.errors import ConfigError, EncctlError, ParameterError
+from encctl_gym.safe_yaml import load_yaml, read_yaml_file
 
 from .base import OBSERVATION_MODES
 
@@ -72,6 +72,7 @@ __all__ = [
     "BUDGETS",
     "MAX_CONFIG_BYTES",
     "MAX_CONFIG_DEPTH",
+    "MAX_CONFIG_NODES",
     "MAX_STEPS",
     "MAX_SEED",
     "read_yaml",
@@ -90,6 +91,15 @@ DEFAULTS_DIR = CONFIG_DIR / "defaults"
 MAX_CONFIG_BYTES = 1 << 20
 #: Deepest nesting of mappings and lists in a config file or an override value.
 MAX_CONFIG_DEPTH = 32
+#: Most YAML nodes in a config file or an override value (no aliases: the nodes written).
+MAX_CONFIG_NODES = 1 << 20
+#: How config files and override values are read: no aliases, every bound a ConfigError.
+_YAML_POLICY: dict[str, Any] = {
+    "max_nodes": MAX_CONFIG_NODES,
+    "max_depth": MAX_CONFIG_DEPTH,
+    "aliases": False,
+    "limit_error": ConfigError,
+}
 #: Largest step count (``n_timesteps``, ``eval.freq``): stable-baselines3 divides step counts in
 #: float64, exact for integers up to 2**53.
 MAX_STEPS = 2**53
@@ -137,52 +147,24 @@ COMMON: dict[str, Any] = {
 # --------------------------------------------------------------------------- reading
 def read_yaml(path: str | Path) -> dict[str, Any]:
     """Read one config file: a YAML mapping, safe tags only, no aliases, at most 1 MiB, nested at
-    most :data:`MAX_CONFIG_DEPTH` levels.
+    most :data:`MAX_CONFIG_DEPTH` levels, no key twice (:func:`encctl_gym.safe_yaml.read_yaml_file`).
 
     Raises
     ------
     ConfigError
         Missing or unreadable file, a YAML error (including ``!!python/...`` tags and integers
-        of over 4300 digits), an alias, deeper nesting, or a top level that is not a mapping.
+        of over 4300 digits), an alias, deeper nesting, a key given twice, or a top level that
+        is not a mapping.
     """
     p = Path(path)
     if not p.is_file():
         raise ConfigError(f"config file {str(p)!r} does not exist")
-    raw = read_bounded("config file", p, MAX_CONFIG_BYTES, "MAX_CONFIG_BYTES", error=ConfigError)
-    try:
-        text = raw.decode("utf-8")
-        _check_yaml_tokens(text, f"config file {str(p)!r}")
-        data = yaml.safe_load(text)
-    except ConfigError:
-        raise
-    except (OSError, UnicodeDecodeError, ValueError, yaml.YAMLError) as exc:  # ValueError: an integer of over 4300 digits
-        first = str(exc).strip().splitlines()
-        what = format_value(" ".join(first[:2])) if first else type(exc).__name__
-        raise ConfigError(f"cannot read config file {str(p)!r}: {what}") from None
+    data = read_yaml_file(p, what="config file", max_bytes=MAX_CONFIG_BYTES, limit_name="MAX_CONFIG_BYTES", **_YAML_POLICY)
     if data is None:
         return {}
     if not isinstance(data, dict):
         raise ConfigError(f"config file {str(p)!r} must hold a mapping at the top level, got a {type(data).__name__}")
     return data
-
-
-def _check_yaml_tokens(text: str, where: str) -> None:
-    """Refuse YAML aliases and nesting deeper than :data:`MAX_CONFIG_DEPTH`, from the tokens alone
-    (before a Python object is built: PyYAML builds nested values recursively)."""
-    depth = 0
-    for tok in yaml.scan(text):
-        if isinstance(tok, yaml.AliasToken):
-            raise ConfigError(f"{where} uses a YAML alias (*name); write the values out")
-        if isinstance(tok, _OPENING):
-            depth += 1
-            if depth > MAX_CONFIG_DEPTH:
-                raise ConfigError(f"{where} nests mappings or lists more than {MAX_CONFIG_DEPTH} levels deep")
-        elif isinstance(tok, _CLOSING):
-            depth -= 1
-
-
-_OPENING = (yaml.BlockMappingStartToken, yaml.BlockSequenceStartToken, yaml.FlowMappingStartToken, yaml.FlowSequenceStartToken)
-_CLOSING = (yaml.BlockEndToken, yaml.FlowMappingEndToken, yaml.FlowSequenceEndToken)
 
 
 def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
@@ -476,14 +458,9 @@ def _check_elgamal_evaluation(cfg: dict[str, Any]) -> None:
 
 # --------------------------------------------------------------------------- overrides
 def _yaml_value(text: str) -> Any:
-    """A YAML value, with ``1e-3``-style floats (strings to YAML 1.1) read as floats."""
-    try:
-        _check_yaml_tokens(text, f"override value {format_value(text)}")
-        v = yaml.safe_load(text)
-    except (ValueError, yaml.YAMLError) as exc:  # ValueError: an integer of over 4300 digits
-        raise ConfigError(
-            f"override value {format_value(text)} is not valid YAML: {format_value(str(exc).splitlines()[0])}"
-        ) from None
+    """A YAML value (:func:`encctl_gym.safe_yaml.load_yaml`, the bounds of a config file); a plain
+    string that Python reads as a number (``inf``, ``1_000.5``) is that float."""
+    v = load_yaml(text, what=f"override value {format_value(text)}", **_YAML_POLICY)
     if isinstance(v, str):
         try:
             return float(v)

@@ -26,9 +26,10 @@ defaults. Unknown fields, and a field given twice, are an error naming them. In 
 with an exponent but no dot (``1e-6``, ``442e15``) is a number, as in JSON and on the command line
 (PyYAML's YAML 1.1 would read it as a string); a quoted value stays a string.
 
-Reading is bounded: files over :data:`MAX_FILE_BYTES` are refused before they are read; YAML
-aliases are expanded in a node count (:data:`MAX_YAML_NODES`) before any Python object is built
-(a few hundred bytes of nested aliases would otherwise take gigabytes); NPZ members are checked
+Reading is bounded: files over :data:`MAX_FILE_BYTES` are refused before they are read; YAML is
+read by :func:`encctl_gym.safe_yaml.load_yaml`, with aliases allowed but counted expanded within
+:data:`MAX_YAML_NODES` nodes before any Python object is built (a few hundred bytes of nested
+aliases would otherwise take gigabytes), nesting at most :data:`MAX_YAML_DEPTH` levels; NPZ members are checked
 for their uncompressed size and loaded without pickles. Numbers must be real and finite in
 float64: booleans, strings, NaN, infinities, complex data and integers beyond the float range
 (``10**400``) are refused, naming the field and the position of the first bad entry (``A[1][0]``).
@@ -36,7 +37,6 @@ float64: booleans, strings, NaN, infinities, complex data and integers beyond th
 
 from __future__ import annotations
 
-import functools
 import io
 import json
 import math
@@ -61,9 +61,19 @@ from ._validation import (
 )
 from .errors import ConfigError, ParameterError, ResourceLimitError
 from .presets import DESIGN_FIELDS, SystemPreset, design_defaults
+from .safe_yaml import load_yaml
 from .units import parse_duration
 
-__all__ = ["PlantSpec", "load_plant_file", "load_system", "PLANT_FIELDS", "MAX_FILE_BYTES", "MAX_YAML_NODES", "SUFFIXES"]
+__all__ = [
+    "PlantSpec",
+    "load_plant_file",
+    "load_system",
+    "PLANT_FIELDS",
+    "MAX_FILE_BYTES",
+    "MAX_YAML_NODES",
+    "MAX_YAML_DEPTH",
+    "SUFFIXES",
+]
 
 #: The fields of the measurement ``y = C x + v`` (optional; without them the state is measured).
 OUTPUT_FIELDS: tuple[str, ...] = ("C", "sigma_v2")
@@ -73,6 +83,8 @@ PLANT_FIELDS: tuple[str, ...] = ("A", "B", *OUTPUT_FIELDS, *DESIGN_FIELDS)
 MAX_FILE_BYTES: int = 64 * 2**20
 #: Largest number of YAML nodes after alias expansion.
 MAX_YAML_NODES: int = 4_000_000
+#: Deepest nesting of mappings and lists in a YAML plant file (the top-level mapping is one level).
+MAX_YAML_DEPTH: int = 32
 #: Accepted file name endings.
 SUFFIXES: tuple[str, ...] = (".json", ".yaml", ".yml", ".npz")
 _MAX_NPZ_MEMBERS = len(PLANT_FIELDS)
@@ -131,90 +143,13 @@ def _fail(path: Path, msg: str) -> ConfigError:
 
 
 # --------------------------------------------------------------------------- bounded decoding
-# YAML 1.1 (PyYAML) reads ``1e-6`` and ``442e15`` as strings, since its floats need a dot; YAML 1.2,
-# JSON and the command line read them as numbers, and so do plant files
-_YAML_EXPONENT_FLOAT = r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"
-
-
-@functools.lru_cache(maxsize=1)
-def _yaml_loader_class() -> Any:
-    """The safe YAML loader (the C one when available) that also reads ``1e-6`` as a float."""
-    import re
-
-    import yaml
-
-    base = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-    loader: Any = type("PlantFileLoader", (base,), {})
-    loader.add_implicit_resolver("tag:yaml.org,2002:float", re.compile(_YAML_EXPONENT_FLOAT), list("-+0123456789"))
-    return loader
-
-
 def _refuse_duplicate_keys(path: Path, keys: list[Any]) -> None:
-    """A field given twice is an error: the reader would otherwise keep the last one silently."""
+    """A JSON field given twice is an error: the reader would otherwise keep the last one silently."""
     seen: set[Any] = set()
     for k in keys:
         if k in seen:
             raise _fail(path, f"field {format_value(k)} is given more than once")
         seen.add(k)
-
-
-def _expanded_yaml_nodes(root: Any, limit: int) -> int:
-    """Number of nodes of ``root`` with every alias expanded, counted without expanding (memoised
-    on node identity; a recursive alias, which would expand forever, raises ValueError)."""
-    import yaml
-
-    sizes: dict[int, int] = {}
-    on_path: set[int] = set()
-    stack: list[tuple[Any, bool]] = [(root, False)]
-    while stack:
-        node, done = stack.pop()
-        key = id(node)
-        if done:
-            on_path.discard(key)
-            if isinstance(node, yaml.SequenceNode):
-                children = node.value
-            elif isinstance(node, yaml.MappingNode):
-                children = [c for pair in node.value for c in pair]
-            else:
-                children = []
-            total = 1 + sum(sizes[id(c)] for c in children)
-            sizes[key] = min(total, limit + 1)
-            continue
-        if key in sizes:
-            continue
-        if key in on_path:
-            raise ValueError("a YAML alias refers to a node that contains it (recursive alias)")
-        on_path.add(key)
-        stack.append((node, True))
-        if isinstance(node, yaml.SequenceNode):
-            stack.extend((c, False) for c in node.value)
-        elif isinstance(node, yaml.MappingNode):
-            stack.extend((c, False) for pair in node.value for c in pair)
-    return sizes[id(root)]
-
-
-def _load_yaml(path: Path, text: str) -> Any:
-    import yaml
-
-    loader = _yaml_loader_class()(text)
-    try:
-        node = loader.get_single_node()
-        if node is None:
-            return None
-        if isinstance(node, yaml.MappingNode):
-            _refuse_duplicate_keys(path, [k.value for k, _ in node.value if isinstance(k, yaml.ScalarNode)])
-        try:
-            count = _expanded_yaml_nodes(node, MAX_YAML_NODES)
-        except ValueError as exc:
-            raise _fail(path, str(exc)) from None
-        if count > MAX_YAML_NODES:
-            raise ResourceLimitError(
-                f"system file {str(path)!r}: its YAML aliases expand to more than {MAX_YAML_NODES} nodes; "
-                "write the matrices out instead of nesting aliases"
-            )
-        return loader.construct_document(node)
-    finally:
-        loader.dispose()
 
 
 def _load_npz(path: Path, raw: bytes) -> dict[str, Any]:
@@ -253,7 +188,9 @@ def _decode(path: Path) -> Any:
         text = raw.decode("utf-8")
         if suffix == ".json":
             return json.loads(text, object_pairs_hook=lambda pairs: _json_object(path, pairs))
-        return _load_yaml(path, text)
+        return load_yaml(
+            text, what=f"system file {str(path)!r}", max_nodes=MAX_YAML_NODES, max_depth=MAX_YAML_DEPTH, aliases=True
+        )
     except (ConfigError, ResourceLimitError):
         raise
     except Exception as exc:  # noqa: BLE001 - any parse failure (syntax, tags, depth, digits) is one ConfigError
