@@ -17,7 +17,8 @@ A sample is collected only if its cost, with the group it lies in, stays within
 ``Upsilon tau_c`` (exact rational arithmetic, as the horizon's); the game ends the attack at the
 step whose sample the budget cannot pay (terminated, as a deciphering budget ends it). Under the
 measured clock (``deciphering_clock="measured"``) the breaker's own seconds already pay each
-group's precomputation, and the clock is off.
+group's precomputation, and the clock is off; so it is where every key costs the same (the
+paper's model with independent keys).
 """
 
 from __future__ import annotations
@@ -41,15 +42,18 @@ class GroupClock:
     Attributes
     ----------
     active : bool
-        False under the measured clock (the breaker charges the groups itself).
+        False under the measured clock (the breaker charges the groups itself) and where every
+        key costs the same with independent keys (rotation changes nothing: the episode's own
+        table is exact).
     samples, groups : int
         Samples collected this episode and the groups they lie in.
     """
 
     def __init__(self, params: Any) -> None:
-        self.active = params.deciphering_clock == "model"
         self.first, self.next = Fraction(params.cost.first), Fraction(params.cost.next)
         self.independent = bool(params.independent_keys)
+        # a group costs more than its keys only with a precomputation, or when one break reveals it
+        self.active = params.deciphering_clock == "model" and (self.first != self.next or not self.independent)
         self.upsilon = decimal_fraction("upsilon", params.upsilon)
         self.budget = self.upsilon * decimal_fraction("tau_c", params.tau_c)
         self.reset(1)
