@@ -86,8 +86,11 @@ def test_the_observed_budget_fraction_counts_the_new_groups_precomputation():
 
 
 def test_the_clock_charges_groups_by_hand_count():
-    clock = GroupClock(resolve_params(_cfg()))
+    p = resolve_params(_cfg())
+    clock = GroupClock(p)
     first, nxt = clock.first, clock.next
+    for n in (1, 7, N):  # one group: the episode's own table (sample_deciphering_time)
+        assert float(clock.work(n, 1) / clock.upsilon) == pytest.approx(float(p.deciphering_time(n)), rel=1e-12)
     clock.reset(1)
     assert clock.work(1, 1) == first and clock.work(0, 1) == 0
     clock.advance(2, rotated=False)
