@@ -24,7 +24,8 @@ The defender's action is a vector in ``[-1, 1]``, one entry per lever of :data:`
   this step's period (:mod:`encctl_gym.loop.rotation`: the groups come from a
   :class:`~encctl_gym.loop.rotation.GroupPool` seeded from the plant's stream, the same sequence
   as the ``"rotate"`` defender's), so the samples from the next one on lie in the new group and
-  the attacker's deciphering pays for it (its cost model charges per group). Each rotation costs
+  the attacker's deciphering pays for it (its cost model charges per group: the game's
+  :class:`~encctl_gym.multiagent.clock.GroupClock`). Each rotation costs
   :attr:`GameRules.rotation_cost`.
 
 A new lever is one more name in :data:`LEVERS`, one more entry of the action, one more field
