@@ -26,8 +26,8 @@ at every other step):
 Writes ``game_ALGO.md`` (the tables), ``game_ALGO_cells.csv`` (one row per cell) and the figure.
 
 **Static only** (``--static-only``, no training): the static defenders with the rotate lever on
-(group rotation every ``K`` of :data:`ROTATION_PERIODS` steps, with no defence, random audits and
-the chi-squared detector for reference) against the static attackers (Gaussian, AR(1), the
+(group rotation every ``K`` of :data:`ROTATION_PERIODS` steps, the chi-squared detector's audit
+with rotation every 10 steps, and no defence, random audits and the detector alone for reference) against the static attackers (Gaussian, AR(1), the
 optimal design, pass-through, sparse Gaussian), under ``--deciphering-model`` (default
 ``precomputation``: the attacker pays one precomputation per group it meets, charged by the
 game's :class:`~encctl_gym.multiagent.clock.GroupClock`, so rotation shortens its attack; under
@@ -53,6 +53,7 @@ from encctl_gym._validation import check_int
 from encctl_gym.agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker
 from encctl_gym.agents.evaluate import budget_config, env_config
 from encctl_gym.agents.game import (
+    Combined,
     ConstantNoise,
     DetectorAudit,
     NoDefence,
@@ -173,6 +174,7 @@ def rotation_players(params: Any) -> tuple[list[Player], list[Player]]:
         RandomAudit(0.05),
         DetectorAudit(p.n, p.m),
         *(RotateEvery(K) for K in ROTATION_PERIODS),
+        Combined(DetectorAudit(p.n, p.m), RotateEvery(10)),
     ]
     attackers: list[Player] = [
         ScheduledAttacker(GaussianAttacker(p)),

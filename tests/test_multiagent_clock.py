@@ -127,4 +127,17 @@ def test_the_static_only_table_records_the_rotation_rows(tmp_path):
     rows = {line.split(" | ")[0].strip("| "): line for line in samples.splitlines() if line.startswith("| rotate")}
     assert set(rows) == {"rotate(K=1)", "rotate(K=10)", "rotate(K=100)"}
     assert rows["rotate(K=10)"].count("| 10 ") == 5 and rows["rotate(K=100)"].count("| 32 ") == 5  # K past N: one group
-    assert (tmp_path / "game_static_cells.csv").read_text().count("\n") == 1 + 6 * 5
+    assert (tmp_path / "game_static_cells.csv").read_text().count("\n") == 1 + 7 * 5
+
+
+def test_combined_defenders_set_a_lever_if_any_of_them_does():
+    from encctl_gym.agents.game import Combined, ConstantNoise, DetectorAudit
+
+    both = Combined(DetectorAudit(2, 1), RotateEvery(2), ConstantNoise(0.25))
+    assert both.name == "chi2+rotate(K=2)+noise(0.25)"
+    both.reset(0)
+    quiet, alarm = np.zeros(6, np.float32), np.array([0, 0, 0, 2.0, 0, 0], np.float32)  # entry n + m: the statistic
+    got = [both.act(o).tolist() for o in (quiet, alarm, quiet, quiet)]
+    assert got == [[-1, 0.25, -1], [1, 0.25, 1], [-1, 0.25, -1], [-1, 0.25, 1]]
+    with pytest.raises(ParameterError, match="two defenders"):
+        Combined(RotateEvery(2))
