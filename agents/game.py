@@ -9,7 +9,7 @@ of :class:`~encctl_gym.multiagent.game.EncryptedControlGame` (its observation an
   :class:`NoDefence`, :class:`RandomAudit` (audit with probability ``p`` per step),
   :class:`DetectorAudit` (audit when the chi-squared statistic it observes passes its threshold),
   :class:`ConstantNoise` (a fixed noise level), :class:`RotateEvery` (a fresh group every ``K``
-  steps);
+  steps), and :class:`Combined` (several of them at once: a lever is on if any of them sets it);
 * attackers: :class:`ScheduledAttacker` turns any attacker of :mod:`encctl_gym.agents` (Gaussian, AR(1),
   the optimal design, a learned one) into a game player that injects on a schedule: at every
   step, at random steps with probability ``q`` (sparse), or in bursts of ``duty`` steps every
@@ -52,6 +52,7 @@ __all__ = [
     "DetectorAudit",
     "ConstantNoise",
     "RotateEvery",
+    "Combined",
     "ScheduledAttacker",
     "PassThrough",
     "LearnedPlayer",
@@ -182,6 +183,30 @@ class RotateEvery:
     def act(self, obs: np.ndarray) -> np.ndarray:
         self.k += 1
         return defender_action(rotate=1.0 if self.k % self.K == 0 else -1.0)
+
+
+class Combined:
+    """Several defenders at once: each lever's entry is the largest of theirs (a lever is on if
+    any of them sets it; the noise is the highest level asked for).
+
+    Parameters
+    ----------
+    defenders : Player
+        Two or more defenders, each seeing the same observation.
+    """
+
+    def __init__(self, *defenders: Player) -> None:
+        if len(defenders) < 2:
+            raise ParameterError(f"Combined needs at least two defenders, got {len(defenders)}")
+        self.defenders = list(defenders)
+        self.name = "+".join(d.name for d in self.defenders)
+
+    def reset(self, seed: int | None = None) -> None:
+        for d, s in zip(self.defenders, np.random.SeedSequence(seed).spawn(len(self.defenders))):
+            d.reset(int(s.generate_state(1)[0]))
+
+    def act(self, obs: np.ndarray) -> np.ndarray:
+        return np.max([d.act(obs) for d in self.defenders], axis=0).astype(np.float32)
 
 
 # ---------------------------------------------------------------------- attackers

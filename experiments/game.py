@@ -24,6 +24,17 @@ at every other step):
         [--out docs/results/game] [--figure docs/figures/game_learning_curves_ALGO.png]
 
 Writes ``game_ALGO.md`` (the tables), ``game_ALGO_cells.csv`` (one row per cell) and the figure.
+
+**Static only** (``--static-only``, no training): the static defenders with the rotate lever on
+(group rotation every ``K`` of :data:`ROTATION_PERIODS` steps, the chi-squared detector's audit
+with rotation every 10 steps, and no defence, random audits and the detector alone for reference) against the static attackers (Gaussian, AR(1), the
+optimal design, pass-through, sparse Gaussian), under ``--deciphering-model`` (default
+``precomputation``: the attacker pays one precomputation per group it meets, charged by the
+game's :class:`~encctl_gym.multiagent.clock.GroupClock`, so rotation shortens its attack; under
+the paper's model every key costs the same and rotation changes nothing). Writes
+``game_static.md`` and ``game_static_cells.csv``.
+
+    python -m encctl_gym.experiments.game --static-only [--N 128] [--episodes 30]
 """
 
 from __future__ import annotations
@@ -42,6 +53,7 @@ from encctl_gym._validation import check_int
 from encctl_gym.agents import ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker
 from encctl_gym.agents.evaluate import budget_config, env_config
 from encctl_gym.agents.game import (
+    Combined,
     ConstantNoise,
     DetectorAudit,
     NoDefence,
@@ -49,6 +61,7 @@ from encctl_gym.agents.game import (
     PassThrough,
     Player,
     RandomAudit,
+    RotateEvery,
     ScheduledAttacker,
     play,
 )
@@ -68,6 +81,10 @@ METRICS = (
     ("attacker_return", "the attacker's return"),
     ("defender_return", "the defender's return"),
 )
+
+
+#: Rotation periods of the static-only table's rotation rows.
+ROTATION_PERIODS: tuple[int, ...] = (1, 10, 100)
 
 
 def static_players(params: Any) -> tuple[list[Player], list[Player]]:
@@ -146,7 +163,83 @@ def plot_curves(curves: Sequence[Curve], path: str | Path, window: int = 50) -> 
     return out
 
 
+def rotation_players(params: Any) -> tuple[list[Player], list[Player]]:
+    """The defenders and attackers of the static-only table (module docstring)."""
+    p = params
+    defenders: list[Player] = [
+        NoDefence(),
+        RandomAudit(0.05),
+        DetectorAudit(p.n, p.m),
+        *(RotateEvery(K) for K in ROTATION_PERIODS),
+        Combined(DetectorAudit(p.n, p.m), RotateEvery(10)),
+    ]
+    attackers: list[Player] = [
+        ScheduledAttacker(GaussianAttacker(p)),
+        ScheduledAttacker(ColoredGaussianAttacker(p)),
+        ScheduledAttacker(OptimalDesignAttacker(p)),
+        PassThrough(p.m),
+        ScheduledAttacker(GaussianAttacker(p), q=0.25),
+    ]
+    return defenders, attackers
+
+
+def write_cells(path: Path, cells: dict[tuple[str, str], Any]) -> None:
+    """One CSV row per cell: every metric's mean and 95 % interval."""
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["defender", "attacker"] + [f"{k}_{s}" for k, _ in METRICS for s in ("mean", "low", "high")])
+        for (dn, an), c in cells.items():
+            w.writerow([dn, an] + [f"{v:.6g}" for k, _ in METRICS for v in c[k]])
+
+
+def run_static(args: argparse.Namespace) -> int:
+    """The static-only table with rotation (module docstring)."""
+    t0 = time.time()
+    base = {"preset": args.preset, "deciphering_model": args.deciphering_model}
+    if args.key_length is not None:
+        base["key_length"] = args.key_length
+    config = budget_config(env_config(base), args.N)
+    params = resolve_params(config)
+    rules = GameRules()  # the rotate lever on
+    defenders, attackers = rotation_players(params)
+    cells: dict[tuple[str, str], Any] = {}
+    for d in defenders:
+        for a in attackers:
+            cells[(d.name, a.name)] = cell(play(a, d, config, rules, episodes=args.episodes, seed=args.seed))
+    theta = np.hstack([params.A, params.B])
+    eps0 = float(np.sum(theta**2)) / (params.n * (params.n + params.m))  # Definition def:error of the estimate [A B] = 0
+    rows, cols = [d.name for d in defenders], [a.name for a in attackers]
+    c = params.cost
+    key = f" --key-length {args.key_length}" if args.key_length is not None else ""
+    header = [
+        "# The game's static defenders with group rotation (recorded by experiments/game.py --static-only)",
+        "",
+        f"Command: `python -m encctl_gym.experiments.game --static-only --N {args.N} --episodes {args.episodes} "
+        f"--deciphering-model {args.deciphering_model}{key} --seed {args.seed}` ({time.time() - t0:.0f} s).",
+        "",
+        f"Plant `{args.preset}`, ideal backend, {params.key_length}-bit groups, `deciphering_model = {args.deciphering_model}`: "
+        f"one key costs {float(c.next):.3g} operations, the first key of a group {float(c.first):.3g} (its precomputation), "
+        f"tau_c set so that one group pays for N = {args.N} samples (deciphering budget). The game charges the budget per group "
+        "the defender moves to (multiagent.clock.GroupClock), so rotate(K) ends the attack at the first sample "
+        "the budget cannot pay. Default GameRules (rotation_cost = "
+        f"{rules.rotation_cost}, audit_cost = {rules.audit_cost}, detection_penalty = {rules.detection_penalty}). "
+        f"{args.episodes} paired episodes per cell (episode e seeded {args.seed} + e in every cell). epsilon_0 = {eps0:.3g} is "
+        "the error before any data (of the estimate [A B] = 0).",
+    ]
+    body = [metric_table(k, title, rows, cols, cells) for k, title in METRICS]
+    text = "\n".join(header) + "\n\n" + "\n\n".join(body) + "\n"
+    print(text)
+    out = ensure_out_dir(args.out)
+    md, cells_csv = out / "game_static.md", out / "game_static_cells.csv"
+    md.write_text(text)
+    write_cells(cells_csv, cells)
+    print(f"wrote {md} and {cells_csv}")
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
+    if args.static_only:
+        return run_static(args)
     t0 = time.time()
     config = budget_config(env_config({"preset": args.preset}), args.N)
     params = resolve_params(config)
@@ -222,11 +315,7 @@ def run(args: argparse.Namespace) -> int:
     out = ensure_out_dir(args.out)
     md, cells_csv = out / f"game_{args.algo}.md", out / f"game_{args.algo}_cells.csv"
     md.write_text(text)
-    with open(cells_csv, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["defender", "attacker"] + [f"{k}_{s}" for k, _ in METRICS for s in ("mean", "low", "high")])
-        for (dn, an), c in cells.items():
-            w.writerow([dn, an] + [f"{v:.6g}" for k, _ in METRICS for v in c[k]])
+    write_cells(cells_csv, cells)
     fig = plot_curves(curves, args.figure or f"docs/figures/game_learning_curves_{args.algo}.png")
     print(f"wrote {md}, {cells_csv} and {fig}")
     return 0
@@ -244,6 +333,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--algo", choices=("ppo", "ars"), default="ppo")
     parser.add_argument("--seed", type=_checked(lambda t: check_int("seed", int(t), minimum=0), "seed"), default=0)
     parser.add_argument("--out", default="docs/results/game")
+    parser.add_argument("--static-only", action="store_true", help="the static table with rotation, no training")
+    parser.add_argument("--deciphering-model", default="precomputation", help="with --static-only (default: precomputation)")
+    parser.add_argument(
+        "--key-length", type=_checked(lambda t: check_int("key_length", int(t), minimum=16), "key_length"), default=None
+    )
     parser.add_argument("--figure", default=None, help="default: docs/figures/game_learning_curves_ALGO.png")
 
 

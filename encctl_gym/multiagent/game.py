@@ -17,6 +17,13 @@ the defender's decision enters through the defender seam (:mod:`encctl_gym.loop.
 a defender that always does nothing (action ``[-1, -1]``) and an attacker that always injects
 give the single environment's trajectory bit for bit.
 
+The deciphering budget is charged per group the defender moves to
+(:class:`~encctl_gym.multiagent.clock.GroupClock`): under a cost model with a precomputation
+(``deciphering_model="precomputation"``) each rotation costs the attacker one more, so its attack
+ends sooner (terminated at the step whose sample the budget cannot pay), and its observed budget
+fraction and ``deciphering_time`` count it. The game runs on states (``observe="state"``);
+``observe="output"`` is refused (the output episode has no defender seam).
+
 Rewards per step, with ``g`` the attacker's reward of the single environment (its
 identification gain, the ``reward`` key: ``log_error`` by default), ``D`` 1 at the step the
 defender detects the attack (which ends it; the paid samples are still delivered) and ``c`` the
@@ -47,6 +54,7 @@ from ..envs.encrypted_lti_attack import RESET_OPTIONS, check_seed
 from ..envs.episode import EpisodeCore, EpisodeSchedule, attack_design_for, check_episode_memory
 from ..errors import ParameterError
 from ..loop import make_loop
+from .clock import GroupClock
 from .levers import LEVERS, DefenderLevers, GameRules
 
 __all__ = ["EncryptedControlGame", "AGENTS"]
@@ -106,6 +114,11 @@ class EncryptedControlGame(ParallelEnv):
             raise ParameterError(
                 f"rotate_group_every = {p.rotate_group_every} rotates outside the game's defender; leave it None and use the rotate lever"
             )
+        if p.observe != "state":
+            raise ParameterError(
+                f"the game runs on states only (observe='state'); observe={format_value(p.observe)} is not supported: "
+                "the output episode has no defender seam"
+            )
         p.warn_if_capped()
         check_episode_memory(p, 1, schedule)
         self.rules = GameRules.of(rules)
@@ -113,6 +126,7 @@ class EncryptedControlGame(ParallelEnv):
         self._loop = make_loop(p, self.levers)
         self.design = attack_design_for(p) if p.gamma_opt else None
         self.episode = EpisodeCore(p, self._loop, self.design, schedule=schedule, defender=self.levers)
+        self.clock = GroupClock(p)  # the deciphering budget charged per group (multiagent.clock)
         self.possible_agents = list(AGENTS)
         self.agents: list[str] = []
         low, high = p.observation_bounds()
@@ -155,6 +169,7 @@ class EncryptedControlGame(ParallelEnv):
             self._np_random, _ = seeding.np_random(seed)
         opts = {} if options is None else {k: v for k, v in dict(options).items() if k in RESET_OPTIONS}
         obs = self.episode.reset(self._np_random, **opts)
+        self.clock.reset(self.episode.collected)
         self.agents = list(AGENTS)
         observations = {"attacker": obs[0], "defender": self.levers.observe(self.episode.plant_view)}
         return observations, {"attacker": self.episode.info(), "defender": self._defender_info(0.0)}
@@ -173,8 +188,11 @@ class EncryptedControlGame(ParallelEnv):
         if a.shape != (m + 1,):
             raise ParameterError(f"the attacker's action must have shape ({m + 1},), got {np.shape(actions['attacker'])}")
         self.levers.decide(actions["defender"])
-        core = self.episode
+        core, clock = self.episode, self.clock
+        if clock.active and not clock.affords(self.levers.rotates_at(core.plant_view.step)):
+            core.expired = True  # the budget cannot pay this step's sample in its group: the attack ends now
         gains, terminated, truncated = core.step(a[:m], inject=bool(a[m] >= 0.0))
+        clock.advance(core.collected, self.levers.rotated)
         gain, detected, cost = float(gains[0]), core.stopped, self.levers.cost()
         attacker = gain - self.rules.detection_penalty * float(detected)
         if self.rules.zero_sum:
@@ -182,8 +200,8 @@ class EncryptedControlGame(ParallelEnv):
             defender = -attacker
         else:
             defender = -gain - cost
-        observations = {"attacker": core.observation()[0], "defender": self.levers.observe(core.plant_view)}
-        infos = {"attacker": core.info(), "defender": self._defender_info(cost)}
+        observations = {"attacker": self._attacker_observation(), "defender": self.levers.observe(core.plant_view)}
+        infos = {"attacker": self._attacker_info(), "defender": self._defender_info(cost)}
         if terminated or truncated:
             self.agents = []
         return (
@@ -193,6 +211,22 @@ class EncryptedControlGame(ParallelEnv):
             dict.fromkeys(AGENTS, bool(truncated)),
             infos,
         )
+
+    def _attacker_observation(self) -> np.ndarray:
+        """The single environment's observation, its budget fraction charged per group once
+        the defender has rotated (:mod:`encctl_gym.multiagent.clock`)."""
+        obs = self.episode.observation()[0]
+        if self.clock.active and self.clock.rotated:
+            obs[self.episode.layout.time_fraction] = self.clock.fraction
+        return obs
+
+    def _attacker_info(self) -> dict[str, Any]:
+        """The single environment's info, its ``deciphering_time`` charged per group once the
+        defender has rotated."""
+        info = self.episode.info()
+        if self.clock.active and self.clock.rotated:
+            info["deciphering_time"] = self.clock.seconds
+        return info
 
     def _defender_info(self, cost: float) -> dict[str, Any]:
         lv = self.levers

@@ -24,7 +24,8 @@ The defender's action is a vector in ``[-1, 1]``, one entry per lever of :data:`
   this step's period (:mod:`encctl_gym.loop.rotation`: the groups come from a
   :class:`~encctl_gym.loop.rotation.GroupPool` seeded from the plant's stream, the same sequence
   as the ``"rotate"`` defender's), so the samples from the next one on lie in the new group and
-  the attacker's deciphering pays for it (its cost model charges per group). Each rotation costs
+  the attacker's deciphering pays for it (its cost model charges per group: the game's
+  :class:`~encctl_gym.multiagent.clock.GroupClock`). Each rotation costs
   :attr:`GameRules.rotation_cost`.
 
 A new lever is one more name in :data:`LEVERS`, one more entry of the action, one more field
@@ -245,17 +246,19 @@ class DefenderLevers(_PlantSidePolicy):
         if dec.sigma_d2 > 0.0:  # the draws of NoiseDefender
             noise = np.stack([rng.normal(scale=math.sqrt(dec.sigma_d2), size=self.m) for rng in self.rngs[: self.K]])
         self._noise_prev = np.zeros((self.K, self.m)) if noise is None else noise
-        group = self._new_group(view.step) if dec.rotate else None
+        group = self._new_group() if self.rotates_at(view.step) else None
         self.rotated = group is not None
         if noise is None and not self.caught and group is None:
             return None
         return DefenderAction(input_noise=noise, end=self.caught, new_group=group)
 
-    def _new_group(self, step: int) -> GroupParams | None:
-        """The next group of the pool (as :class:`~encctl_gym.loop.rotation.RotatingDefender`
-        takes it), or None at the last step (no sample is collected after it)."""
-        if step + 1 >= self.horizon:
-            return None
+    def rotates_at(self, step: int) -> bool:
+        """Whether the decision of the coming attack step ``step`` moves the loop to a new group:
+        it asks for a rotation and the step is not the last (no sample is collected after it)."""
+        return self._decision.rotate and step + 1 < self.horizon
+
+    def _new_group(self) -> GroupParams:
+        """The next group of the pool (as :class:`~encctl_gym.loop.rotation.RotatingDefender` takes it)."""
         assert self.pool is not None
         group, waited = self.pool.get(self._next_group)
         t = self.tally
