@@ -181,7 +181,7 @@ class EpisodeCore(HelperWork):
         )
         self.estimator = est if self.kernels is None else None
         self.collected = 0  # samples collected and paid for
-        self.expired = False  # the measured deciphering time passed tau_c (deciphering_clock="measured")
+        self.expired = False  # out of time: the measured deciphering time passed tau_c, or end_out_of_time()
         self.delivered = 0  # samples delivered to the agent
         self.new = False
         self.done = False
@@ -220,6 +220,12 @@ class EpisodeCore(HelperWork):
         self._gram_future: Future | None = None
         self._rngs: list[np.random.Generator] = []
         self.history: list[tuple[int, float]] = []  # (N delivered, epsilon) of copy 0, for render
+
+    def end_out_of_time(self) -> None:
+        """End the attack at the next step as out of time (``terminated``, not detected): for a
+        caller that keeps its own deciphering clock, e.g. the game's per-group clock
+        (:mod:`encctl_gym.multiagent.clock`). A reset clears it."""
+        self.expired = True
 
     def close(self) -> None:
         """The helper's work finished, and the defender's own resources released (its optional

@@ -190,7 +190,7 @@ class EncryptedControlGame(ParallelEnv):
         self.levers.decide(actions["defender"])
         core, clock = self.episode, self.clock
         if clock.active and not clock.affords(self.levers.rotates_at(core.plant_view.step)):
-            core.expired = True  # the budget cannot pay this step's sample in its group: the attack ends now
+            core.end_out_of_time()  # the budget cannot pay this step's sample in its group: the attack ends now
         gains, terminated, truncated = core.step(a[:m], inject=bool(a[m] >= 0.0))
         clock.advance(core.collected, self.levers.rotated)
         gain, detected, cost = float(gains[0]), core.stopped, self.levers.cost()
