@@ -191,11 +191,17 @@ def ars_rows(
     import gymnasium as gym
 
     import encctl_gym  # noqa: F401  (registers the environment)
-    from encctl_gym.agents import load_attacker
     from encctl_gym.agents.runs import read_run
+    from encctl_gym.errors import OptionalDependencyError
 
     p = get_preset(system)
-    history = read_run(run_dir).env.get("input_history")
+    history = read_run(run_dir).env.get("input_history")  # a missing run is named before any extra is needed
+    try:
+        from encctl_gym.agents import load_attacker
+    except ModuleNotFoundError as exc:
+        raise OptionalDependencyError(
+            f"playing a trained run needs the rl extra ({exc.name} is missing): pip install 'encctl-gym[rl]'"
+        ) from None
     rows: list[dict[str, Any]] = []
     base = float("nan")
     for label, spec in MEASURED_DEFENDERS:

@@ -128,6 +128,7 @@ def test_bad_reference_is_refused():
 
 
 def test_evaluate_lines_warn_for_a_learned_attacker_whose_margin_the_episodes_cannot_resolve():
+    pytest.importorskip("sb3_contrib", reason="the training configurations name the rl extra's algorithms")
     from encctl_gym.experiments.compare.evaluate_run import resolution_lines
     from encctl_gym.experiments.compare.records import Curve, Result
     from encctl_gym.experiments.compare.settings import make_setting

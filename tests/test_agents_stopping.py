@@ -149,6 +149,7 @@ def test_a_real_ars_run_stops_when_the_rule_says_so(tmp_path):
 
 
 def test_the_ars_default_budget_is_scaled_to_the_plant_and_an_explicit_one_is_fixed():
+    pytest.importorskip("sb3_contrib", reason="the training configurations name the rl extra's algorithms")
     from encctl_gym.agents.config import apply_override, env_config, load_config
     from encctl_gym.agents.curves import curve_for
     from encctl_gym.agents.train import training_budget

@@ -72,6 +72,7 @@ def test_plant_file_billion_laughs_is_refused_before_expansion(tmp_path: Path, n
 def test_config_billion_laughs_is_refused_at_the_first_alias(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, parser: str
 ) -> None:
+    pytest.importorskip("sb3_contrib", reason="the training configurations name the rl extra's algorithms")
     cfg = load_config("ppo", "small", quick=True)
     _refuse_construction(monkeypatch)
     path = tmp_path / "bomb.yaml"
