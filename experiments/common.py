@@ -23,7 +23,7 @@ from encctl_gym.errors import ParameterError
 from encctl_gym.plotting import save_figure
 from encctl_gym.sim.montecarlo import log_grid
 
-__all__ = ["GridConfig", "FULL", "QUICK", "Table", "add_common_arguments", "grid_config", "figure_seed", "ensure_out_dir"]
+__all__ = ["GridConfig", "FULL", "QUICK", "Table", "add_common_arguments", "grid_config", "figure_seed", "ensure_out_dir", "write_recorded_table"]
 
 #: CSV columns, in order.
 COLUMNS = ("figure", "panel", "sigma_w2", "sigma_u2", "r_sigma", "psi_u", "N", "run", "error", "gamma", "bound")
@@ -250,6 +250,16 @@ def ensure_out_dir(out: str | os.PathLike[str]) -> Path:
     except OSError as exc:
         raise ParameterError(f"cannot create the output directory {str(path)!r}: {exc}") from exc
     return path
+
+
+def write_recorded_table(path: str | os.PathLike[str], title: str, command: str, table: str, notes: str = "") -> Path:
+    """Print ``table`` and record it as a Markdown page: ``# title``, the command that printed it
+    (and ``notes`` on its settings, after it), then the table; returns the path written."""
+    print(table)
+    out = Path(path)
+    out.write_text(f"# {title}\n\nCommand: `{command}`{notes}\n\n{table}\n")
+    print(f"  wrote {out}")
+    return out
 
 
 def plot_panel(ax: Any, s: dict[str, Any], title: str, *, bound: bool = False) -> None:

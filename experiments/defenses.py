@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 
 from encctl_gym.errors import EncctlError
+from encctl_gym.experiments.common import write_recorded_table
 from encctl_gym.experiments.defenses_measured import (
     DETECTORS,
     _attackers,
@@ -296,64 +297,52 @@ def main(argv: list[str] | None = None) -> int:
     except EncctlError as exc:
         print(f"defenses: {exc}", file=sys.stderr)
         return 2
-    print(text)
     args.out.mkdir(parents=True, exist_ok=True)
-    path = args.out / "defenses_analytic.md"
-    path.write_text(
-        "# The defender's levers in closed form\n\nCommand: `python -m encctl_gym.experiments.defenses`\n\n" + text + "\n"
-    )
-    print(f"  wrote {path}")
+    cmd = "python -m encctl_gym.experiments.defenses"
+    write_recorded_table(args.out / "defenses_analytic.md", "The defender's levers in closed form", cmd, text)
     if measured:
-        table = format_measured(measured)
-        print(table)
-        path = args.out / "defenses_measured.md"
-        path.write_text(
-            "# The defences measured in the environment\n\nCommand: `python -m encctl_gym.experiments.defenses --measure "
-            f"--episodes {args.episodes}`"
-            f" (seed {args.seed}; decipher_delay = 0, ideal backend, each system's own tau_c)\n\n" + table + "\n"
+        write_recorded_table(
+            args.out / "defenses_measured.md",
+            "The defences measured in the environment",
+            f"{cmd} --measure --episodes {args.episodes}",
+            format_measured(measured),
+            f" (seed {args.seed}; decipher_delay = 0, ideal backend, each system's own tau_c)",
         )
-        print(f"  wrote {path}")
     if rotation is not None:
-        table = format_rotation(rotation)
-        print(table)
-        path = args.out / "defenses_rotation.md"
-        path.write_text(
-            "# Group rotation on the design example\n\nCommand: `python -m encctl_gym.experiments.defenses --rotation "
-            f"--rotation-samples {args.rotation_samples}` (seed {args.seed}; the design: uncorrected GNFS, budget "
-            "Upsilon tau_c of paper-example; measured: real ElGamal at 64 bits, index-calculus breaker, Gaussian "
-            "attacker, one episode per K)\n\n" + table + "\n"
+        write_recorded_table(
+            args.out / "defenses_rotation.md",
+            "Group rotation on the design example",
+            f"{cmd} --rotation --rotation-samples {args.rotation_samples}",
+            format_rotation(rotation),
+            f" (seed {args.seed}; the design: uncorrected GNFS, budget Upsilon tau_c of paper-example; measured: real "
+            "ElGamal at 64 bits, index-calculus breaker, Gaussian attacker, one episode per K)",
         )
-        print(f"  wrote {path}")
     if ars:
-        table = format_measured(ars)
-        print(table)
-        path = args.out / "defenses_ars.md"
-        path.write_text(
-            "# A learned attacker against the defences\n\nCommand: `python -m encctl_gym.experiments.defenses --ars "
-            f"{args.ars} --episodes {args.episodes}` (seed {args.seed}; the run trained without any defence; "
-            "decipher_delay = 0, ideal backend, the design example's own tau_c; rows of the measured table)\n\n" + table + "\n"
+        write_recorded_table(
+            args.out / "defenses_ars.md",
+            "A learned attacker against the defences",
+            f"{cmd} --ars {args.ars} --episodes {args.episodes}",
+            format_measured(ars),
+            f" (seed {args.seed}; the run trained without any defence; decipher_delay = 0, ideal backend, the design "
+            "example's own tau_c; rows of the measured table)",
         )
-        print(f"  wrote {path}")
     if elgamal is not None:
-        table = format_elgamal(elgamal)
-        print(table)
-        path = args.out / "defenses_elgamal.md"
-        path.write_text(
-            "# The defences through real ElGamal\n\nCommand: `python -m encctl_gym.experiments.defenses --elgamal "
-            f"--elgamal-samples {args.elgamal_samples} --elgamal-episodes {args.elgamal_episodes}` (seed {args.seed}; "
-            "paper-example, decipher_delay = 0, crypto = elgamal, key_length = 64, breaker = index-calculus "
-            "(breaker_time_limit 60 s), crypto_seed = seed; the same attacks on the ideal backend beside them)\n\n" + table + "\n"
+        write_recorded_table(
+            args.out / "defenses_elgamal.md",
+            "The defences through real ElGamal",
+            f"{cmd} --elgamal --elgamal-samples {args.elgamal_samples} --elgamal-episodes {args.elgamal_episodes}",
+            format_elgamal(elgamal),
+            f" (seed {args.seed}; paper-example, decipher_delay = 0, crypto = elgamal, key_length = 64, breaker = "
+            "index-calculus (breaker_time_limit 60 s), crypto_seed = seed; the same attacks on the ideal backend beside them)",
         )
-        print(f"  wrote {path}")
     if delays:
-        table = format_delays(delays)
-        print(table)
-        path = args.out / "defenses_detection.md"
-        path.write_text(
-            f"# Detection delay against the attack power\n\nCommand: `python -m encctl_gym.experiments.defenses --delays --episodes {args.episodes}`"
-            f" (seed {args.seed}; decipher_delay = 0, ideal backend, attacks of at most 2000 steps)\n\n" + table + "\n"
+        write_recorded_table(
+            args.out / "defenses_detection.md",
+            "Detection delay against the attack power",
+            f"{cmd} --delays --episodes {args.episodes}",
+            format_delays(delays),
+            f" (seed {args.seed}; decipher_delay = 0, ideal backend, attacks of at most 2000 steps)",
         )
-        print(f"  wrote {path}")
         args.figures.mkdir(parents=True, exist_ok=True)
         print(f"  wrote {plot_delays(delays, args.figures / 'defenses_detection.png')}")
     return 0
