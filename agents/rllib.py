@@ -22,12 +22,21 @@ RLlib env runner (one Python ``step`` per copy) does not.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from encctl_gym.errors import EncctlError
 
-__all__ = ["ENV_NAME", "make_env", "register", "ppo_config", "train_ppo"]
+__all__ = [
+    "ENV_NAME",
+    "make_env",
+    "register",
+    "register_factory",
+    "ppo_config",
+    "with_ppo_hyperparameters",
+    "train_ppo",
+    "run_training",
+]
 
 #: The name the environment is registered under in RLlib.
 ENV_NAME = "encctl_gym/EncryptedLTIAttack-v0"
@@ -44,6 +53,64 @@ def _require_rllib() -> Any:
     return ray
 
 
+def register_factory(name: str, factory: Callable[[Any], Any]) -> str:
+    """Register ``factory`` (env config -> environment) with RLlib under ``name``; return the name."""
+    _require_rllib()
+    from ray.tune.registry import register_env
+
+    register_env(name, factory)
+    return name
+
+
+def with_ppo_hyperparameters(
+    config: Any, *, train_batch_size: int, minibatch_size: int, num_epochs: int, gamma: float, lr: float, seed: int | None
+) -> Any:
+    """``config`` (a ``PPOConfig``) with PPO's batch, minibatch, epochs per batch, discount and
+    learning rate, the torch framework and, unless ``None``, RLlib's seed."""
+    config = config.training(
+        train_batch_size=int(train_batch_size),
+        minibatch_size=int(minibatch_size),
+        num_epochs=int(num_epochs),
+        gamma=float(gamma),
+        lr=float(lr),
+    ).framework("torch")
+    return config if seed is None else config.debugging(seed=int(seed))
+
+
+def run_training(
+    build_config: Callable[[], Any], iterations: int, address: str | None, summary: Callable[[dict[str, Any]], dict[str, Any]]
+) -> list[dict[str, Any]]:
+    """Train the algorithm of ``build_config()`` for ``iterations`` iterations on Ray (joining
+    ``address``, or a local instance started and stopped here); one row per iteration:
+    ``iteration``, ``env_steps`` (lifetime), ``seconds`` and what ``summary`` reads from RLlib's
+    result."""
+    ray = _require_rllib()
+    from encctl_gym._validation import check_int
+
+    iterations = check_int("iterations", iterations, minimum=1)
+    started = not ray.is_initialized()
+    if started:
+        ray.init(address=address, include_dashboard=False, log_to_driver=False)
+    algo = build_config().build_algo()
+    rows = []
+    try:
+        for i in range(iterations):
+            r = algo.train()
+            rows.append(
+                {
+                    "iteration": i + 1,
+                    "env_steps": int(r.get("num_env_steps_sampled_lifetime", 0)),
+                    **summary(r),
+                    "seconds": float(r.get("time_this_iter_s", float("nan"))),
+                }
+            )
+    finally:
+        algo.stop()
+        if started:
+            ray.shutdown()
+    return rows
+
+
 def make_env(env_config: Mapping[str, Any]) -> Any:
     """The environment for one RLlib env runner: ``gymnasium.make`` of the registered id with
     ``env_config`` (any mapping, such as RLlib's ``EnvContext``) as its configuration."""
@@ -56,11 +123,7 @@ def make_env(env_config: Mapping[str, Any]) -> Any:
 
 def register(name: str = ENV_NAME) -> str:
     """Register :func:`make_env` with RLlib under ``name``; return the name."""
-    _require_rllib()
-    from ray.tune.registry import register_env
-
-    register_env(name, make_env)
-    return name
+    return register_factory(name, make_env)
 
 
 def ppo_config(
@@ -99,18 +162,16 @@ def ppo_config(
         PPOConfig()
         .environment(register(), env_config=dict(env_config))
         .env_runners(num_env_runners=int(num_env_runners), num_envs_per_env_runner=int(num_envs_per_env_runner))
-        .training(
-            train_batch_size=int(train_batch_size),
-            minibatch_size=int(minibatch_size),
-            num_epochs=int(num_epochs),
-            gamma=float(gamma),
-            lr=float(lr),
-        )
-        .framework("torch")
     )
-    if seed is not None:
-        cfg = cfg.debugging(seed=int(seed))
-    return cfg
+    return with_ppo_hyperparameters(
+        cfg,
+        train_batch_size=train_batch_size,
+        minibatch_size=minibatch_size,
+        num_epochs=num_epochs,
+        gamma=gamma,
+        lr=lr,
+        seed=seed,
+    )
 
 
 def train_ppo(
@@ -137,28 +198,9 @@ def train_ppo(
         ``log eps_0 - log eps_N`` of the episodes finished in that iteration, ``None`` if none)
         and ``seconds``.
     """
-    ray = _require_rllib()
-    from encctl_gym._validation import check_int
-
-    iterations = check_int("iterations", iterations, minimum=1)
-    started = not ray.is_initialized()
-    if started:
-        ray.init(address=address, include_dashboard=False, log_to_driver=False)
-    algo = ppo_config(env_config, **kwargs).build_algo()
-    rows = []
-    try:
-        for i in range(iterations):
-            r = algo.train()
-            rows.append(
-                {
-                    "iteration": i + 1,
-                    "env_steps": int(r.get("num_env_steps_sampled_lifetime", 0)),
-                    "episode_return_mean": r.get("env_runners", {}).get("episode_return_mean"),
-                    "seconds": float(r.get("time_this_iter_s", float("nan"))),
-                }
-            )
-    finally:
-        algo.stop()
-        if started:
-            ray.shutdown()
-    return rows
+    return run_training(
+        lambda: ppo_config(env_config, **kwargs),
+        iterations,
+        address,
+        lambda r: {"episode_return_mean": r.get("env_runners", {}).get("episode_return_mean")},
+    )

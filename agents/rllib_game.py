@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from .rllib import _require_rllib
+from .rllib import _require_rllib, register_factory, run_training, with_ppo_hyperparameters
 
 __all__ = ["GAME_NAME", "make_game", "register_game", "game_ppo_config", "train_game"]
 
@@ -45,11 +45,7 @@ def make_game(env_config: Mapping[str, Any]) -> Any:
 
 def register_game(name: str = GAME_NAME) -> str:
     """Register :func:`make_game` with RLlib under ``name``; return the name."""
-    _require_rllib()
-    from ray.tune.registry import register_env
-
-    register_env(name, make_game)
-    return name
+    return register_factory(name, make_game)
 
 
 def game_ppo_config(
@@ -82,18 +78,16 @@ def game_ppo_config(
         .env_runners(num_env_runners=int(num_env_runners))
         .multi_agent(policies=set(AGENTS), policy_mapping_fn=lambda agent_id, *args, **kwargs: agent_id)
         .rl_module(rl_module_spec=MultiRLModuleSpec(rl_module_specs={a: RLModuleSpec() for a in AGENTS}))
-        .training(
-            train_batch_size=int(train_batch_size),
-            minibatch_size=int(minibatch_size),
-            num_epochs=int(num_epochs),
-            gamma=float(gamma),
-            lr=float(lr),
-        )
-        .framework("torch")
     )
-    if seed is not None:
-        config = config.debugging(seed=int(seed))
-    return config
+    return with_ppo_hyperparameters(
+        config,
+        train_batch_size=train_batch_size,
+        minibatch_size=minibatch_size,
+        num_epochs=num_epochs,
+        gamma=gamma,
+        lr=lr,
+        seed=seed,
+    )
 
 
 def train_game(
@@ -102,29 +96,9 @@ def train_game(
     """Train both sides with RLlib's PPO for ``iterations`` iterations; one summary per
     iteration: ``iteration``, ``env_steps`` (lifetime), ``returns`` (the mean episode return of
     each agent in that iteration, where RLlib reports it) and ``seconds``."""
-    ray = _require_rllib()
-    from encctl_gym._validation import check_int
-
-    iterations = check_int("iterations", iterations, minimum=1)
-    started = not ray.is_initialized()
-    if started:
-        ray.init(address=address, include_dashboard=False, log_to_driver=False)
-    algo = game_ppo_config(env_config, **kwargs).build_algo()
-    rows = []
-    try:
-        for i in range(iterations):
-            r = algo.train()
-            runners = r.get("env_runners", {})
-            rows.append(
-                {
-                    "iteration": i + 1,
-                    "env_steps": int(r.get("num_env_steps_sampled_lifetime", 0)),
-                    "returns": dict(runners.get("agent_episode_returns_mean", {})),
-                    "seconds": float(r.get("time_this_iter_s", float("nan"))),
-                }
-            )
-    finally:
-        algo.stop()
-        if started:
-            ray.shutdown()
-    return rows
+    return run_training(
+        lambda: game_ppo_config(env_config, **kwargs),
+        iterations,
+        address,
+        lambda r: {"returns": dict(r.get("env_runners", {}).get("agent_episode_returns_mean", {}))},
+    )
