@@ -23,7 +23,17 @@ from encctl_gym.errors import ParameterError
 from encctl_gym.plotting import save_figure
 from encctl_gym.sim.montecarlo import log_grid
 
-__all__ = ["GridConfig", "FULL", "QUICK", "Table", "add_common_arguments", "grid_config", "figure_seed", "ensure_out_dir", "write_recorded_table"]
+__all__ = [
+    "GridConfig",
+    "FULL",
+    "QUICK",
+    "Table",
+    "add_common_arguments",
+    "grid_config",
+    "figure_seed",
+    "ensure_out_dir",
+    "write_recorded_table",
+]
 
 #: CSV columns, in order.
 COLUMNS = ("figure", "panel", "sigma_w2", "sigma_u2", "r_sigma", "psi_u", "N", "run", "error", "gamma", "bound")
