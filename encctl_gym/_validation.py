@@ -28,6 +28,7 @@ from .errors import ConfigError, EncctlError, ParameterError, ResourceLimitError
 __all__ = [
     "one_line",
     "format_value",
+    "format_count",
     "check_positive",
     "check_nonnegative",
     "check_real",
@@ -58,6 +59,12 @@ def _format_int(v: int) -> str:
     digits = int(bits * math.log10(2)) + 1  # exact to within one digit, without str(v)
     sign = "-" if v < 0 else ""
     return f"{sign}<integer of {bits} bits, about {digits} digits>"
+
+
+def format_count(count: int, noun: str) -> str:
+    """``"1 episode"``, ``"4 episodes"``: a count and its noun, plural unless the count is 1
+    (a noun whose plural is not ``noun + "s"`` is not for this function)."""
+    return f"{count} {noun}" + ("" if count == 1 else "s")
 
 
 def format_value(value: Any, limit: int = 120) -> str:
@@ -162,6 +169,15 @@ def check_nonnegative(name: str, value: Any) -> float:
     v = _as_float(name, value)
     if v < 0:
         raise ParameterError(f"{name} must be >= 0, got {format_value(value)}")
+    return v
+
+
+def check_probability(name: str, value: Any) -> float:
+    """Return ``value`` as a probability in [0, 1] (an audit rate, a detection level), raising
+    :class:`ParameterError` naming it otherwise: the package's one rule for a rate."""
+    v = check_nonnegative(name, value)
+    if v > 1:
+        raise ParameterError(f"{name} must lie in [0, 1], got {format_value(value)}")
     return v
 
 

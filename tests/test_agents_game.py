@@ -72,8 +72,8 @@ def test_bad_players_are_refused_naming_the_value(make, text):
 
 def test_the_static_defenders_act_as_documented():
     obs = np.zeros(P.n + P.m + 3, dtype=np.float32)
-    assert NoDefence().act(obs).tolist() == [-1.0, -1.0, -1.0]  # audit, noise, rotate: all off
-    assert ConstantNoise(0.5).act(obs).tolist() == [-1.0, 0.5, -1.0]
+    assert NoDefence().act(obs).tolist() == [-1.0, -1.0, -1.0, -1.0]  # audit, noise, rotate, verify: all off
+    assert ConstantNoise(0.5).act(obs).tolist() == [-1.0, 0.5, -1.0, -1.0]
     rot = RotateEvery(3)
     rot.reset()
     assert [rot.act(obs)[2] for _ in range(7)] == [-1.0, -1.0, 1.0, -1.0, -1.0, 1.0, -1.0]

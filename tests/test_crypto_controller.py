@@ -23,7 +23,7 @@ from encctl_gym.crypto.group import shipped_group
 from encctl_gym.crypto.modified import ModifiedCiphertext, modified_decrypt, modified_eval
 from encctl_gym.crypto.plant_side import PlantParty, StaticPlant
 from encctl_gym.crypto.quantized import QuantizedLinearController
-from encctl_gym.crypto.schemes import SCHEMES
+from encctl_gym.crypto.schemes import ELGAMAL_VARIANTS
 from encctl_gym.crypto.servers import ControllerServer, StaticControllerServer
 from encctl_gym.errors import CiphertextError, EncodingOverflowError, KeyMismatchError, ParameterError
 from encctl_gym.loop.scheme import SCHEMES as LOOP_SCHEMES
@@ -366,9 +366,9 @@ def test_injection_must_be_a_matrix_of_the_plants_ciphertexts(inject, match):
 def test_every_scheme_pairs_its_plant_and_server_and_forgery():
     """The registry's parties run the loop for every scheme; static keys never change and the
     forged output of each scheme decodes to injection_value."""
-    assert set(SCHEMES) == {"modified", "token", "static"}
+    assert set(ELGAMAL_VARIANTS) == {"modified", "token", "static"}
     a = np.array([0.5, -1.0, 2.0, 0.0])
-    for name, scheme in SCHEMES.items():
+    for name, scheme in ELGAMAL_VARIANTS.items():
         ctrl = EncryptedLinearController(PHI, G128, 2.0**12, 10.0, scheme=name, rng=3)
         assert isinstance(ctrl.plant, scheme.plant)
         pk0 = ctrl.pk0

@@ -111,14 +111,50 @@ def test_bad_output_configurations_are_refused():
         resolve_params({**CFG, "preset": "fig1-a", "C": [[1.0, 1.0, 1.0, 1.0]]})
     with pytest.raises(ParameterError, match="sigma_v2"):
         resolve_params({**CFG, "sigma_v2": -1.0})
-    with pytest.raises(ParameterError, match="ARX"):
+    with pytest.raises(ParameterError, match="ARX least squares, N4SID, PO-MOESP"):
         resolve_params({**CFG, "estimator": "bayes"})
     with pytest.raises(ParameterError, match="unknown controller"):
         resolve_params({**CFG, "controller": "pid"})
 
 
-def test_vector_environment_refuses_outputs():
+@pytest.mark.parametrize("estimator", ["ls", "n4sid"])
+def test_the_vector_environment_steps_output_copies_as_single_environments(estimator):
+    """Issue 34 item 10: copy i of the vector environment, seeded s, is the single environment
+    seeded s + i, bit for bit, on outputs too."""
     from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
 
-    with pytest.raises(ParameterError, match="observe='state'"):
-        EncryptedLTIAttackVectorEnv(2, config=CFG)
+    cfg = {**CFG, "estimator": estimator, "max_samples": 60}
+    acts = np.random.default_rng(6).uniform(-0.4, 0.4, (60, 3, 2))
+    vec = EncryptedLTIAttackVectorEnv(3, config=cfg)
+    obs, info = vec.reset(seed=20)
+    rows, rewards, eps = [obs], [], []
+    for a in acts:
+        obs, r, te, tr, info = vec.step(a)
+        if te.any() or tr.any():
+            break
+        rows.append(obs)
+        rewards.append(r)
+        eps.append(info["epsilon"])
+    vec.close()
+    for i in range(3):
+        env, o, r, single = _run(cfg, acts[: len(rewards), i], seed=20 + i)
+        np.testing.assert_array_equal(np.array(rows)[:, i], o)
+        np.testing.assert_array_equal(np.array(rewards)[:, i], r)
+        assert eps[-1][i] == single["epsilon"]
+    assert np.all(np.array(eps)[-1] < 1.0)  # every copy has an estimate by then
+
+
+def test_close_releases_an_output_environment_through_gym_make():
+    """Issue 34 item 22: ``close()`` on ``observe="output"`` (the episode has a ``close``), through
+    ``gym.make`` and its wrappers, twice."""
+    import gymnasium as gym
+
+    import encctl_gym  # noqa: F401  (registers the id)
+
+    env = gym.make("encctl_gym/EncryptedLTIAttack-v0", config=CFG)
+    env.reset(seed=0)
+    env.step(np.zeros(2))
+    env.close()
+    env.close()
+    bare = EncryptedLTIAttackEnv(config=CFG)
+    bare.close()  # before any reset too

@@ -15,7 +15,9 @@ from encctl_gym.envs.config import resolve_params
 from encctl_gym.envs.encrypted_lti_attack import EncryptedLTIAttackEnv
 from encctl_gym.errors import ParameterError
 from encctl_gym.loop import SCHEMES, ElGamalScheme, EncryptionScheme, LoopSpec, make_scheme
+from encctl_gym.loop.scheme import SchemeBase
 from encctl_gym.plant import Plant
+from encctl_gym.security.cost_models import DECIPHERING_MODELS
 from encctl_gym.security.deciphering import independent_keys
 from encctl_gym.security.threat import ThreatModel
 
@@ -41,7 +43,7 @@ class PadServer:
         self.ct_phi, self.p = ct_phi, p
 
 
-class MultiplicativePad:
+class MultiplicativePad(SchemeBase):
     """A toy multiplicatively homomorphic scheme: ``ct = m k mod p`` with a pad ``k`` in G.
 
     Phi is padded once with ``k_0``, each state with the period's ``k_t``; the server's products
@@ -50,6 +52,23 @@ class MultiplicativePad:
     """
 
     name = "toy-pad"
+    family = "discrete-log"
+    cost_models = DECIPHERING_MODELS
+
+    def public_parameters(self, key_length: int, *, ciphertexts: bool = True) -> Any:
+        return make_scheme("modified").public_parameters(key_length, ciphertexts=ciphertexts)
+
+    def nearest_plaintext(self, encoder: Any, v: int) -> int:
+        return make_scheme("modified").nearest_plaintext(encoder, v)
+
+    def rounding(self, params: Any, limit: int) -> Any:
+        return make_scheme("modified").rounding(params, limit)
+
+    def quantization(self, Phi: Any, encoder: Any, x_bound: float) -> Any:
+        return make_scheme("modified").quantization(Phi, encoder, x_bound)
+
+    def add(self, plant: Any, out: Any, a: np.ndarray, encoder: Any, secret_of: Any, rng: Any) -> Any:
+        raise ParameterError("the toy pad has no addition")
 
     def encoder(self, group: Any, delta: float) -> Encoder:
         return Encoder(group, float(delta))
@@ -85,7 +104,7 @@ class MultiplicativePad:
     def public_key(self, plant: PadPlant) -> int:
         return plant.pad
 
-    def oracle_secret(self, plant: PadPlant) -> int:
+    def oracle_secret(self, plant: PadPlant, pk: Any = None) -> int:
         return plant.pad
 
     def reveal(self, group: Any, secret: int, ct: int, encoder: Encoder) -> float:

@@ -18,7 +18,7 @@ from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
 from encctl_gym.errors import ParameterError
 from encctl_gym.ident import make_estimator
 from encctl_gym.ident.compiled import RecursiveLeastSquaresKernels
-from encctl_gym.loop import DefenderAction, FixedDefender, loop_group
+from encctl_gym.loop import DefenderAction, DefenderBase, FixedDefender, make_scheme
 
 BASE = {"preset": "paper-example", "gamma_opt": False}
 
@@ -98,7 +98,7 @@ def test_the_elgamal_backend_runs_the_generic_step():
 
 
 # ----------------------------------------------------------------------------- defenders
-class NoisyActuator:
+class NoisyActuator(DefenderBase):
     """A toy defence written here, outside the package: the plant side adds Gaussian noise of
     standard deviation ``scale`` to its actuator input, drawn from the defender's own streams,
     and records what it added."""
@@ -110,7 +110,7 @@ class NoisyActuator:
         self.added: list[np.ndarray] = []
 
     def group(self, params):
-        return loop_group(params.key_length)
+        return params.group()
 
     def reset(self, K, n, m, rngs):
         self.rngs, self.m, self.added = rngs, m, []
@@ -121,7 +121,7 @@ class NoisyActuator:
         return DefenderAction(input_noise=v)
 
 
-class InputWatchdog:
+class InputWatchdog(DefenderBase):
     """A toy detector: the plant side stops the attack once a decoded input exceeds ``limit``."""
 
     name = "watchdog"
@@ -131,7 +131,7 @@ class InputWatchdog:
         self.steps_seen: list[int] = []
 
     def group(self, params):
-        return loop_group(params.key_length)
+        return params.group()
 
     def reset(self, K, n, m, rngs):
         self.steps_seen = []
@@ -225,15 +225,33 @@ def test_a_defender_runs_in_the_vector_env_with_a_stream_per_copy():
 def test_the_defender_picks_the_loop_group():
     class BiggerGroup(FixedDefender):
         def group(self, params):
-            return loop_group(128)
+            return make_scheme("modified").public_parameters(128)
 
     env = gym.make(ENV_ID, config={**BASE, "max_samples": 12, "crypto": "elgamal", "key_length": 64, "defender": BiggerGroup()})
     assert env.unwrapped.loop.group.bits == 128
 
 
+class _FourMembers:  # the protocol's first four members only: no rotates, tally, on_new_group, close
+    name = "four"
+
+    def group(self, params):
+        return params.group()
+
+    def reset(self, K, n, m, rngs):
+        pass
+
+    def act(self, view):
+        return None
+
+
 @pytest.mark.parametrize(
     "spec, text",
-    [("nobody", "unknown defender 'nobody'"), (object(), "defender must be a name"), (FixedDefender, "defender must")],
+    [
+        ("nobody", "unknown defender 'nobody'"),
+        (object(), "defender must be a name"),
+        (FixedDefender, "defender must"),
+        (_FourMembers(), "lacks rotates, tally, on_new_group, close"),
+    ],
 )
 def test_a_bad_defender_is_refused_at_construction(spec, text):
     with pytest.raises(ParameterError, match=text):

@@ -2,8 +2,9 @@
 
 Imports are read from the source with ``ast`` (module level and inside functions alike: an
 import deferred into a function is still a dependency), so the test needs no optional extra.
-Imports under ``if TYPE_CHECKING:`` are left out: they exist for the type checker only, and no
-module loads another through them.
+Imports under ``if TYPE_CHECKING:`` count too: a module written against another module's types
+depends on it as much as one that loads it (the loop written against the environment's config
+was such a circle, issue 29).
 """
 
 from __future__ import annotations
@@ -70,22 +71,10 @@ def imports_of(module: str, source: str, modules: Mapping[str, Path], *, is_pack
     return found
 
 
-def _is_type_checking(test: ast.expr) -> bool:
-    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
-        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING"
-    )
-
-
 def _runtime_nodes(tree: ast.AST) -> Iterable[ast.AST]:
-    """Every node of ``tree`` except the bodies of ``if TYPE_CHECKING:`` (their ``else`` stays)."""
-    todo = [tree]
-    while todo:
-        node = todo.pop()
-        yield node
-        if isinstance(node, ast.If) and _is_type_checking(node.test):
-            todo.extend(node.orelse)
-            continue
-        todo.extend(ast.iter_child_nodes(node))
+    """Every node of ``tree``, the bodies of ``if TYPE_CHECKING:`` included (a type-only
+    import is a dependency)."""
+    return ast.walk(tree)
 
 
 def import_graph(packages: Mapping[str, str] = PACKAGES) -> dict[str, set[str]]:
@@ -164,6 +153,8 @@ def test_imports_are_read_from_every_form_of_import_statement() -> None:
     assert imports_of("pkg.sub.c", source.replace("from .sub.c import thing\n", ""), modules) == {"pkg.a", "pkg.sub"}
     assert imports_of("pkg", "from .sub.c import thing\nfrom .a import f\n", modules, is_package=True) == {"pkg.sub.c", "pkg.a"}
     assert imports_of("pkg.b", "def f():\n    from .a import g\n", modules) == {"pkg.a"}
+    typed = "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from .a import T\n"
+    assert imports_of("pkg.b", typed, modules) == {"pkg.a"}  # a type-only import is a dependency
 
 
 # ----------------------------------------------------------------------------- the packages
@@ -193,6 +184,7 @@ FORBIDDEN = {
         "encctl_gym.envs",
     ),
     "encctl_gym.ident": ("encctl_gym.crypto", "encctl_gym.loop", "encctl_gym.envs", "encctl_gym.sim"),
+    "encctl_gym.loop": ("encctl_gym.envs", "encctl_gym.multiagent"),  # the loop takes its own LoopSpec (issue 29)
     "encctl_gym": APPLICATIONS,
     "encctl_gym.agents": ("encctl_gym.experiments",),
 }
@@ -213,13 +205,11 @@ def test_no_layer_imports_a_higher_one(layer: str) -> None:
     assert not upward, "upward imports:\n" + "\n".join(upward)
 
 
-def test_type_checking_imports_are_not_runtime_dependencies() -> None:
+def test_type_checking_imports_count_as_dependencies() -> None:
     modules = {"pkg": Path("pkg/__init__.py"), "pkg.a": Path("pkg/a.py"), "pkg.b": Path("pkg/b.py"), "pkg.c": Path("pkg/c.py")}
-    source = (
-        "from typing import TYPE_CHECKING\n"
-        "if TYPE_CHECKING:\n    from .b import B\nelse:\n    from .c import C\n"
-        "def f():\n    from . import b\n"
-    )
-    # the deferred import inside f counts, the type-only one does not, the else branch does
-    assert imports_of("pkg.a", source, modules) == {"pkg.b", "pkg.c"}
-    assert imports_of("pkg.a", "import typing\nif typing.TYPE_CHECKING:\n    from .b import B\n", modules) == set()
+    source = "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from .b import B\nelse:\n    from .c import C\n"
+    assert imports_of("pkg.a", source, modules) == {"pkg.b", "pkg.c"}  # both branches
+    assert imports_of("pkg.a", "import typing\nif typing.TYPE_CHECKING:\n    from .b import B\n", modules) == {"pkg.b"}
+    assert cycles({"pkg.a": {"pkg.b"}, "pkg.b": imports_of("pkg.b", "if TYPE_CHECKING:\n    from .a import A\n", modules)}) == [
+        ["pkg.a", "pkg.b"]
+    ]

@@ -13,31 +13,31 @@ from encctl_gym.crypto.encoding import Encoder
 from encctl_gym.crypto.quantized import QuantizedLinearController
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import EncodingOverflowError, ParameterError
-from encctl_gym.loop import BACKENDS, ElGamalLoop, IdealLoop, LoopBackend, loop_group, make_loop
+from encctl_gym.loop import BACKENDS, ElGamalLoop, IdealLoop, LoopBackend, make_loop, make_scheme
 
 SMALL = {"preset": "small", "gamma_opt": False, "key_length": 128}
 
 
 @pytest.fixture(scope="module")
 def ideal() -> IdealLoop:
-    return make_loop(resolve_params(SMALL))
+    return make_loop(resolve_params(SMALL).loop)
 
 
 @pytest.fixture(scope="module")
 def encoder() -> Encoder:
-    return Encoder(loop_group(128), 4096.0)
+    return Encoder(make_scheme("modified").public_parameters(128), 4096.0)
 
 
 def test_every_backend_implements_the_protocol():
     for name in BACKENDS:
-        loop = make_loop(resolve_params({**SMALL, "crypto": name, "max_samples": 20}))
+        loop = make_loop(resolve_params({**SMALL, "crypto": name, "max_samples": 20}).loop)
         assert isinstance(loop, LoopBackend)
         assert loop.batched == (name == "ideal") and (loop.quantization is not None) == (name == "ideal")
     with pytest.raises(ParameterError, match="one copy"):
         from encctl_gym.envs.episode import EpisodeCore
 
         p = resolve_params({**SMALL, "crypto": "elgamal", "max_samples": 20})
-        EpisodeCore(p, make_loop(p), num_envs=2)
+        EpisodeCore(p, make_loop(p.loop), num_envs=2)
 
 
 @settings(max_examples=60, deadline=None)
@@ -82,7 +82,7 @@ def _held(obj) -> list:
 def test_parties_of_the_elgamal_loop_hold_independent_randomness(scheme):
     """No party is handed another's random source, and the seeded streams differ."""
     p = resolve_params({**SMALL, "crypto": "elgamal", "scheme": scheme, "crypto_seed": 123, "max_samples": 20})
-    loop = ElGamalLoop(p, loop_group(128))
+    loop = ElGamalLoop(p, make_scheme("modified").public_parameters(128))
     loop.start_episode()
     sources = loop.random_sources
     draws = {name: tuple(src.below(2**62) for _ in range(4)) for name, src in sources.items()}

@@ -37,7 +37,7 @@ def test_the_audit_tolerance_holds_the_honest_encrypted_controller(preset):
     """The quantised controller of the loop (eq:ec) stays within the tolerance on 20000 states
     across the encoder's range, so an audit of the honest loop never alarms."""
     p = resolve_params({"preset": preset, "gamma_opt": False})
-    loop = make_loop(p)
+    loop = make_loop(p.loop)
     rng = np.random.default_rng(0)
     x = rng.uniform(-p.x_bound, p.x_bound, size=(20000, p.n)) * rng.uniform(0, 1, size=(20000, 1))
     diff = np.abs(loop.control(x) - x @ loop.Phi.T)
@@ -47,7 +47,7 @@ def test_the_audit_tolerance_holds_the_honest_encrypted_controller(preset):
 def test_an_audit_of_the_honest_input_never_stops_the_attack_and_of_a_forged_one_always():
     p = resolve_params(SMALL)
     d = AuditDefender(rate=1.0)
-    loop = make_loop(p, d)
+    loop = make_loop(p.loop, d)
     rng = np.random.default_rng(1)
     K, T = 50, 40
     x = np.zeros((K, p.n))

@@ -138,6 +138,6 @@ def test_combined_defenders_set_a_lever_if_any_of_them_does():
     both.reset(0)
     quiet, alarm = np.zeros(6, np.float32), np.array([0, 0, 0, 2.0, 0, 0], np.float32)  # entry n + m: the statistic
     got = [both.act(o).tolist() for o in (quiet, alarm, quiet, quiet)]
-    assert got == [[-1, 0.25, -1], [1, 0.25, 1], [-1, 0.25, -1], [-1, 0.25, 1]]
+    assert got == [[-1, 0.25, -1, -1], [1, 0.25, 1, -1], [-1, 0.25, -1, -1], [-1, 0.25, 1, -1]]
     with pytest.raises(ParameterError, match="two defenders"):
         Combined(RotateEvery(2))

@@ -92,7 +92,7 @@ def test_both_backends_run_the_output_loop_bit_for_bit(controller):
     for crypto in ("ideal", "elgamal"):
         p = resolve_params({**cfg, "crypto": crypto, "crypto_seed": 5})
         ctrl = loop_controller(p)
-        loop = OutputLoop(make_loop(p), ctrl)
+        loop = OutputLoop(make_loop(p.loop), ctrl)
         loop.start(1)
         rng = np.random.default_rng(7)
         x = rng.normal(size=(1, 2))

@@ -50,20 +50,20 @@ def _no_generation(bits: int) -> None:
 
 def test_the_ideal_backend_never_generates_a_group_above_the_shipped_sizes(monkeypatch: pytest.MonkeyPatch) -> None:
     # lambda = 128 at Upsilon = 1e30, tau_c = 1e10 s asks for a key of more than 2048 bits.
-    import encctl_gym.loop.backend as backend
+    import encctl_gym.loop.elgamal_scheme as backend
     from encctl_gym.crypto.group import SHIPPED_BITS
     from encctl_gym.loop import IdealLoop, make_loop
 
     monkeypatch.setattr(backend, "_generated_group", _no_generation)
     params = resolve_params({"security_parameter": 128, "upsilon": 1e30, "tau_c": 1e10})
     assert params.key_length > max(SHIPPED_BITS)
-    loop = make_loop(params)
+    loop = make_loop(params.loop)
     assert isinstance(loop, IdealLoop)
     assert loop.table.p.bit_length() == max(SHIPPED_BITS)
 
 
 def test_the_elgamal_backend_still_asks_for_the_group_of_its_key_length(monkeypatch: pytest.MonkeyPatch) -> None:
-    import encctl_gym.loop.backend as backend
+    import encctl_gym.loop.elgamal_scheme as backend
     from encctl_gym.loop import make_loop
 
     asked: list[int] = []
@@ -75,7 +75,7 @@ def test_the_elgamal_backend_still_asks_for_the_group_of_its_key_length(monkeypa
     monkeypatch.setattr(backend, "_generated_group", record)
     params = resolve_params({"security_parameter": 128, "upsilon": 1e30, "tau_c": 1e10, "crypto": "elgamal"})
     with pytest.raises(ResourceLimitError, match="recorded"):
-        make_loop(params)
+        make_loop(params.loop)
     assert asked == [params.key_length]
 
 

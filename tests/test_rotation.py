@@ -20,7 +20,7 @@ from encctl_gym.crypto.group import GroupParams, shipped_group
 from encctl_gym.envs import EncryptedLTIAttackEnv
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ParameterError
-from encctl_gym.loop import DefenderAction, RotatingDefender
+from encctl_gym.loop import DefenderAction, DefenderBase, RotatingDefender
 from encctl_gym.loop.elgamal import party_random_sources
 from encctl_gym.loop.provisioning import GroupDecipherers
 from encctl_gym.loop.rotation import GroupPool
@@ -226,7 +226,7 @@ def test_rotation_composes_with_another_policy_and_is_refused_twice():
         RotatingDefender(every=0)
 
 
-class _BadGroup:
+class _BadGroup(DefenderBase):
     name = "bad-group"
 
     def __init__(self, group):
@@ -282,7 +282,7 @@ def test_an_audit_composed_with_rotation_follows_the_encoding_of_each_new_group(
 
     p = resolve_params({**BASE, "max_samples": 40})
     d = RotatingDefender(every=3, inner=AuditDefender(rate=1.0))
-    loop = make_loop(p, d)
+    loop = make_loop(p.loop, d)
     K, T = 20, 30
     rng = np.random.default_rng(3)
     x, U = np.zeros((K, p.n)), np.zeros((T, K, p.m))
@@ -298,7 +298,7 @@ def test_an_audit_composed_with_rotation_follows_the_encoding_of_each_new_group(
         if action is not None and action.new_group is not None:
             loop.rotate_group(action.new_group)
             moves += 1
-            assert d.inner.max_shift == residue_table(loop.group, table_limit(p, loop.Phi)).max_shift
+            assert d.inner.max_shift == residue_table(loop.group, table_limit(p.loop, loop.Phi)).max_shift
         U[k] = loop.control(x)
     assert moves == T // 3 and d.inner.audits == K * (T - 1)
 

@@ -58,6 +58,7 @@ __all__ = [
     "powmod",
     "mulmod",
     "invert",
+    "gcd",
     "is_prime",
     "jacobi",
     "legendre",
@@ -200,6 +201,19 @@ def invert(a: int, mod: int) -> int:
         return gmpy2.invert(a, mod)
     except ZeroDivisionError as exc:
         raise ParameterError(f"{format_int(a)} has no inverse modulo {format_int(mod)}") from exc
+
+
+def gcd(a: int, b: int) -> int:
+    """Return ``gcd(a, b) >= 0`` (gmpy2; the Paillier checks of ``Z_n^*`` and the factoring breakers).
+
+    Raises
+    ------
+    ParameterError
+        If an argument is not an integer.
+    """
+    if not (type(a) in _INT_TYPES and type(b) in _INT_TYPES):
+        a, b = check_integer("a", a), check_integer("b", b)
+    return gmpy2.gcd(a, b)
 
 
 def is_prime(n: int, reps: int = 25) -> bool:

@@ -37,7 +37,7 @@ class EncryptedLinearController:
     under ``pk_t``); the plant decrypts (``Dec_bar(sk_0, sk_t, .)`` or ``Dec(sk_t, .)``), sums
     each row in Z, decodes with ``Delta**2`` and updates the keys (the token scheme sends
     sigma_t to the server, which CtUpds Phi's ciphertexts; static keys are never updated). The
-    parties come from :data:`~.schemes.SCHEMES`. The result equals
+    parties come from :data:`~.schemes.ELGAMAL_VARIANTS`. The result equals
     :meth:`QuantizedLinearController.compute` bit for bit.
 
     Parameters

@@ -33,7 +33,7 @@ from .plant_side import ModifiedPlant, PlantParty, StaticPlant, TokenPlant
 from .quantized import QuantizedLinearController
 from .servers import ControllerServer, StaticControllerServer, TokenControllerServer
 
-__all__ = ["Scheme", "SCHEMES", "get_scheme"]
+__all__ = ["Scheme", "ELGAMAL_VARIANTS", "get_scheme"]
 
 
 @dataclass(frozen=True)
@@ -64,16 +64,29 @@ class Scheme:
         return plant, self.make_server(plant, plant.encrypt_parameter(), server_rng)
 
 
-#: The schemes by name.
-SCHEMES: dict[str, Scheme] = {
-    "modified": Scheme("modified", ModifiedPlant, lambda plant, ct, rng: ControllerServer(plant.pk0, ct), False),
-    "token": Scheme("token", TokenPlant, lambda plant, ct, rng: TokenControllerServer(plant.pk0, ct, rng), True),
-    "static": Scheme("static", StaticPlant, lambda plant, ct, rng: StaticControllerServer(plant.pk0, ct), False),
+def _controller_server(plant: PlantParty, ct: Any, rng: RandomSource) -> ControllerServer:
+    return ControllerServer(plant.pk0, ct)
+
+
+def _token_server(plant: PlantParty, ct: Any, rng: RandomSource) -> TokenControllerServer:
+    return TokenControllerServer(plant.pk0, ct, rng)
+
+
+def _static_server(plant: PlantParty, ct: Any, rng: RandomSource) -> StaticControllerServer:
+    return StaticControllerServer(plant.pk0, ct)
+
+
+#: The parties of the three ElGamal variants by name (the loop's one scheme registry,
+#: :data:`encctl_gym.loop.scheme.SCHEMES`, holds the schemes; these are their parts).
+ELGAMAL_VARIANTS: dict[str, Scheme] = {
+    "modified": Scheme("modified", ModifiedPlant, _controller_server, False),
+    "token": Scheme("token", TokenPlant, _token_server, True),
+    "static": Scheme("static", StaticPlant, _static_server, False),
 }
 
 
 def get_scheme(name: Any) -> Scheme:
-    """The scheme ``name`` of :data:`SCHEMES`; an unknown name raises :class:`ParameterError`."""
-    if not isinstance(name, str) or name not in SCHEMES:
-        raise ParameterError(f"unknown scheme {format_value(name)}; choose one of {', '.join(SCHEMES)}")
-    return SCHEMES[name]
+    """The variant ``name`` of :data:`ELGAMAL_VARIANTS`; an unknown name raises :class:`ParameterError`."""
+    if not isinstance(name, str) or name not in ELGAMAL_VARIANTS:
+        raise ParameterError(f"unknown scheme {format_value(name)}; choose one of {', '.join(ELGAMAL_VARIANTS)}")
+    return ELGAMAL_VARIANTS[name]

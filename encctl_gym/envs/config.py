@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 import os
-import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -17,11 +16,13 @@ from typing import Any
 
 import numpy as np
 
+from .._user_warning import warn_user
 from .._validation import (
     check_bool,
     check_int,
     check_nonnegative,
     check_positive,
+    check_probability,
     check_regular_file,
     check_schur_stable,
     check_system,
@@ -31,22 +32,19 @@ from ..errors import BudgetError, ConfigError, ParameterError
 from ..ident.registry import make_estimator
 from ..loop import BACKENDS as _LOOP_BACKENDS
 from ..loop.defender import make_defender
-from ..loop.detection import check_audit_rate
-from ..loop.scheme import SCHEMES, make_scheme
+from ..loop.injection import check_injection
+from ..loop.scheme import MalleableScheme, make_scheme
 from ..loop.spec import LoopSpec
 from ..plant import Plant
 from ..presets import get_preset
 from ..security.complexity import sic_from_traces
 from ..security.cost_models import (
-    DECIPHERING_MODELS,
     GENERIC_MIN_KEY_LENGTH,
     GUILLEVIC_CORRECTION,
     CostModel,
     KeyBreakCost,
-    PaperModel,
     check_gnfs_correction,
     check_security_parameter,
-    deciphering_model,
 )
 from ..security.deciphering import ADVERSARIES, independent_keys, max_affordable_samples, per_sample_cost, sample_deciphering_time
 from ..security.design import design_from_traces
@@ -86,7 +84,7 @@ class AttackParams:
     sigma_w2: float
     sigma_x2: float
     sigma_u2: float
-    scheme: str
+    scheme: Any  # the scheme specification (a name of loop.scheme.SCHEMES, a mapping with a name, or an object)
     adversary: str
     security_parameter: float  # lambda of the paper's model for this key (def:bit_sec, eq:opt_key)
     key_length: int
@@ -132,6 +130,7 @@ class AttackParams:
     C: np.ndarray | None = None  # the sensors of observe="output" (None: the state is sent)
     sigma_v2: float = 0.0  # measurement noise variance of observe="output"
     controller: str = "static"  # the loop's controller on outputs (loop.output_feedback.CONTROLLERS)
+    injection: str = "replace"  # how the action enters the loop (loop.injection.INJECTIONS)
 
     @cached_property
     def plant(self) -> Plant:
@@ -154,8 +153,13 @@ class AttackParams:
 
     @cached_property
     def loop(self) -> LoopSpec:
-        """The closed loop: backend, scheme, key length, Delta, breaker, defender."""
+        """The closed loop as the loop layer takes it (:class:`~encctl_gym.loop.spec.LoopSpec`):
+        the plant, backend, scheme, key length, Delta, breaker, defender and injection mode."""
         return LoopSpec(
+            plant=self.plant,
+            sigma_w2=self.sigma_w2,
+            adversary=self.adversary,
+            horizon=self.horizon,
             crypto=self.crypto,
             scheme=self.scheme,
             key_length=self.key_length,
@@ -170,6 +174,10 @@ class AttackParams:
             breaker_precomputation=self.breaker_precomputation,
             observe=self.observe,
             controller=self.controller,
+            injection=self.injection,
+            audit_probability=self.audit_probability,
+            defense_noise_sigma2=self.defense_noise_sigma2,
+            ciphertexts=bool(getattr(_LOOP_BACKENDS[self.crypto], "needs_key_length_group", True)),
         )
 
     @property
@@ -181,12 +189,10 @@ class AttackParams:
         """Warn (once per environment, when it is made) that the attack length is the default cap
         :data:`MAX_DEFAULT_HORIZON`, not what the budget buys."""
         if self.horizon_capped:
-            warnings.warn(
+            warn_user(
                 f"the deciphering budget buys N = {format_value(self.budget_samples)} samples within tau_c = "
                 f"{self.tau_c:g} s (k = {self.key_length} bits); without max_samples the attack is capped at "
-                f"N = {self.horizon} (MAX_DEFAULT_HORIZON) and truncated there: set max_samples for another length",
-                UserWarning,
-                stacklevel=3,
+                f"N = {self.horizon} (MAX_DEFAULT_HORIZON) and truncated there: set max_samples for another length"
             )
 
     @property
@@ -314,27 +320,8 @@ def completion_preset(config: Mapping[str, Any]) -> Any:
     return config["preset"] if "preset" in config else default_config()["preset"]
 
 
-def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> AttackParams:
-    """Merge ``config`` and ``kwargs`` over :func:`default_config` and validate everything.
-
-    A plant given by ``A`` and ``B`` is completed from a preset (:func:`completion_preset`: the
-    configuration's ``preset``, else the default ``"paper-example"``): the variances and design
-    values it does not give come from that preset, and a warning names them. With
-    ``preset=None`` nothing is completed: every variance and design value must then be given
-    (all missing ones are named at once). :attr:`AttackParams.sources` records where each value
-    came from.
-
-    Raises
-    ------
-    ParameterError
-        Unknown keys, schemes, backends, rewards or presets; non-positive Upsilon, tau_c or
-        variances; an unstable A (UnstableSystemError); mismatched shapes (ShapeError); a flag
-        that is not a bool; missing values without a preset.
-    ConfigError
-        A configuration that is not a mapping.
-    BudgetError
-        A budget too small to identify anything (fewer than n + m + 1 samples).
-    """
+def _merged_config(config: Mapping[str, Any] | None, kwargs: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
+    """``(cfg, merged)``: the user's keys over :func:`default_config`, and the user's keys alone."""
     if config is not None and not isinstance(config, Mapping):
         raise ConfigError(f"config must be a mapping of configuration keys to values, got {format_value(config)}")
     cfg = default_config()
@@ -344,6 +331,13 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     if unknown:
         raise ParameterError(f"unknown configuration key(s) {format_value(unknown)}; known keys: {sorted(cfg)}")
     cfg.update(merged)
+    return cfg, merged
+
+
+def resolve_plant(cfg: dict[str, Any], merged: Mapping[str, Any]) -> tuple[Any, dict[str, Any], dict[str, Any]]:
+    """The plant room: ``(preset, values, sources)``, ``values`` holding the checked ``A``, ``B``
+    (eq:system, Schur stable) and the raw design values of :data:`SOURCE_KEYS` (from the
+    configuration, else the preset, else the default; all missing ones named at once)."""
     name = cfg["preset"] = completion_preset(merged)
     if name is not None and not isinstance(name, str):
         raise ParameterError(f"preset must be a preset name or None, got {format_value(name)}")
@@ -373,69 +367,89 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         raise ParameterError(f"without a preset these values must be given too: {', '.join(missing)}")
     inherited = [k for k in SOURCE_KEYS if sources.get(k, "").startswith("preset")]
     if preset is not None and {"A", "B"} & set(merged) and inherited:
-        warnings.warn(
+        warn_user(
             f"A/B are given and the other values come from preset {preset.name!r}: {', '.join(inherited)}; "
-            "pass preset=None to give them all yourself",
-            UserWarning,
-            stacklevel=3,
+            "pass preset=None to give them all yourself"
         )
+    return preset, {"A": A, "B": B, **raw}, sources
 
-    sigma_w2 = check_positive("sigma_w2", raw["sigma_w2"])
-    sigma_x2 = check_nonnegative("sigma_x2", raw["sigma_x2"])
-    sigma_u2 = check_positive("sigma_u2", raw["sigma_u2"])
-    upsilon = check_positive("upsilon", raw["upsilon"])
-    tau_c = parse_duration(raw["tau_c"], "tau_c")
-    gamma_c = check_positive("gamma_c", raw["gamma_c"])
-    scheme = _choice("scheme", cfg["scheme"], tuple(SCHEMES))
-    encryption = make_scheme(scheme)  # the scheme seam: what the adversary must break
-    adversary = _choice("adversary", cfg["adversary"], ADVERSARIES)
-    reward = _choice("reward", cfg["reward"], REWARDS)
-    estimator = cfg["estimator"]
-    make_estimator(estimator).check_dimensions(A.shape[0], B.shape[1])  # an unknown or impossible estimator fails here
-    crypto = _choice("crypto backend", cfg["crypto"], BACKENDS)
-    breaker, clock, breaker_limit = _breaking(cfg, crypto)
 
-    n, m = A.shape[0], B.shape[1]
-    psi_u = controllability_gramian(A, B)
-    psi_w = noise_gramian(A)
-    tr_psi_u, tr_psi_w = float(np.trace(psi_u)), float(np.trace(psi_w))
+def resolve_threat(values: Mapping[str, Any], cfg: Mapping[str, Any]) -> dict[str, Any]:
+    """The threat room (Definition def:security): the checked variances, ``upsilon``, ``tau_c``,
+    ``gamma_c`` and the adversary."""
+    return {
+        "sigma_w2": check_positive("sigma_w2", values["sigma_w2"]),
+        "sigma_x2": check_nonnegative("sigma_x2", values["sigma_x2"]),
+        "sigma_u2": check_positive("sigma_u2", values["sigma_u2"]),
+        "upsilon": check_positive("upsilon", values["upsilon"]),
+        "tau_c": parse_duration(values["tau_c"], "tau_c"),
+        "gamma_c": check_positive("gamma_c", values["gamma_c"]),
+        "adversary": _choice("adversary", cfg["adversary"], ADVERSARIES),
+    }
 
-    lam_cfg, k_cfg = cfg["security_parameter"], cfg["key_length"]
-    if lam_cfg is not None and k_cfg is not None:
-        raise ParameterError("give either security_parameter or key_length, not both")
-    model_name = _choice("deciphering_model", cfg["deciphering_model"], tuple(DECIPHERING_MODELS))
+
+def _cost_models(cfg: Mapping[str, Any], encryption: Any) -> tuple[str, CostModel, Any]:
+    """``(name, model, baseline)``: the scheme's deciphering-cost model the configuration names
+    and the scheme's baseline model (eq:opt_key: lambda <-> key length), with the GNFS correction
+    where the model takes one."""
+    registry = encryption.cost_models
+    given = cfg["deciphering_model"]
+    model_name = _choice("deciphering_model", encryption.baseline_model if given is None else given, tuple(registry))
     correction = cfg["gnfs_correction"]
     if correction == "guillevic":
         correction = GUILLEVIC_CORRECTION
     correction = check_gnfs_correction(correction)
-    model = deciphering_model(model_name, **({"gnfs_correction": correction} if model_name != "generic" else {}))
-    paper = PaperModel(correction)  # eq:opt_key: lambda <-> key length
+
+    def build(name: str) -> Any:
+        return registry.build(name, **({"gnfs_correction": correction} if "gnfs_correction" in registry.options(name) else {}))
+
+    return model_name, build(model_name), build(encryption.baseline_model)
+
+
+def resolve_key(
+    cfg: Mapping[str, Any], encryption: Any, traces: tuple[float, float], threat: Mapping[str, Any], n: int, m: int
+) -> dict[str, Any]:
+    """The key room (eq:opt_key, Theorem thm:opt_sec): the cost model, lambda, the key length and
+    what breaking one key costs, under the scheme's own cost models."""
+    lam_cfg, k_cfg = cfg["security_parameter"], cfg["key_length"]
+    if lam_cfg is not None and k_cfg is not None:
+        raise ParameterError("give either security_parameter or key_length, not both")
+    model_name, model, baseline = _cost_models(cfg, encryption)
     if k_cfg is not None:
         key_length = check_int("key_length", k_cfg, minimum=GENERIC_MIN_KEY_LENGTH)
         cost = model.break_cost(key_length)
         lam = cost.security_parameter
-        if model_name != "paper" or lam is None:
-            lam = paper.security_parameter_of_key_length(key_length)
+        if model_name != encryption.baseline_model or lam is None:
+            lam = baseline.security_parameter_of_key_length(key_length)
     else:
         if lam_cfg is not None:
             lam = check_security_parameter(lam_cfg)
         else:
+            t = threat
             design = design_from_traces(
-                tr_psi_u,
-                tr_psi_w,
-                m,
-                n,
-                sigma_u2=sigma_u2,
-                sigma_w2=sigma_w2,
-                sigma_x2=sigma_x2,
-                gamma_c=gamma_c,
-                tau_c=tau_c,
-                upsilon=upsilon,
-            )
+                *traces, m, n, sigma_u2=t["sigma_u2"], sigma_w2=t["sigma_w2"], sigma_x2=t["sigma_x2"], gamma_c=t["gamma_c"],
+                tau_c=t["tau_c"], upsilon=t["upsilon"],
+            )  # fmt: skip
             lam = design.lam_star  # Theorem thm:opt_sec
-        key_length = paper.key_length_for_security_parameter(lam)  # eq:opt_key
-        cost = paper.cost_of_security_parameter(lam) if model_name == "paper" else model.break_cost(key_length)
+        key_length = baseline.key_length_for_security_parameter(lam)  # eq:opt_key
+        cost = (
+            baseline.cost_of_security_parameter(lam) if model_name == encryption.baseline_model else model.break_cost(key_length)
+        )
+    return {
+        "deciphering_model": model_name,
+        "cost_model": model,
+        "security_parameter": lam,
+        "key_length": key_length,
+        "cost": cost,
+    }
 
+
+def resolve_budget(
+    cfg: Mapping[str, Any], encryption: Any, key: Mapping[str, Any], threat: Mapping[str, Any], clock: str, n: int, m: int
+) -> dict[str, Any]:
+    """The budget room (Definition def:sdt): the samples ``tau_c`` buys (every group charged with
+    ``rotate_group_every``), the attack length N and whether the budget or ``max_samples`` sets it."""
+    tau_c, upsilon, adversary, cost = threat["tau_c"], threat["upsilon"], threat["adversary"], key["cost"]
     rotate_every = cfg["rotate_group_every"]
     if rotate_every is not None:  # every group's keys are charged (security.rotation)
         rotate_every = check_rotation_period(rotate_every)
@@ -456,7 +470,7 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         budget = math.inf  # the measured clock, not the model, ends the episode within tau_c
     if budget == math.inf and max_samples is None:  # budget may be an int beyond float range
         raise ParameterError(
-            f"with scheme={scheme!r} and adversary={adversary!r} one break reveals every sample, so the "
+            f"with scheme={encryption.name!r} and adversary={adversary!r} one break reveals every sample, so the "
             "deciphering budget does not bound the attack: set max_samples"
         )
     if max_samples is not None and max_samples < budget:
@@ -468,10 +482,23 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     if horizon < n + m + 1:
         raise BudgetError(
             f"the attack can collect only N = {horizon} samples (budget {budget} within tau_c = {tau_c:g} s at "
-            f"lambda = {format_value(lam)}, k = {key_length} bits, {model_name} model, Upsilon = {upsilon:g}; "
-            f"max_samples = {max_samples}); identification needs N >= n + m + 1 = {n + m + 1}"
+            f"lambda = {format_value(key['security_parameter'])}, k = {key['key_length']} bits, {key['deciphering_model']} "
+            f"model, Upsilon = {upsilon:g}; max_samples = {max_samples}); identification needs N >= n + m + 1 = {n + m + 1}"
         )
+    return {
+        "budget_samples": budget,
+        "horizon": horizon,
+        "budget_limited": budget_limited,
+        "horizon_capped": max_samples is None and horizon < budget,
+        "rotate_group_every": rotate_every,
+        "sample_cost": per_sample_cost(cost, upsilon),
+        "next_sample_cost": float(cost.next / decimal_fraction("upsilon", upsilon)),
+        "independent_keys": independent_keys(encryption, adversary),
+    }
 
+
+def resolve_episode(cfg: Mapping[str, Any], A: np.ndarray, B: np.ndarray) -> dict[str, Any]:
+    """The episode room: the deciphering delay, warm-up, observation history, estimator and reward."""
     delay = cfg["decipher_delay"]
     if isinstance(delay, str):
         if delay != "end":
@@ -487,7 +514,21 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
         raise ParameterError(
             f"input_history must be <= {MAX_INPUT_HISTORY} (MAX_INPUT_HISTORY), got {format_value(input_history)}"
         )
+    return {
+        "decipher_delay": delay_v,
+        "warmup_steps": warmup,
+        "input_history": input_history,
+        "logdet_regularization": check_positive("logdet_regularization", cfg["logdet_regularization"]),
+        "gamma_opt": check_bool("gamma_opt", cfg["gamma_opt"]),
+    }
 
+
+def resolve_loop(cfg: Mapping[str, Any], encryption: Any, sigma_u2: float, adversary: str) -> dict[str, Any]:
+    """The loop room (Definition def:ec, def:adversary): backend, breaker and clock, Delta, the
+    encoder's bounds, the seed, the defender and its levers, and the injection mode with what the
+    scheme needs for it."""
+    crypto = _choice("crypto backend", cfg["crypto"], BACKENDS)
+    breaker, clock, breaker_limit = _breaking(cfg, crypto)
     delta = check_int("delta", cfg["delta"], minimum=2)
     if delta > MAX_DELTA:
         raise ParameterError(f"delta must be <= 2^53 (MAX_DELTA: exact in float64), got {format_value(delta)}")
@@ -501,62 +542,104 @@ def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> At
     crypto_seed = cfg["crypto_seed"]
     if crypto_seed is not None:
         crypto_seed = check_int("crypto_seed", crypto_seed, minimum=0)
-    defender = cfg["defender"]
-    make_defender(defender)  # an unknown name or an object that is no policy fails here
-    audit_p = cfg["audit_probability"]
-    if audit_p is not None:
-        audit_p = check_audit_rate(audit_p, "audit_probability")
-    noise_d2 = cfg["defense_noise_sigma2"]
-    if noise_d2 is not None:
-        noise_d2 = check_nonnegative("defense_noise_sigma2", noise_d2)
+    make_defender(cfg["defender"])  # an unknown name or an object that is no policy fails here
+    audit_p, noise_d2 = cfg["audit_probability"], cfg["defense_noise_sigma2"]
+    return {
+        "crypto": crypto,
+        "breaker": breaker,
+        "deciphering_clock": clock,
+        "breaker_time_limit": breaker_limit,
+        "breaker_precomputation": _breaker_file(cfg, breaker),
+        "delta": delta,
+        "x_bound": check_positive("x_bound", cfg["x_bound"]),
+        "u_max": u_max,
+        "crypto_seed": crypto_seed,
+        "defender": cfg["defender"],
+        "audit_probability": None if audit_p is None else check_probability("audit_probability", audit_p),
+        "defense_noise_sigma2": None if noise_d2 is None else check_nonnegative("defense_noise_sigma2", noise_d2),
+        "injection": _injection(cfg, encryption, adversary),
+    }
+
+
+def _injection(cfg: Mapping[str, Any], encryption: Any, adversary: str) -> str:
+    """The checked ``injection``: a mode of :data:`~encctl_gym.loop.injection.INJECTIONS` the scheme
+    can realise with the configured deciphering delay."""
+    mode = check_injection(cfg["injection"])
+    if mode != "replace" and cfg["observe"] == "output":
+        raise ParameterError(
+            f"injection={mode!r} with observe='output' is not built: the output episode runs the forgery "
+            "(injection='replace') only"
+        )
+    if mode == "scale" and not isinstance(encryption, MalleableScheme):
+        raise ParameterError(
+            f"injection='scale' needs a scheme with a scale() (the ElGamal schemes); the {encryption.name} scheme has none"
+        )
+    needs = encryption.injection_needs(mode, adversary)
+    if needs.period_key and cfg["decipher_delay"] != 0:
+        raise ParameterError(
+            f"injection={mode!r} on the {encryption.name} scheme reads the period's products with the period's key, "
+            f"so it needs decipher_delay=0, got decipher_delay={format_value(cfg['decipher_delay'])}"
+        )
+    return mode
+
+
+def resolve_params(config: Mapping[str, Any] | None = None, **kwargs: Any) -> AttackParams:
+    """Merge ``config`` and ``kwargs`` over :func:`default_config` and validate everything.
+
+    One resolver per room, each owning its keys and checking each once: the plant
+    (:func:`resolve_plant`), the threat (:func:`resolve_threat`), the key (:func:`resolve_key`,
+    under the scheme's own cost models), the budget (:func:`resolve_budget`), the episode
+    (:func:`resolve_episode`), the loop (:func:`resolve_loop`) and the outputs
+    (:func:`~encctl_gym.envs.output_episode.resolve_output`).
+
+    A plant given by ``A`` and ``B`` is completed from a preset (:func:`completion_preset`: the
+    configuration's ``preset``, else the default ``"paper-example"``): the variances and design
+    values it does not give come from that preset, and a warning names them. With
+    ``preset=None`` nothing is completed: every variance and design value must then be given
+    (all missing ones are named at once). :attr:`AttackParams.sources` records where each value
+    came from.
+
+    Raises
+    ------
+    ParameterError
+        Unknown keys, schemes, backends, rewards or presets; non-positive Upsilon, tau_c or
+        variances; an unstable A (UnstableSystemError); mismatched shapes (ShapeError); a flag
+        that is not a bool; missing values without a preset.
+    ConfigError
+        A configuration that is not a mapping.
+    BudgetError
+        A budget too small to identify anything (fewer than n + m + 1 samples).
+    """
+    cfg, merged = _merged_config(config, kwargs)
+    preset, values, sources = resolve_plant(cfg, merged)
+    A, B = values["A"], values["B"]
+    n, m = A.shape[0], B.shape[1]
+    threat = resolve_threat(values, cfg)
+    encryption = make_scheme(cfg["scheme"])  # the scheme seam: its keys, costs and what the adversary must break
+    reward = _choice("reward", cfg["reward"], REWARDS)
+    estimator = cfg["estimator"]
+    make_estimator(estimator).check_dimensions(n, m)  # an unknown or impossible estimator fails here
+    loop = resolve_loop(cfg, encryption, threat["sigma_u2"], threat["adversary"])
+    traces = (float(np.trace(controllability_gramian(A, B))), float(np.trace(noise_gramian(A))))
+    key = resolve_key(cfg, encryption, traces, threat, n, m)
+    budget = resolve_budget(cfg, encryption, key, threat, loop["deciphering_clock"], n, m)
+    episode = resolve_episode(cfg, A, B)
     from .output_episode import resolve_output
 
-    output = resolve_output(cfg, preset, A, B, estimator=estimator, reward=reward, defender=defender)
+    output = resolve_output(cfg, preset, A, B, estimator=estimator, reward=reward, defender=cfg["defender"])
     return AttackParams(
         A=A,
         B=B,
-        sigma_w2=sigma_w2,
-        sigma_x2=sigma_x2,
-        sigma_u2=sigma_u2,
-        scheme=scheme,
-        adversary=adversary,
-        security_parameter=lam,
-        key_length=key_length,
-        upsilon=upsilon,
-        tau_c=tau_c,
-        gamma_c=gamma_c,
-        deciphering_model=model_name,
-        cost=cost,
-        sample_cost=per_sample_cost(cost, upsilon),
-        next_sample_cost=float(cost.next / decimal_fraction("upsilon", upsilon)),
-        budget_samples=budget,
-        horizon=horizon,
-        independent_keys=independent_keys(encryption, adversary),
-        budget_limited=budget_limited,
-        decipher_delay=delay_v,
-        warmup_steps=warmup,
+        scheme=cfg["scheme"],
         estimator=estimator,
         reward=reward,
-        logdet_regularization=check_positive("logdet_regularization", cfg["logdet_regularization"]),
-        crypto=crypto,
-        delta=delta,
-        x_bound=check_positive("x_bound", cfg["x_bound"]),
-        u_max=u_max,
-        input_history=input_history,
-        gamma_opt=check_bool("gamma_opt", cfg["gamma_opt"]),
-        crypto_seed=crypto_seed,
-        breaker=breaker,
-        breaker_time_limit=breaker_limit,
-        deciphering_clock=clock,
-        tr_psi_u=tr_psi_u,
-        tr_psi_w=tr_psi_w,
+        tr_psi_u=traces[0],
+        tr_psi_w=traces[1],
         sources=sources,
-        defender=defender,
-        horizon_capped=max_samples is None and horizon < budget,
-        rotate_group_every=rotate_every,
-        audit_probability=audit_p,
-        defense_noise_sigma2=noise_d2,
-        cost_model=model,
-        breaker_precomputation=_breaker_file(cfg, breaker),
+        **threat,
+        **key,
+        **budget,
+        **episode,
+        **loop,
         **output,
     )

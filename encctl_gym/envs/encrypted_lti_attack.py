@@ -10,10 +10,11 @@ from gymnasium import spaces
 
 from .._validation import format_value
 from ..errors import ParameterError
-from ..loop import LoopBackend, defender_for, make_loop
+from ..loop import LoopBackend
+from .builder import build_episode
 from .config import AttackParams, default_config, resolve_params
-from .episode import EpisodeCore, attack_design_for
-from .schedule import EpisodeSchedule, check_episode_memory
+from .episode import EpisodeCore
+from .schedule import EpisodeSchedule
 
 __all__ = ["EncryptedLTIAttackEnv", "reset_options", "check_seed"]
 
@@ -191,26 +192,19 @@ class EncryptedLTIAttackEnv(gym.Env):
         schedule: EpisodeSchedule | None = None,
         **kwargs: Any,
     ) -> None:
-        self.params: AttackParams = resolve_params(config, **kwargs)
-        self.params.warn_if_capped()
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ParameterError(
                 f"unknown render_mode {format_value(render_mode)}; choose one of {self.metadata['render_modes']}"
             )
         self.render_mode = render_mode
+        built = build_episode(resolve_params(config, **kwargs), schedule=schedule)
+        self.params: AttackParams = built.params
         p = self.params
-        check_episode_memory(p, 1, schedule)  # before anything is sized by the parameters
-        defender = defender_for(p)
-        self._loop = make_loop(p, defender)  # refuses a loop it cannot build (the quantisation table) before the spaces are sized
+        self._loop = built.loop
         self.action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
         self.observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
-        self.design = attack_design_for(p) if p.gamma_opt else None
-        if p.observe == "output":  # the plant sends y = C x + v: the episode of envs.output_episode
-            from .output_episode import OutputEpisode
-
-            self._core: Any = OutputEpisode(p, self._loop, self.design)
-        else:
-            self._core = EpisodeCore(p, self._loop, self.design, schedule=schedule, defender=defender)
+        self.design = built.design
+        self._core: Any = built.core
 
     @staticmethod
     def default_config() -> dict[str, Any]:

@@ -50,9 +50,11 @@ from ..errors import EncodingOverflowError, ParameterError, ShapeError
 from ..ident.compiled import OnlineKernels, ProvidesKernels
 from ..ident.registry import make_estimator
 from ..loop import LoopBackend
+from ..loop.assembly import defender_for
 from ..loop.defender import DefenderPolicy, DefenderStreams, PlantView, check_defender_action, make_defender
+from ..loop.injection import injection_code
 from ..loop.provisioning import RotationRecord
-from ..loop.rotation import check_new_group, defender_for, move_loop, rotation_info
+from ..loop.rotation import move_loop, rotation_info
 from . import _kernels as kern
 from .config import AttackParams
 from .episode_work import HelperWork
@@ -140,21 +142,7 @@ class EpisodeCore(HelperWork):
         self._eps0 = float(np.sum(self._theta_true**2)) / self._c  # error of the estimate [A B] = 0
         self._sw = math.sqrt(p.sigma_w2)
         self._sx = math.sqrt(p.sigma_x2)
-        # tables over the sample size N = 0..horizon
-        Ns = np.arange(N + 1)
-        self.gamma_table = np.full(N + 1, np.inf)
-        self.gamma_table[2:] = p.gamma(Ns[2:])  # eq:sic
-        self.has_gamma_opt = design is not None
-        self.gamma_opt_table = np.full(N + 1, np.inf)
-        if design is not None:
-            self.gamma_opt_table[2:] = design.gamma(Ns[2:])
-        # Definition def:sdt, under the model; with the measured clock, filled as the keys are broken
-        self._measured = p.deciphering_clock == "measured"
-        self.time_table = np.zeros(N + 1) if self._measured else np.asarray(p.deciphering_time(Ns), dtype=np.float64)
-        self._time_frac = self.time_table / p.tau_c
-        # the same tables as Python floats, for the per-step info scalars
-        self._gamma_list, self._time_list = self.gamma_table.tolist(), self.time_table.tolist()
-        self._gamma_opt_list = self.gamma_opt_table.tolist()
+        self._build_tables(design)
         # the per-copy arrays the kernels write, by name (steps.EpisodeArrays): collected
         # (deciphered) states X and applied inputs U, time-major (the data of all copies for one
         # period are contiguous); the recursive least squares [P | Theta_hat^T] in Q, P by its
@@ -167,9 +155,66 @@ class EpisodeCore(HelperWork):
         self._GC = np.zeros((self.d * (self.d + n), K))
         self.G, self.C = self._gram_views()
         self._gram_scratch = np.zeros((self.d + n, K))  # add_gram's, apart from the step's (the helper runs it)
-        self._gram_upto = 1  # G and C hold the columns j < _gram_upto (the fused step lets them lag)
-        self._dims = kern.dims(n, m, p.input_history * m)  # the sizes, as the kernels take them
+        self.gram_upto = 1  # G and C hold the columns j < gram_upto (the fused step lets them lag)
+        self.dims = kern.dims(n, m, p.input_history * m)  # the sizes, as the kernels take them
         self.reward = REWARDS[p.reward](p, K)
+        self._build_estimator(sch)
+        self.collected = 0  # samples collected and paid for
+        self.expired = False  # out of time: the measured deciphering time passed tau_c, or end_out_of_time()
+        self.delivered = 0  # samples delivered to the agent
+        self.new = False
+        self.done = False
+        self.obs_out: np.ndarray | None = None  # observation written by the fused step, not yet handed out
+        self._act = np.zeros((K, m))  # the actions of the current step, float64
+        self.obs_shape = (K, self.layout.dim)
+        self.obs_at = self.layout.offsets
+        self.consts = KernelConstants(
+            self._A, self._B, np.ascontiguousarray(self._theta_true.T), float(self._c), p.u_max, p.energy_budget
+        )
+        # what the compiled kernels take (see _kernels): built once, the arrays are never rebound
+        self.kernel_consts, self.kernel_arrays = self.consts.kernel_tuple(), s.kernel_tuple()
+        # how a step runs, chosen once: the ideal backend's steady state is one compiled call
+        q = loop.quantization
+        fused = q is not None and self.reward.fused and self.kernels is not None and self.kernels.fused
+        self.input_history = p.input_history
+        #: the episode's injection mode (:mod:`encctl_gym.loop.injection`), as the steps take it
+        self.injection = injection_code(p.injection)
+        self.stepper: StepStrategy = choose_step(self, q, fused, parallel, self.injection)
+        # the other party: the plant side's decisions, each step, on what the plant knows
+        self.defender = defender_for(p.loop) if defender is None else make_defender(defender)
+        self._rotates = bool(self.defender.rotates)  # the info carries the rotation fields
+        self.plant_view = PlantView(s.x, s.U, self._attack_step)
+        self.stopped = False  # the defender ended the attack
+        #: the group rotations of the episode (loop.rotation): every episode starts on the loop's first group
+        self.rotation = RotationRecord()
+        self._first_group = getattr(loop, "group", None)
+        self._build_noise(sch, helper)
+        self._rngs: list[np.random.Generator] = []
+        self.history: list[tuple[int, float]] = []  # (N delivered, epsilon) of copy 0, for render
+
+    def _build_tables(self, design: Any) -> None:
+        """The tables over the sample size N = 0..horizon: gamma (eq:sic), gamma_opt of the
+        design, the deciphering time (Definition def:sdt) and their Python-float copies."""
+        p, N = self.p, self.p.horizon
+        Ns = np.arange(N + 1)
+        self.gamma_table = np.full(N + 1, np.inf)
+        self.gamma_table[2:] = p.gamma(Ns[2:])  # eq:sic
+        self.has_gamma_opt = design is not None
+        self.gamma_opt_table = np.full(N + 1, np.inf)
+        if design is not None:
+            self.gamma_opt_table[2:] = design.gamma(Ns[2:])
+        # Definition def:sdt, under the model; with the measured clock, filled as the keys are broken
+        self._measured = p.deciphering_clock == "measured"
+        self.time_table = np.zeros(N + 1) if self._measured else np.asarray(p.deciphering_time(Ns), dtype=np.float64)
+        self.time_frac = self.time_table / p.tau_c
+        # the same tables as Python floats, for the per-step info scalars
+        self._gamma_list, self._time_list = self.gamma_table.tolist(), self.time_table.tolist()
+        self._gamma_opt_list = self.gamma_opt_table.tolist()
+
+    def _build_estimator(self, sch: EpisodeSchedule) -> None:
+        """The attacker's estimator: compiled kernels on the episode's arrays when it provides
+        them, else the estimator itself (updated column by column)."""
+        p, s, K = self.p, self.state, self.K
         # the attacker's estimator: one that provides kernels (least squares, fused; Bayes,
         # forgetting, IV: moment kernels) runs compiled on the episode's arrays; any other is
         # updated column by column (encctl_gym.ident)
@@ -180,32 +225,10 @@ class EpisodeCore(HelperWork):
             else None
         )
         self.estimator = est if self.kernels is None else None
-        self.collected = 0  # samples collected and paid for
-        self.expired = False  # out of time: the measured deciphering time passed tau_c, or end_out_of_time()
-        self.delivered = 0  # samples delivered to the agent
-        self.new = False
-        self.done = False
-        self._obs_out: np.ndarray | None = None  # observation written by the fused step, not yet handed out
-        self._act = np.zeros((K, m))  # the actions of the current step, float64
-        self._obs_shape = (K, self.layout.dim)
-        self._obs_at = self.layout.offsets
-        self.consts = KernelConstants(
-            self._A, self._B, np.ascontiguousarray(self._theta_true.T), float(self._c), p.u_max, p.energy_budget
-        )
-        # what the compiled kernels take (see _kernels): built once, the arrays are never rebound
-        self._consts, self._arrays = self.consts.kernel_tuple(), s.kernel_tuple()
-        # how a step runs, chosen once: the ideal backend's steady state is one compiled call
-        q = loop.quantization
-        fused = q is not None and self.reward.fused and self.kernels is not None and self.kernels.fused
-        self.stepper: StepStrategy = choose_step(self, q, fused, parallel)
-        # the other party: the plant side's decisions, each step, on what the plant knows
-        self.defender = defender_for(p) if defender is None else make_defender(defender)
-        self._rotates = bool(getattr(self.defender, "rotates", False))  # the info carries the rotation fields
-        self.plant_view = PlantView(s.x, s.U, self._attack_step)
-        self.stopped = False  # the defender ended the attack
-        #: the group rotations of the episode (loop.rotation): every episode starts on the loop's first group
-        self.rotation = RotationRecord()
-        self._first_group = getattr(loop, "group", None)
+
+    def _build_noise(self, sch: EpisodeSchedule, helper: HelperThread | None) -> None:
+        """The process-noise chunks (drawn ahead, with or without the helper thread)."""
+        p, K, n = self.p, self.K, self.n
         C = sch.chunk
         self._noise_draws = np.zeros((K, C, n))  # each copy's chunk, as its generator draws it
         self._noise = np.zeros((C, K, n))  # period-major, like X: one period's noise is contiguous
@@ -218,8 +241,6 @@ class EpisodeCore(HelperWork):
         self.helper = helper
         self._noise_future: Future | None = None
         self._gram_future: Future | None = None
-        self._rngs: list[np.random.Generator] = []
-        self.history: list[tuple[int, float]] = []  # (N delivered, epsilon) of copy 0, for render
 
     def end_out_of_time(self) -> None:
         """End the attack at the next step as out of time (``terminated``, not detected): for a
@@ -231,9 +252,7 @@ class EpisodeCore(HelperWork):
         """The helper's work finished, and the defender's own resources released (its optional
         ``close``, e.g. the rotating defender's group pool)."""
         self.wait()
-        close = getattr(self.defender, "close", None)
-        if close is not None:
-            close()
+        self.defender.close()
 
     def _gram_views(self) -> tuple[np.ndarray, np.ndarray]:
         """G and C as views of ``[G | C]`` (``_GC``), shape (K, d, d) and (K, d, n)."""
@@ -287,7 +306,7 @@ class EpisodeCore(HelperWork):
         self.wait()  # the helper may still be drawing from the old generators or adding to G
         self._rngs = rngs
         self._given_noise = given
-        self._obs_out = None
+        self.obs_out = None
         for i, g in enumerate(rngs):
             draw = g.standard_normal(self.n) * self._sx
             self.state.x[i] = draw if x0_arr is None else x0_arr[i]
@@ -299,11 +318,11 @@ class EpisodeCore(HelperWork):
         self.rotation = RotationRecord()
         self.loop.start_episode()
         for _ in range(self.p.warmup_steps):  # normal operation under the encrypted controller (eq:ec)
-            kern.plant_step(self._dims, self.state.x, self.loop.control(self.state.x), self._draw_noise(), self._A, self._B)
+            kern.plant_step(self.dims, self.state.x, self.loop.control(self.state.x), self._draw_noise(), self._A, self._B)
         self.X[:] = 0.0
         self.U[:] = 0.0
         self._GC[:] = 0.0
-        self._gram_upto = 1
+        self.gram_upto = 1
         if self.kernels is not None:
             self.kernels.reset()
         self.state.hist[:] = 0.0
@@ -318,7 +337,7 @@ class EpisodeCore(HelperWork):
         self.done = False
         self.history = []
         self.defender.reset(self.K, self.n, self.m, DefenderStreams(rngs))
-        self._collect()
+        self.collect_next()
         self.new = self._deliver(final=False)
         return self.observation()
 
@@ -338,7 +357,7 @@ class EpisodeCore(HelperWork):
         return self.X[:N].transpose(1, 0, 2).copy(), self.U[: max(N - 1, 0)].transpose(1, 0, 2).copy()
 
     # ----------------------------------------------------------------- step
-    def _collect(self) -> None:
+    def collect_next(self) -> None:
         """Collect and pay for the state ciphertext of the current period.
 
         With the measured clock the time paid is what the breaker took so far this episode; a
@@ -352,16 +371,16 @@ class EpisodeCore(HelperWork):
                 self.expired = True
                 return
             self.time_table[self.collected + 1] = spent
-            self._time_frac[self.collected + 1] = spent / self.p.tau_c
+            self.time_frac[self.collected + 1] = spent / self.p.tau_c
             self._time_list[self.collected + 1] = spent
         self.collected += 1
 
-    def _overflow(self) -> None:
+    def raise_overflow(self) -> None:
         raise EncodingOverflowError(
             f"state {self.state.x.tolist()} leaves the encoder's declared range |x| <= {self.p.x_bound} (x_bound)"
         )
 
-    def _target(self, collected: int) -> int:
+    def target_of(self, collected: int) -> int:
         """Number of samples delivered once ``collected`` are paid for (before the end)."""
         delay = self.p.decipher_delay
         if delay is None:  # "end": nothing before the attack ends
@@ -370,7 +389,7 @@ class EpisodeCore(HelperWork):
 
     def _deliver(self, final: bool) -> bool:
         """Deliver paid samples whose delay has passed; update the estimate and its error."""
-        target = self.collected if final else self._target(self.collected)
+        target = self.collected if final else self.target_of(self.collected)
         if target <= self.delivered:
             return False
         first = max(self.delivered, 1)
@@ -383,9 +402,9 @@ class EpisodeCore(HelperWork):
             and kernels.since_refresh + target - first < kernels.refresh
         ):  # steady state: columns, the compiled estimate and its error
             self._sync_gram(first)
-            kernels.add_columns(self._dims, self.X, self.U, first, target, self._GC)
-            self._gram_upto = target
-            kernels.steady_error(self._dims, self.eps)
+            kernels.add_columns(self.dims, self.X, self.U, first, target, self._GC)
+            self.gram_upto = target
+            kernels.steady_error(self.dims, self.eps)
             kernels.since_refresh += target - first
             self.delivered = target
             self.history.append((target, float(self.eps[0])))
@@ -393,16 +412,16 @@ class EpisodeCore(HelperWork):
         self._sync_gram(first)
         if target > first:
             if kernels is not None:
-                kernels.add_columns(self._dims, self.X, self.U, first, target, self._GC)
+                kernels.add_columns(self.dims, self.X, self.U, first, target, self._GC)
             else:  # the Gram matrices alone (the rewards read them), as the columns would add them
-                kern.add_gram(self._dims, self.X, self.U, first, target, self._GC, self._gram_scratch)
-            self._gram_upto = target
+                kern.add_gram(self.dims, self.X, self.U, first, target, self._GC, self._gram_scratch)
+            self.gram_upto = target
         self.delivered = target
         if self.estimator is not None:
             self._estimate(first, target)
         self.reward.on_delivery(self)
         if kernels is not None:
-            kernels.settle(self._dims, self.G, self.C, target - first, self.delivered, final, self.eps)
+            kernels.settle(self.dims, self.G, self.C, target - first, self.delivered, final, self.eps)
         self.history.append((self.delivered, float(self.eps[0])))
         return True
 
@@ -449,18 +468,20 @@ class EpisodeCore(HelperWork):
             raise ParameterError(f"action must be {what}, got {np.asarray(action).tolist()}")
         return self._act
 
-    def step(self, action: Any, *, inject: bool = True) -> tuple[np.ndarray, bool, bool]:
+    def step(self, action: Any, *, injection: str | None = None) -> tuple[np.ndarray, bool, bool]:
         """Apply the actions of all copies. Returns (rewards (K,), terminated, truncated).
 
-        ``inject=False`` (every copy at once): the attacker forges nothing this period and the
-        plant applies the encrypted controller's own input ``u_k = Phi x_k`` (eq:ec,
-        :meth:`_pass_period`); ``action`` is still checked but unused. Such a step cannot fail an
-        audit, and its regression column is closed-loop data (``u`` a function of ``x``).
+        ``injection`` (every copy at once): this step's mode of :data:`~encctl_gym.loop.injection.INJECTIONS`
+        instead of the episode's (``params.injection``); the game passes ``"pass"`` for a step in
+        which the attacker injects nothing: the plant applies the encrypted controller's own input
+        ``u_k = Phi x_k`` (eq:ec), ``action`` is still checked but unused, no energy is spent, and
+        the regression column is closed-loop data (``u`` a function of ``x``).
         """
         if not self._rngs:
             raise ParameterError("step() called before reset(); call reset() first")
         if self.done:
             raise ParameterError("step() called after the episode ended; call reset() first")
+        mode = self.injection if injection is None else injection_code(injection)
         act = self.check_actions(action)
         w = self._draw_noise()
         ended = self.collected >= self.p.horizon or self.expired
@@ -472,28 +493,9 @@ class EpisodeCore(HelperWork):
             if stop:
                 self.stopped = ended = True
             if decision.new_group is not None:  # group rotation: the period runs in the new group
-                group = check_new_group(decision.new_group, getattr(self.loop, "group", None))
+                group = self.p.loop.encryption().check_fresh(decision.new_group, getattr(self.loop, "group", None))
                 self.rotation.add(move_loop(self.loop, self.stepper, group))
-        if not inject:
-            self._obs_out = None
-            return self.finish_step(self._pass_period(w, ended))
-        return self.stepper.step(act, w, ended)
-
-    def _pass_period(self, w: np.ndarray, ended: bool) -> bool:
-        """A period of normal operation inside the attack: the backend's :meth:`control` (eq:ec,
-        with its key update) computes the input the plant applies, recorded like a forged one;
-        no input energy is spent and the agent's input history takes zeros (it injected nothing).
-        Returns whether the attack has ended (as :meth:`StepStrategy.period`)."""
-        s = self.state
-        u = self.loop.control(s.x)
-        s.U[self.collected - 1] = u
-        kern.plant_step(self._dims, s.x, np.ascontiguousarray(u, dtype=np.float64), w, self._A, self._B)
-        if self.p.input_history:
-            kern.shift_history(self._dims, s.hist, np.zeros((self.K, self.m)))
-        if not ended:
-            self._collect()
-            ended = self.expired
-        return ended
+        return self.stepper.step(act, w, ended, mode)
 
     def _attack_step(self) -> int:
         """The attack step about to run (0 at the first): its input goes to ``U[collected - 1]``."""
@@ -515,19 +517,19 @@ class EpisodeCore(HelperWork):
         """Observations of all copies, shape (K, obs_dim), float32 (layout:
         :class:`~encctl_gym.envs.layout.ObservationLayout`), in a new array: the one the fused
         step wrote, if not yet handed out, else filled now."""
-        obs, self._obs_out = self._obs_out, None
+        obs, self.obs_out = self.obs_out, None
         if obs is None:
-            obs = np.empty(self._obs_shape, dtype=np.float32)
+            obs = np.empty(self.obs_shape, dtype=np.float32)
             kern.fill_observation(
-                self._dims,
+                self.dims,
                 obs,
-                self._obs_at,
+                self.obs_at,
                 self.X,
                 self.U,
                 self.delivered - 1,
                 float(self.new),
                 self.state.hist,
-                float(self._time_frac[self.collected]),
+                float(self.time_frac[self.collected]),
                 self.state.energy,
                 self.consts.budget,
             )

@@ -33,8 +33,8 @@ class HelperWork:
     U: np.ndarray
     _GC: np.ndarray
     _gram_scratch: np.ndarray
-    _gram_upto: int
-    _dims: Any
+    gram_upto: int
+    dims: Any
     _noise_future: Future | None
     _gram_future: Future | None
     _given_noise: np.ndarray | None
@@ -111,11 +111,11 @@ class HelperWork:
     def _sync_gram(self, upto: int) -> None:
         """Bring G and C up to the columns j < ``upto`` (the fused step leaves them behind)."""
         self._wait_gram()
-        if upto > self._gram_upto:
-            kern.add_gram(self._dims, self.X, self.U, self._gram_upto, upto, self._GC, self._gram_scratch)
-            self._gram_upto = upto
+        if upto > self.gram_upto:
+            kern.add_gram(self.dims, self.X, self.U, self.gram_upto, upto, self._GC, self._gram_scratch)
+            self.gram_upto = upto
 
-    def _gram_behind(self, upto: int) -> None:
+    def gram_behind(self, upto: int) -> None:
         """Hand the Gram catch-up of the columns j < ``upto`` to the helper thread, unless it
         is still busy with the previous one. The columns are final: rows of X and U only ever
         get written once, ahead of the columns that read them."""
@@ -124,7 +124,7 @@ class HelperWork:
             if not self._gram_future.done():
                 return
             self._wait_gram()
-        first, self._gram_upto = self._gram_upto, upto
+        first, self.gram_upto = self.gram_upto, upto
         self._gram_future = self.helper.submit(
-            kern.add_gram, self._dims, self.X, self.U, first, upto, self._GC, self._gram_scratch
+            kern.add_gram, self.dims, self.X, self.U, first, upto, self._GC, self._gram_scratch
         )

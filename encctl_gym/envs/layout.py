@@ -10,14 +10,11 @@ entries, for one copy (Python scalars) and for a batch (arrays).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from ..errors import ParameterError
-
-if TYPE_CHECKING:
-    from .config import AttackParams
 
 __all__ = ["ObservationLayout", "OBSERVATION_MODES", "INFO_KEYS", "SHARED_INFO", "PRIVILEGED_INFO", "info_dict"]
 
@@ -50,7 +47,7 @@ class ObservationLayout:
     H: int
 
     @classmethod
-    def of(cls, params: AttackParams) -> ObservationLayout:
+    def of(cls, params: Any) -> ObservationLayout:
         """The layout of an environment's resolved parameters (:class:`~encctl_gym.envs.config.AttackParams`);
         with ``observe="output"`` the "state" slice holds the ``p`` deciphered outputs."""
         return cls(int(params.observed_dim), int(params.m), int(params.input_history))

@@ -11,17 +11,22 @@ def:adversary, the same budget rules as :class:`~encctl_gym.envs.episode.Episode
    the copy's generator after the process noise of that period) and encrypts it; the
    adversary collects and pays for the ciphertext (``2^lambda / Upsilon`` seconds, Definition
    def:sdt, under the same schedule and delay as the state case);
-2. delivered outputs, with the attacker's own inputs, feed its online estimator: **least squares
-   on an ARX model** ``y[t] = sum_{k<=q} a_k y[t-k] + b_k u[t-k]`` with ``q = ceil(n / p) + 1``
-   lags (enough for a plant of order ``n``; :func:`~encctl_gym.ident.subspace.arx` on the
-   delivered data, kept online as the Gram matrix of its regressors and solved exactly at
-   each delivery once it has full rank);
+2. delivered outputs, with the attacker's own inputs, feed its online estimator
+   (:func:`~encctl_gym.ident.output_estimators.output_estimator` of the ``estimator`` key):
+   ``"ls"``, **least squares on an ARX model** ``y[t] = sum_{k<=q} a_k y[t-k] + b_k u[t-k]``
+   with ``q = ceil(n / p) + 1`` lags (enough for a plant of order ``n``;
+   :func:`~encctl_gym.ident.subspace.arx` on the delivered data, kept online as the Gram matrix
+   of its regressors and solved exactly at each delivery once it has full rank), or the
+   subspace methods ``"n4sid"`` and ``"moesp"`` at the plant's order ``n``, refitted on all the
+   delivered data at each delivery (``O(N)`` work a delivery);
 3. the agent acts under the energy budget, the plant decrypts and applies the forged input.
 
 ``epsilon`` (``info``, privileged) is the **Markov-parameter error**
-(:func:`~encctl_gym.ident.subspace.markov_error`, ``L = MARKOV_LENGTH``) of the ARX estimate against
-the true ``(A, B, C, 0)``; the estimate ``0`` (``epsilon = 1``) until the scaled Gram matrix of the
-regressors has a condition number below :data:`COND_LIMIT`.
+(:func:`~encctl_gym.ident.subspace.markov_error`, ``L = MARKOV_LENGTH``) of the estimate against
+the true ``(A, B, C, 0)``; the estimate ``0`` (``epsilon = 1``) until the estimator has one (ARX:
+the scaled Gram matrix of the regressors has a condition number below :data:`COND_LIMIT`; the
+subspace methods: enough samples for their windows), and a copy whose fit fails keeps its
+previous ``epsilon``.
 The reward ``log_error`` is its decrease, ``log epsilon_{k-1} - log epsilon_k``: the basis-free
 error replaces Definition def:error, which needs the state. ``gamma`` and ``gamma_opt`` stay
 those of the state-measured attack (eq:sic and the optimal design), as references.
@@ -30,9 +35,9 @@ The observation is the layout of :class:`~encctl_gym.envs.layout.ObservationLayo
 in place of ``n``: ``[y_j | u_{j-1} | new | own inputs | time fraction | energy fraction]``.
 Nothing of the state enters it: the plant side hands the loop ``y`` only.
 
-Scope: one copy per environment call is the common case, but copies are batched (``K`` generators);
-only the fixed defender (the others act on states), the ``log_error`` reward and the least-squares
-estimator (on the ARX model) are available with outputs.
+Scope: copies are batched (``K`` generators; the vector environment steps them); only the fixed
+defender (the others act on states), the ``log_error`` reward and the estimators on outputs
+(ARX least squares, N4SID, PO-MOESP) are available with outputs.
 """
 
 from __future__ import annotations
@@ -45,7 +50,7 @@ import numpy as np
 
 from .._validation import as_finite_array, format_value
 from ..errors import ParameterError, ShapeError
-from ..ident.subspace import arx_realisation, markov_error
+from ..ident.output_estimators import ARX_COND_LIMIT, output_estimator
 from ..loop.output_feedback import CONTROLLERS, OutputLoop, loop_controller
 from . import _kernels as kern
 from .layout import ObservationLayout, info_dict
@@ -57,10 +62,8 @@ OBSERVE: tuple[str, ...] = ("state", "output")
 #: ``L`` of the Markov-parameter error behind ``epsilon`` with outputs.
 MARKOV_LENGTH = 20
 #: A copy's ARX estimate is taken once the condition number of its regressors' Gram matrix,
-#: scaled to unit diagonal, is below this (as the state case's ``EpisodeSchedule.cond_limit``):
-#: inputs that barely excite the plant (an attacker forging zeros) give a Gram matrix of full
-#: rank whose solve is noise, with Markov errors of 1e60.
-COND_LIMIT = 1e10
+#: scaled to unit diagonal, is below this (:data:`encctl_gym.ident.output_estimators.ARX_COND_LIMIT`).
+COND_LIMIT = ARX_COND_LIMIT
 
 
 def resolve_output(
@@ -98,10 +101,7 @@ def resolve_output(
     controller = cfg["controller"]
     if not isinstance(controller, str) or controller not in CONTROLLERS:
         raise ParameterError(f"unknown controller {format_value(controller)}; choose one of {', '.join(CONTROLLERS)}")
-    if estimator != "ls":
-        raise ParameterError(
-            f"with observe='output' the attacker's estimator is least squares on an ARX model (estimator='ls'), got {format_value(estimator)}"
-        )
+    output_estimator(estimator)  # ARX least squares, N4SID or PO-MOESP; any other is refused here
     if reward != "log_error":
         raise ParameterError(f"with observe='output' the reward is 'log_error' (of the Markov-parameter error), got {reward!r}")
     if not (isinstance(defender, str) and defender == "fixed"):
@@ -119,18 +119,19 @@ class OutputEpisode:
 
     The same interface as :class:`~encctl_gym.envs.episode.EpisodeCore` for the environment:
     :meth:`reset`, :meth:`step`, :meth:`observation`, :meth:`info`, :meth:`delivered_data`,
-    :attr:`done`, :attr:`collected`, :attr:`delivered`, :attr:`eps`.
+    :meth:`close`, :attr:`done`, :attr:`collected`, :attr:`delivered`, :attr:`eps`.
     """
 
-    def __init__(self, params: Any, loop: Any, design: Any = None, num_envs: int = 1) -> None:
+    def __init__(self, params: Any, loop: Any, design: Any = None, num_envs: int = 1, defender: Any = None) -> None:
         p = self.p = params
+        self.defender = defender
         if params.C is None:
             raise ParameterError("OutputEpisode needs observe='output' parameters (C is None)")
         self.K = K = int(num_envs)
         if K > 1 and not loop.batched:
             raise ParameterError(f"the {p.crypto} backend steps one copy, got num_envs = {K}")
         self.loop = loop
-        self.controller = loop_controller(p)
+        self.controller = loop_controller(p.loop)
         self.closed_loop = OutputLoop(loop, self.controller)
         n, m = p.n, p.m
         self.n, self.m = n, m
@@ -139,9 +140,9 @@ class OutputEpisode:
         self._A, self._B = np.ascontiguousarray(p.A), np.ascontiguousarray(p.B)
         self._sw, self._sv, self._sx = math.sqrt(p.sigma_w2), math.sqrt(p.sigma_v2), math.sqrt(p.sigma_x2)
         self.layout = ObservationLayout(q, m, p.input_history)
-        self._dims = kern.dims(n, m, p.input_history * m)
-        self.lags = -(-n // q) + 1
-        self._d = self.lags * (q + m)
+        self.dims = kern.dims(n, m, p.input_history * m)
+        self.estimator = output_estimator(p.estimator)
+        self.lags = -(-n // q) + 1  # the ARX estimator's lags (its regressors)
         self._true = (p.A, p.B, self.C, np.zeros((q, m)))
         N = p.horizon
         self.Y = np.zeros((N, K, q))
@@ -151,8 +152,6 @@ class OutputEpisode:
         self.hist = np.zeros((K, p.input_history * m))
         self._act = np.zeros((K, m))
         self._a = np.zeros((K, m))
-        self.G = np.zeros((K, self._d, self._d))
-        self.Cr = np.zeros((K, self._d, q))
         self.eps = np.ones(K)
         Ns = np.arange(N + 1)
         self._gamma = np.full(N + 1, np.inf)
@@ -213,11 +212,10 @@ class OutputEpisode:
         for _ in range(self.p.warmup_steps):  # normal operation on outputs (loop.output_feedback)
             w, v = self._noise()
             u = self.closed_loop.control(self._measure(v))
-            kern.plant_step(self._dims, self.x, u, w, self._A, self._B)
+            kern.plant_step(self.dims, self.x, u, w, self._A, self._B)
         self.Y[:] = 0.0
         self.U[:] = 0.0
-        self.G[:] = 0.0
-        self.Cr[:] = 0.0
+        self.estimator.start_outputs(self.K, self.n, self.p_out, self.m)
         self.energy[:] = 0.0
         self.hist[:] = 0.0
         self.eps[:] = 1.0
@@ -225,12 +223,12 @@ class OutputEpisode:
         self.done = self.stopped = False
         self.history = []
         self._wv = self._noise()  # the first attack period's (w, v): its v is measured now
-        self._collect()
+        self.collect_next()
         self.new = self._deliver(final=False)
         return self.observation()
 
     # ----------------------------------------------------------------- the attack
-    def _collect(self) -> None:
+    def collect_next(self) -> None:
         """The plant encrypts ``y_k``; the adversary collects and pays for it (``Dcd(Ecd(y_k))``)."""
         self.Y[self.collected] = self.closed_loop.collect(self._measure(self._wv[1]))
         self.collected += 1
@@ -240,28 +238,18 @@ class OutputEpisode:
         target = self.collected if final else (0 if delay is None else max(self.collected - delay, 0))
         if target <= self.delivered:
             return False
-        L = self.lags
-        for t in range(max(self.delivered, L), target):  # regressors of y_t: outputs and inputs of t-1 .. t-L
-            z = np.concatenate([self.Y[t - L : t][::-1].transpose(1, 0, 2).reshape(self.K, -1),
-                                self.U[t - L : t][::-1].transpose(1, 0, 2).reshape(self.K, -1)], axis=1)  # fmt: skip
-            self.G += z[:, :, None] * z[:, None, :]
-            self.Cr += z[:, :, None] * self.Y[t][:, None, :]
         self.delivered = target
         self._estimate()
         self.history.append((self.delivered, float(self.eps[0])))
         return True
 
     def _estimate(self) -> None:
-        """``epsilon`` of the ARX least-squares estimate where its scaled Gram matrix is well conditioned."""
-        if self.delivered - self.lags < self._d:
+        """``epsilon`` of the estimator's estimate on the delivered data, where it has one."""
+        if not self.estimator.deliver_outputs(self.Y, self.U, self.delivered):
             return
-        scale = np.sqrt(np.maximum(np.einsum("kii->ki", self.G), np.finfo(float).tiny))
-        ok = np.linalg.cond(self.G / scale[:, :, None] / scale[:, None, :]) < COND_LIMIT
-        if not ok.any():
-            return
-        theta = np.linalg.solve(self.G[ok], self.Cr[ok])  # (k, d, p): [a_1^T .. a_L^T, b_1^T .. b_L^T]
-        A, B, C, D = arx_realisation(theta, self.lags, self.lags, self.p_out, self.m)
-        self.eps[ok] = markov_error(self._true, (A, B, C, D), MARKOV_LENGTH)
+        err = self.estimator.output_error(self._true, MARKOV_LENGTH)
+        ok = np.isfinite(err)
+        self.eps[ok] = err[ok]
 
     def check_actions(self, action: Any) -> np.ndarray:
         """Actions of shape (K, m) (or (m,) for K = 1), finite, inside [-1, 1], as float64."""
@@ -290,21 +278,27 @@ class OutputEpisode:
         act = self.check_actions(action)
         ended = self.collected >= self.p.horizon
         w = self._wv[0]
-        kern.energy_budget(self._dims, act, self.p.u_max, self.energy, self.p.energy_budget, self._a)
+        kern.energy_budget(self.dims, act, self.p.u_max, self.energy, self.p.energy_budget, self._a)
         u = self.closed_loop.inject(self._a)
         self.U[self.collected - 1] = u
-        kern.plant_step(self._dims, self.x, u, w, self._A, self._B)
+        kern.plant_step(self.dims, self.x, u, w, self._A, self._B)
         if self.p.input_history:
-            kern.shift_history(self._dims, self.hist, act)
+            kern.shift_history(self.dims, self.hist, act)
         self.loop.tick()
         if not ended:
             self._wv = self._noise()
-            self._collect()
+            self.collect_next()
         before = np.log(self.eps)
         self.new = self._deliver(final=ended)
         reward = before - np.log(self.eps)
         self.done = ended
         return reward, ended and self.p.budget_limited, ended and not self.p.budget_limited
+
+    def close(self) -> None:
+        """Release the defender's resources (its ``close``; the fixed defender holds none), as
+        :meth:`EpisodeCore.close <encctl_gym.envs.episode.EpisodeCore.close>`. Idempotent."""
+        if self.defender is not None:
+            self.defender.close()
 
     # ----------------------------------------------------------------- what the attacker sees
     def delivered_data(self) -> tuple[np.ndarray, np.ndarray]:

@@ -14,16 +14,13 @@ regressors after every delivery, so the episode keeps it up to date for them.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from ..errors import ConfigError
 from ..registry import Registry
 from . import _kernels as kern
-
-if TYPE_CHECKING:
-    from .config import AttackParams
 
 __all__ = ["Reward", "GramReward", "LogErrorReward", "LogDetReward", "AOptimalityReward", "REWARDS"]
 
@@ -35,7 +32,7 @@ class Reward:
     fused = False
     needs_gram = False
 
-    def __init__(self, params: AttackParams, num_envs: int) -> None:
+    def __init__(self, params: Any, num_envs: int) -> None:
         self.params = params
         self.K = num_envs
 
@@ -79,7 +76,7 @@ class GramReward(Reward):
     needs_gram = True
     sign = 1.0
 
-    def __init__(self, params: AttackParams, num_envs: int) -> None:
+    def __init__(self, params: Any, num_envs: int) -> None:
         super().__init__(params, num_envs)
         self._d = params.n + params.m
         self._delta = params.logdet_regularization

@@ -6,9 +6,10 @@ dispatches a plain tuple as fast as separate arguments), built once per episode 
 :meth:`EpisodeArrays.kernel_tuple` and :meth:`KernelConstants.kernel_tuple` in the order the
 kernels unpack them. Nothing reads those tuples by position outside the kernels.
 
-A :class:`StepStrategy` runs the period of one attack step (energy budget, forged input, plant,
-own-input history, collected state); the episode picks one when it is built
-(:func:`choose_step`), never per step:
+A :class:`StepStrategy` runs the period of one attack step (energy budget, the input under the
+injection mode of :mod:`encctl_gym.loop.injection`, plant, own-input history, collected state)
+on a :class:`StepContext` (the episode's arrays, counters and closing operations, by public
+name); the episode picks one when it is built (:func:`choose_step`), never per step:
 
 * :class:`GenericStep`: the loop backend is called period by period (any backend, e.g. ElGamal);
 * :class:`CompiledIdealStep`: the backend exposes its arithmetic
@@ -23,17 +24,24 @@ The three compute the same numbers (tested): a strategy is a speed, not a semant
 from __future__ import annotations
 
 from dataclasses import astuple, dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 
 from ..errors import ParameterError
+from ..loop.injection import PASS, REPLACE
 from . import _kernels as kern
 
-if TYPE_CHECKING:
-    from .episode import EpisodeCore
-
-__all__ = ["EpisodeArrays", "KernelConstants", "StepStrategy", "GenericStep", "CompiledIdealStep", "FusedStep", "choose_step"]
+__all__ = [
+    "EpisodeArrays",
+    "KernelConstants",
+    "StepContext",
+    "StepStrategy",
+    "GenericStep",
+    "CompiledIdealStep",
+    "FusedStep",
+    "choose_step",
+]
 
 
 @dataclass(frozen=True)
@@ -132,6 +140,70 @@ class EpisodeArrays:
         return tuple(getattr(self, name) for name in self.__dataclass_fields__)
 
 
+class StepContext(Protocol):
+    """What a step strategy reads and advances of its episode (:class:`~encctl_gym.envs.episode.EpisodeCore`,
+    :class:`~encctl_gym.envs.output_episode.OutputEpisode`): the arrays and constants the kernels
+    take, the loop backend, the progress counters and the few operations a period ends with. A
+    strategy reads nothing else."""
+
+    state: EpisodeArrays
+    consts: KernelConstants
+    kernel_consts: tuple[Any, ...]
+    kernel_arrays: tuple[np.ndarray, ...]
+    dims: Any
+    loop: Any
+    input_history: int
+    collected: int
+    delivered: int
+    expired: bool
+    new: bool
+    kernels: Any
+    helper: Any
+    schedule: Any
+    history: list[tuple[int, float]]
+    gram_upto: int
+    obs_shape: tuple[int, int]
+    obs_at: tuple[int, int, int, int, int, int]
+    time_frac: np.ndarray
+    obs_out: np.ndarray | None
+
+    def collect_next(self) -> None:
+        """Collect (encrypt, pay for and decipher) the next state into ``X``."""
+
+    def raise_overflow(self) -> None:
+        """Raise the encoder's overflow for the current state."""
+
+    def target_of(self, collected: int) -> int:
+        """The samples delivered once ``collected`` are collected (the deciphering delay)."""
+
+    def gram_behind(self, upto: int) -> None:
+        """Catch the Gram matrices up to column ``upto`` (on the helper thread, if any)."""
+
+    def finish_step(self, ended: bool) -> tuple[np.ndarray, bool, bool]:
+        """Delivery, estimate and reward after the period."""
+
+
+def backend_period(core: StepContext, act: np.ndarray, w: np.ndarray, ended: bool, injection: int) -> bool:
+    """One period through the backend's own methods (any backend, any injection mode): energy
+    budget, :meth:`~encctl_gym.loop.backend.LoopBackend.period_input`, plant, own-input history,
+    key update, collected state. ``PASS`` injects nothing: no energy is spent and the own-input
+    history takes zeros. Returns whether the attack has ended (:meth:`StepStrategy.period`)."""
+    s, c = core.state, core.consts
+    if injection == PASS:
+        act[:] = 0.0
+    kern.energy_budget(core.dims, act, c.u_max, s.energy, c.budget, s.a_buf)
+    u = np.ascontiguousarray(core.loop.period_input(s.a_buf, s.x, injection), dtype=np.float64)
+    s.U[core.collected - 1] = u
+    kern.plant_step(core.dims, s.x, u, w, c.A, c.B)
+    if core.input_history:
+        kern.shift_history(core.dims, s.hist, act)
+    core.loop.tick()
+    if not ended:
+        core.collect_next()
+        ended = core.expired  # the measured clock passed tau_c: the attack is over now
+    return ended
+
+
 class StepStrategy:
     """How the period of one step runs (see the module docstring); bound to one episode.
 
@@ -141,43 +213,34 @@ class StepStrategy:
 
     name = "step"
 
-    def __init__(self, core: EpisodeCore) -> None:
+    def __init__(self, core: StepContext) -> None:
         self.core = core
 
-    def period(self, act: np.ndarray, w: np.ndarray, ended: bool) -> bool:
-        """Apply the energy-limited, forged input ``act`` with noise ``w``; collect the next
-        state unless ``ended``. Returns whether the attack has ended (``ended``, or the
-        measured clock passed ``tau_c`` in this period)."""
+    def period(self, act: np.ndarray, w: np.ndarray, ended: bool, injection: int = REPLACE) -> bool:
+        """Apply the energy-limited input ``act`` under the injection mode (``REPLACE``: forged;
+        :mod:`encctl_gym.loop.injection`) with noise ``w``; collect the next state unless ``ended``.
+        Returns whether the attack has ended (``ended``, or the measured clock passed ``tau_c``
+        in this period)."""
         raise NotImplementedError
 
-    def step(self, act: np.ndarray, w: np.ndarray, ended: bool) -> tuple[np.ndarray, bool, bool]:
-        """The step: the period, then what follows it (:meth:`EpisodeCore.finish_step`)."""
+    def step(self, act: np.ndarray, w: np.ndarray, ended: bool, injection: int = REPLACE) -> tuple[np.ndarray, bool, bool]:
+        """The step: the period, then what follows it (:meth:`StepContext.finish_step`)."""
         core = self.core
-        core._obs_out = None
-        ended = self.period(act, w, ended)
+        core.obs_out = None
+        ended = self.period(act, w, ended, injection)
         return core.finish_step(ended)
 
 
 class GenericStep(StepStrategy):
-    """The backend called period by period (:meth:`~encctl_gym.loop.backend.LoopBackend.inject`,
-    :meth:`~encctl_gym.loop.backend.LoopBackend.tick`, then the state collected)."""
+    """The backend called period by period (:meth:`~encctl_gym.loop.backend.LoopBackend.period_input`
+    under any injection mode, :meth:`~encctl_gym.loop.backend.LoopBackend.tick`, then the state
+    collected). ``PASS`` injects nothing: no energy is spent and the own-input history takes
+    zeros."""
 
     name = "generic"
 
-    def period(self, act: np.ndarray, w: np.ndarray, ended: bool) -> bool:
-        core = self.core
-        s, c = core.state, core.consts
-        kern.energy_budget(core._dims, act, c.u_max, s.energy, c.budget, s.a_buf)
-        u = core.loop.inject(s.a_buf)
-        s.U[core.collected - 1] = u
-        kern.plant_step(core._dims, s.x, u, w, c.A, c.B)
-        if core.p.input_history:
-            kern.shift_history(core._dims, s.hist, act)
-        core.loop.tick()
-        if not ended:
-            core._collect()
-            ended = core.expired  # the measured clock passed tau_c: the attack is over now
-        return ended
+    def period(self, act: np.ndarray, w: np.ndarray, ended: bool, injection: int = REPLACE) -> bool:
+        return backend_period(self.core, act, w, ended, injection)
 
 
 class CompiledIdealStep(StepStrategy):
@@ -186,17 +249,26 @@ class CompiledIdealStep(StepStrategy):
 
     name = "compiled-ideal"
 
-    def __init__(self, core: EpisodeCore, quant: tuple[Any, ...]) -> None:
+    def __init__(self, core: StepContext, quant: tuple[Any, ...]) -> None:
         super().__init__(core)
         self.quant = quant
 
-    def period(self, act: np.ndarray, w: np.ndarray, ended: bool) -> bool:
+    def period(self, act: np.ndarray, w: np.ndarray, ended: bool, injection: int = REPLACE) -> bool:
+        if injection != REPLACE:  # another mode this step (the game's pass-through): the backend's own
+            return backend_period(self.core, act, w, ended, injection)
         core = self.core
         status = kern.step_ideal(
-            core._dims, core._consts, core._arrays, self.quant, act, w, core.collected - 1, -1 if ended else core.collected
+            core.dims,
+            core.kernel_consts,
+            core.kernel_arrays,
+            self.quant,
+            act,
+            w,
+            core.collected - 1,
+            -1 if ended else core.collected,
         )
         if status == kern.STATE_OVERFLOW:
-            core._overflow()
+            core.raise_overflow()
         if not ended:
             core.collected += 1
         return ended
@@ -210,29 +282,29 @@ class FusedStep(CompiledIdealStep):
 
     name = "fused"
 
-    def __init__(self, core: EpisodeCore, quant: tuple[Any, ...], parallel: bool = False) -> None:
+    def __init__(self, core: StepContext, quant: tuple[Any, ...], parallel: bool = False) -> None:
         super().__init__(core, quant)
         self._kernel = kern.step_fused_parallel if parallel else kern.step_fused
         if core.kernels is None:
             raise ParameterError("the fused step needs an estimator with fused kernels (online_kernels)")
         self.kernels = core.kernels
 
-    def step(self, act: np.ndarray, w: np.ndarray, ended: bool) -> tuple[np.ndarray, bool, bool]:
+    def step(self, act: np.ndarray, w: np.ndarray, ended: bool, injection: int = REPLACE) -> tuple[np.ndarray, bool, bool]:
         core = self.core
         kernels = self.kernels
-        if not (kernels.all_ready and not ended):
-            return super().step(act, w, ended)
+        if not (kernels.all_ready and not ended and injection == REPLACE):
+            return super().step(act, w, ended, injection)
         first = max(core.delivered, 1)
-        target = core._target(core.collected + 1)
+        target = core.target_of(core.collected + 1)
         if kernels.since_refresh + target - first >= kernels.refresh:
-            return super().step(act, w, ended)
+            return super().step(act, w, ended, injection)
         new = target > core.delivered
-        obs = np.empty(core._obs_shape, dtype=np.float32)
+        obs = np.empty(core.obs_shape, dtype=np.float32)
         N, collected = (target if new else core.delivered), core.collected + 1
         status = self._kernel(
-            core._dims,
-            core._consts,
-            core._arrays,
+            core.dims,
+            core.kernel_consts,
+            core.kernel_arrays,
             self.quant,
             act,
             w,
@@ -241,31 +313,34 @@ class FusedStep(CompiledIdealStep):
             first,
             target,
             obs,
-            core._obs_at,
+            core.obs_at,
             N - 1,
             float(new),
-            float(core._time_frac[collected]),
+            float(core.time_frac[collected]),
         )
         if status == kern.STATE_OVERFLOW:
-            core._overflow()
+            core.raise_overflow()
         core.collected += 1
         core.new = new
         if new:
             kernels.since_refresh += target - first
             core.delivered = target
             core.history.append((target, float(core.state.eps[0])))
-            if core.helper is not None and target - core._gram_upto >= core.schedule.gram_batch:
-                core._gram_behind(target)
-        core._obs_out = obs
+            if core.helper is not None and target - core.gram_upto >= core.schedule.gram_batch:
+                core.gram_behind(target)
+        core.obs_out = obs
         return core.state.reward.copy(), False, False
 
 
-def choose_step(core: EpisodeCore, quantization: Any, fused: bool, parallel: bool = False) -> StepStrategy:
+def choose_step(
+    core: StepContext, quantization: Any, fused: bool, parallel: bool = False, injection: int = REPLACE
+) -> StepStrategy:
     """The strategy of an episode, chosen once: :class:`FusedStep` when the backend exposes its
     arithmetic (``quantization``) and ``fused`` (the reward and the estimator have compiled
     steady states), :class:`CompiledIdealStep` with the arithmetic alone, :class:`GenericStep`
-    otherwise."""
-    if quantization is None:
+    otherwise, and for an episode whose injection mode is not ``REPLACE`` (the compiled period
+    is the forgery's; the backend's :meth:`period_input` does the others)."""
+    if quantization is None or injection != REPLACE:
         return GenericStep(core)
     quant = tuple(quantization)
     if fused:

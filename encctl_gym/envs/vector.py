@@ -20,12 +20,13 @@ from gymnasium.vector.utils import batch_space
 
 from .._validation import check_int, format_value
 from ..errors import ParameterError
-from ..loop import defender_for, make_loop
+from .builder import build_episode
 from .config import AttackParams, resolve_params
 from .encrypted_lti_attack import check_seed, reset_options
-from .episode import EpisodeCore, attack_design_for
+from .episode import EpisodeCore
 from .helper import HelperThread
-from .schedule import EpisodeSchedule, check_episode_memory
+from .output_episode import OutputEpisode
+from .schedule import EpisodeSchedule
 
 __all__ = ["EncryptedLTIAttackVectorEnv"]
 
@@ -77,46 +78,31 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         **kwargs: Any,
     ) -> None:
         self.num_envs = check_int("num_envs", num_envs, minimum=1)
-        self.params: AttackParams = resolve_params(config, **kwargs)
-        self.params.warn_if_capped()
-        if self.params.crypto != "ideal":
-            raise ParameterError(
-                f"the vector environment batches the ideal backend only, got crypto={format_value(self.params.crypto)}"
-            )
-        if self.params.observe != "state":
-            raise ParameterError("the vector environment runs observe='state'; use the single environment for observe='output'")
         if max_episode_steps is not None:
             raise ParameterError(
                 f"the attack length is set by tau_c or max_samples, not max_episode_steps (got {format_value(max_episode_steps)})"
             )
-        p = self.params
-        check_episode_memory(p, self.num_envs, schedule, memory_limit)  # before anything is sized by the parameters
         if not isinstance(parallel, (bool, np.bool_)):
             raise ParameterError(f"parallel must be a bool, got {format_value(parallel)}")
         if not isinstance(helper_thread, (bool, np.bool_, HelperThread)):
             raise ParameterError(f"helper_thread must be a bool or a HelperThread, got {format_value(helper_thread)}")
-        defender = defender_for(p)
-        loop = make_loop(p, defender)  # refuses a loop it cannot build (the quantisation table) before the spaces are sized
-        self.single_action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
-        self.single_observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
-        self.action_space = batch_space(self.single_action_space, self.num_envs)
-        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
-        self.design = attack_design_for(p) if p.gamma_opt else None
+        params = resolve_params(config, **kwargs)
+        _check_vector(params)
         if isinstance(helper_thread, HelperThread):
             self.helper: HelperThread | None = helper_thread
         else:
             self.helper = HelperThread() if helper_thread else None
-        self._core = EpisodeCore(
-            p,
-            loop,
-            self.design,
-            num_envs=self.num_envs,
-            parallel=parallel,
-            helper=self.helper,
-            schedule=schedule,
-            memory_limit=memory_limit,
-            defender=defender,
+        built = build_episode(
+            params, num_envs=self.num_envs, schedule=schedule, memory_limit=memory_limit, parallel=parallel, helper=self.helper
         )
+        self.params: AttackParams = built.params
+        p = self.params
+        self.single_action_space = spaces.Box(-1.0, 1.0, (p.m,), np.float32)
+        self.single_observation_space = spaces.Box(*p.observation_bounds(), dtype=np.float32)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.design = built.design
+        self._core = built.core
         self._rngs: list[np.random.Generator] | None = None
         self._needs_reset = False
 
@@ -138,8 +124,9 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         return obs, self._core.info_arrays()
 
     @property
-    def episode(self) -> EpisodeCore:
-        """The batched episode's state (privileged; see the single environment's ``episode``)."""
+    def episode(self) -> EpisodeCore | OutputEpisode:
+        """The batched episode's state (privileged; see the single environment's ``episode``):
+        an :class:`~encctl_gym.envs.output_episode.OutputEpisode` with ``observe="output"``."""
         return self._core
 
     def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
@@ -160,3 +147,9 @@ class EncryptedLTIAttackVectorEnv(VectorEnv):
         self._core.close()
         if self.helper is not None:
             self.helper.close()
+
+
+def _check_vector(p: AttackParams) -> None:
+    """The vector environment's refusals: it batches the ideal backend (on states or outputs)."""
+    if p.crypto != "ideal":
+        raise ParameterError(f"the vector environment batches the ideal backend only, got crypto={format_value(p.crypto)}")

@@ -17,34 +17,32 @@ The defender policies with real levers (input noise, audits, a chi-squared detec
 :mod:`encctl_gym.loop.defenses`; group rotation (a fresh group every K steps) in
 :mod:`encctl_gym.loop.rotation`.
 
-Both use the group the defender picks (:mod:`encctl_gym.loop.defender`; by default that of
-:func:`~encctl_gym.loop.backend.loop_group` for the key length), so their trajectories agree
-bit for bit up to the largest shipped group (2048 bits). Above it, with the default defender,
-the ElGamal backend generates a safe-prime group of the key length (minutes at 2500 bits), while
-the ideal backend, which needs the group only for the residue pattern of its quantisation, stays
+Both take the loop's own value object, :class:`~encctl_gym.loop.spec.LoopSpec` (nothing here
+knows the environment's configuration), and run on the group the defender picks
+(:mod:`encctl_gym.loop.defender`; by default :meth:`LoopSpec.group`, the scheme's public
+parameters for the key length: the one place that decides them), so their trajectories agree
+bit for bit up to the largest shipped group (2048 bits). Above it the ElGamal backend generates a
+safe-prime group of the key length (minutes at 2500 bits), while the ideal backend, which needs
+the group only for the residue pattern of its quantisation (``LoopSpec.ciphertexts`` False), stays
 on the 2048-bit group: it generates nothing, and its trajectories then differ from ElGamal's in
 the rounding pattern only.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
-from ..crypto.group import SHIPPED_BITS
 from ..errors import ParameterError
-from .backend import LoopBackend, loop_group, lqr_gain, table_limit
-from .defender import DEFENDERS, DefenderAction, DefenderPolicy, FixedDefender, PlantView, make_defender
+from .assembly import defender_for
+from .backend import LoopBackend, lqr_gain, table_limit
+from .defender import DEFENDERS, DefenderAction, DefenderBase, DefenderPolicy, FixedDefender, PlantView, make_defender
 from .defenses import AuditDefender, CusumDefender, DetectorDefender, NoiseDefender  # registers "noise", "audit", "chi2", "cusum"
 from .elgamal import ElGamalLoop
 from .elgamal_scheme import ElGamalScheme  # registers "modified", "token", "static"
 from .ideal import IdealLoop
 from .quantize import Quantization
-from .rotation import RotatingDefender, defender_for  # registers "rotate"
+from .rotation import RotatingDefender  # registers "rotate"
 from .scheme import SCHEMES, EncryptionScheme, make_scheme
 from .spec import LoopSpec
-
-if TYPE_CHECKING:
-    from ..envs.config import AttackParams
+from .verification import LinearCheckDefender  # registers "linear-check"
 
 __all__ = [
     "LoopBackend",
@@ -58,12 +56,12 @@ __all__ = [
     "SCHEMES",
     "make_scheme",
     "LoopSpec",
-    "loop_group",
     "lqr_gain",
     "table_limit",
     "DEFENDERS",
     "DefenderAction",
     "DefenderPolicy",
+    "DefenderBase",
     "FixedDefender",
     "NoiseDefender",
     "AuditDefender",
@@ -73,25 +71,27 @@ __all__ = [
     "make_defender",
     "RotatingDefender",
     "defender_for",
+    "LinearCheckDefender",
 ]
 
 #: Backends by the name the environment's ``crypto`` key gives.
 BACKENDS: dict[str, type] = {"ideal": IdealLoop, "elgamal": ElGamalLoop}
 
 
-def make_loop(params: AttackParams, defender: DefenderPolicy | None = None) -> LoopBackend:
-    """The backend selected by ``params.crypto``, on the group the defender picks
-    (``defender``, else the policy of ``params.defender``; by default :func:`loop_group` of the
-    key length).
+def make_loop(spec: LoopSpec, defender: DefenderPolicy | None = None) -> LoopBackend:
+    """The backend selected by ``spec.crypto``, on the group the defender picks (``defender``,
+    else the policy of ``spec.defender``; by default :meth:`LoopSpec.group`).
 
-    With the default defender, a backend without ciphertexts (``needs_key_length_group = False``:
-    the ideal one) gets the group of ``min(key_length, max(SHIPPED_BITS))`` bits, so it never
-    generates a group."""
+    Raises
+    ------
+    ParameterError
+        For an unknown backend or something that is not a :class:`LoopSpec`.
+    """
+    if not isinstance(spec, LoopSpec):
+        raise ParameterError(f"make_loop takes a LoopSpec (AttackParams.loop), got {type(spec).__name__}")
     try:
-        backend = BACKENDS[params.crypto]
+        backend = BACKENDS[spec.crypto]
     except KeyError:
-        raise ParameterError(f"unknown crypto backend {params.crypto!r}; choose one of {', '.join(BACKENDS)}") from None
-    policy = defender if defender is not None else make_defender(params.defender)
-    if not getattr(backend, "needs_key_length_group", True) and isinstance(policy, FixedDefender):
-        return backend(params, loop_group(min(params.key_length, max(SHIPPED_BITS))))
-    return backend(params, policy.group(params))
+        raise ParameterError(f"unknown crypto backend {spec.crypto!r}; choose one of {', '.join(BACKENDS)}") from None
+    policy = defender if defender is not None else make_defender(spec.defender)
+    return backend(spec, policy.group(spec))

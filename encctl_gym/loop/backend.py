@@ -16,8 +16,7 @@ others set it to ``None`` and are called period by period.
 from __future__ import annotations
 
 import math
-from functools import lru_cache
-from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 import scipy.linalg
@@ -25,11 +24,9 @@ import scipy.linalg
 from .._validation import format_value
 from ..errors import ResourceLimitError
 from .quantize import Quantization
+from .spec import LoopSpec
 
-if TYPE_CHECKING:
-    from ..envs.config import AttackParams
-
-__all__ = ["LoopBackend", "lqr_gain", "table_limit", "loop_group"]
+__all__ = ["LoopBackend", "lqr_gain", "table_limit"]
 
 
 @runtime_checkable
@@ -77,7 +74,7 @@ def lqr_gain(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return np.linalg.solve(np.eye(B.shape[1]) + B.T @ P @ B, B.T @ P @ A)
 
 
-def table_limit(params: AttackParams, Phi: np.ndarray) -> int:
+def table_limit(params: LoopSpec, Phi: np.ndarray) -> int:
     """Largest ``|round(Delta v)|`` the loop must quantise: states, inputs, controller entries.
 
     Raises
@@ -93,27 +90,3 @@ def table_limit(params: AttackParams, Phi: np.ndarray) -> int:
             f"{format_value(span)}, beyond the float range; use a smaller delta, x_bound or action_scale"
         )
     return int(math.ceil(scaled)) + 1
-
-
-def loop_group(key_length: int) -> Any:
-    """The group both backends use for a key length k (same group: same quantisation).
-
-    The smallest shipped group with at least ``k`` bits (``p`` of 64, 128, 256, 512, 712, 1024 or
-    2048 bits), so that the loop is set up instantly and every run uses the same public
-    parameters; beyond 2048 bits a safe-prime group generated from the seed ``k``, so it too is
-    the same in every run (group parameters are public: a fixed seed costs no security).
-    """
-    from ..crypto.group import SHIPPED_BITS, shipped_group
-
-    for bits in SHIPPED_BITS:
-        if bits >= key_length:
-            return shipped_group(bits)
-    return _generated_group(int(key_length))
-
-
-@lru_cache(maxsize=4)
-def _generated_group(bits: int) -> Any:
-    from ..crypto.arith import seeded_random
-    from ..crypto.group import generate_safe_prime_group
-
-    return generate_safe_prime_group(bits, rng=seeded_random(bits))

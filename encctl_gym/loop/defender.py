@@ -5,7 +5,7 @@ side. Its decisions are the group the loop runs on (the key length), what it che
 sees and what noise it adds to its own actuator input. A :class:`DefenderPolicy` makes them:
 
 * :meth:`DefenderPolicy.group`, once, when the environment is built: the group of the loop
-  (the default is the loop's group for the configured key length, :func:`~encctl_gym.loop.backend.loop_group`);
+  (the default is the loop's group for the configured key length, :meth:`~encctl_gym.loop.spec.LoopSpec.group`);
 * :meth:`DefenderPolicy.reset`, at every reset, with a random generator per copy of its own
   (spawned from each copy's generator: drawing from it changes none of the plant's draws);
 * :meth:`DefenderPolicy.act`, at every attack step before the period runs, with a
@@ -14,8 +14,12 @@ sees and what noise it adds to its own actuator input. A :class:`DefenderPolicy`
   applies this period, whether the plant side stops the attack (the episode then ends,
   ``terminated``, with every paid sample delivered), and a fresh group to move the loop to
   (group rotation, :mod:`encctl_gym.loop.rotation`);
-* ``close()``, optional: called by the environment's ``close`` to release what the policy holds
+* :meth:`DefenderPolicy.on_new_group`, when the loop moved to a fresh group (group rotation);
+* :meth:`DefenderPolicy.close`, by the environment's ``close``, to release what the policy holds
   (the rotating defender's group pool stops its worker).
+
+:class:`DefenderBase` implements every member with the paper's defaults; a new defence
+subclasses it and overrides what it decides.
 
 Policies are picked by the environment's ``defender`` key: a name of :data:`DEFENDERS` or an
 object that implements the protocol. The default, :class:`FixedDefender` (``"fixed"``), is the
@@ -32,22 +36,20 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol, overload, runtime_checkable
+from typing import Any, Protocol, overload, runtime_checkable
 
 import numpy as np
 
 from .._validation import as_finite_array, format_value
 from ..errors import ParameterError
-from .backend import loop_group
-
-if TYPE_CHECKING:
-    from ..envs.config import AttackParams
+from .spec import LoopSpec
 
 __all__ = [
     "DefenderAction",
     "DefenderPolicy",
     "PlantView",
     "DefenderStreams",
+    "DefenderBase",
     "FixedDefender",
     "DEFENDERS",
     "make_defender",
@@ -147,18 +149,31 @@ def _read_only(a: np.ndarray) -> np.ndarray:
 
 @runtime_checkable
 class DefenderPolicy(Protocol):
-    """The plant side's decisions (see the module docstring).
+    """The plant side's decisions (see the module docstring): every member the loop and the
+    episode use. :class:`DefenderBase` implements the optional ones (no rotation, no hooks).
 
     Attributes
     ----------
     name : str
         The registry name (:data:`DEFENDERS`), or any label for a policy given as an object.
+    rotates : bool
+        The policy moves the loop to fresh groups (the episode's info then carries the rotation
+        fields, :func:`~encctl_gym.loop.rotation.rotation_info`).
+    tally : object or None
+        What the policy's group generation cost this episode
+        (:class:`~encctl_gym.loop.rotation.GenerationTally`), ``None`` when it generates nothing.
     """
 
     name: str
 
-    def group(self, params: AttackParams) -> Any:
-        """The group the loop runs on (its key length), for the environment's resolved ``params``."""
+    @property
+    def rotates(self) -> bool: ...
+
+    @property
+    def tally(self) -> Any: ...
+
+    def group(self, params: LoopSpec) -> Any:
+        """The group the loop runs on (its key length), for the loop's ``params``."""
         ...
 
     def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
@@ -170,22 +185,46 @@ class DefenderPolicy(Protocol):
         """The decision of the coming attack step: ``None`` (nothing) or a :class:`DefenderAction`."""
         ...
 
+    def on_new_group(self, group: Any) -> None:
+        """The loop moved to ``group`` (group rotation): what depends on the group follows it."""
+        ...
 
-class FixedDefender:
-    """The paper's defender (registry name ``"fixed"``): the configured key length, no checks and
-    no noise (:meth:`act` returns ``None``)."""
+    def close(self) -> None:
+        """Release what the policy holds (the environment's ``close``)."""
+        ...
 
-    name = "fixed"
 
-    def group(self, params: AttackParams) -> Any:
-        """:func:`~encctl_gym.loop.backend.loop_group` of ``params.key_length``."""
-        return loop_group(params.key_length)
+class DefenderBase:
+    """The defaults of :class:`DefenderPolicy`: the loop's own group (:meth:`LoopSpec.group`), no
+    decision, no rotation, nothing to follow or release. Subclass it and override what the
+    policy does."""
+
+    name = "base"
+    rotates = False
+    tally: Any = None
+
+    def group(self, params: LoopSpec) -> Any:
+        """The loop's group for its key length (:meth:`LoopSpec.group`)."""
+        return params.group()
 
     def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
         pass
 
     def act(self, view: PlantView) -> DefenderAction | None:
         return None
+
+    def on_new_group(self, group: Any) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
+class FixedDefender(DefenderBase):
+    """The paper's defender (registry name ``"fixed"``): the configured key length, no checks and
+    no noise (:meth:`act` returns ``None``)."""
+
+    name = "fixed"
 
     def __repr__(self) -> str:
         return "FixedDefender()"
@@ -222,11 +261,16 @@ def make_defender(spec: Any = None) -> DefenderPolicy:
         except KeyError:
             raise ParameterError(f"unknown defender {spec!r}; choose one of {', '.join(DEFENDERS)}") from None
     if isinstance(spec, type) or not isinstance(spec, DefenderPolicy):
+        missing = [k for k in _MEMBERS if not hasattr(spec, k)]
         raise ParameterError(
-            f"defender must be a name ({', '.join(DEFENDERS)}) or an object with name, group, reset and act, "
+            f"defender must be a name ({', '.join(DEFENDERS)}) or a DefenderPolicy (subclass DefenderBase), "
             f"got {format_value(spec)}"
+            + (f", which lacks {', '.join(missing)}" if missing and not isinstance(spec, type) else "")
         )
     return spec
+
+
+_MEMBERS = ("name", "rotates", "tally", "group", "reset", "act", "on_new_group", "close")
 
 
 def check_defender_action(action: Any, K: int, m: int) -> tuple[np.ndarray | None, bool]:

@@ -20,7 +20,7 @@ import numpy as np
 from .._validation import check_int, check_nonnegative
 from ..crypto.group import estimate_generation_seconds, modular_exponentiation_seconds
 from ..plant import as_plant
-from ..security.defense_design import DefenderCosts, DefenseDesign, design_defenses
+from ..security.defense_design import DefenderCosts, design_defenses
 from ..security.threat import ThreatModel
 from .backend import lqr_gain
 from .detection import Audit
@@ -58,12 +58,19 @@ def reference_defender_costs(n: int, m: int, *, local_control_seconds: float | N
     return DefenderCosts(n, m, modular_exponentiation_seconds, estimate_generation_seconds, local)
 
 
-def design_loop_defenses(
-    plant: Any, threat: ThreatModel, *, local_control_seconds: float | None = None, **options: Any
-) -> DefenseDesign:
+def design_loop_defenses(plant: Any, threat: ThreatModel, *, local_control_seconds: float | None = None, **options: Any) -> Any:
     """:func:`~encctl_gym.security.defense_design.design_defenses` with the reference machine's
     costs and the loop's LQR controller; ``options`` are its keywords (``rotate_every``,
-    ``audit_rate``, ``detection_delta``, ``sigma_d2``, ``cost_models``, ...)."""
+    ``audit_rate``, ``detection_delta``, ``sigma_d2``, ``cost_models``, ...); ``verify``
+    (``{"name", "params"}``) adds the check of
+    :func:`~encctl_gym.security.verification_design.design_verification`, measured."""
     p = as_plant(plant)
     costs = reference_defender_costs(p.n, p.m, local_control_seconds=local_control_seconds)
-    return design_defenses(p, threat, costs=costs, controller=-lqr_gain(p.A, p.B), **options)
+    verify = options.pop("verify", None)  # --verify (issue 33): the check priced per step
+    design = design_defenses(p, threat, costs=costs, controller=-lqr_gain(p.A, p.B), **options)
+    if verify is None:
+        return design
+    from ..security.verification_design import design_verification
+    from .verification import measure_check_seconds
+
+    return design_verification(design, costs, verify, check_seconds=measure_check_seconds(p.m, p.n))

@@ -24,19 +24,16 @@ of all (the environment's ``info["detected"]``).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from .._validation import check_int, check_nonnegative, check_positive
-from ..crypto.residue_table import residue_table
 from ..errors import ParameterError
-from .backend import loop_group, lqr_gain, table_limit
-from .defender import DEFENDERS, DefenderAction, PlantView
+from .backend import lqr_gain, table_limit
+from .defender import DEFENDERS, DefenderAction, DefenderBase, PlantView
 from .detection import Audit, ChiSquaredDetector, CusumDetector, check_audit_rate
-
-if TYPE_CHECKING:
-    from ..envs.config import AttackParams
+from .spec import LoopSpec
 
 __all__ = ["AuditDefender", "CusumDefender", "DetectorDefender", "NoiseDefender", "audit_tolerance"]
 
@@ -56,26 +53,27 @@ def audit_tolerance(Phi: np.ndarray, x: np.ndarray, delta: float, max_shift: int
     return e * (row[None, :] + col) / delta + n * e * e / (delta * delta)
 
 
-class _PlantSidePolicy:
+class _PlantSidePolicy(DefenderBase):
     """What every policy here shares: the plant's matrices and controller from ``group``."""
 
     name = "plant-side"
 
-    def group(self, params: AttackParams) -> Any:
+    def group(self, params: LoopSpec) -> Any:
         self.A = np.asarray(params.A, dtype=float)
         self.B = np.asarray(params.B, dtype=float)
         self.Phi = -lqr_gain(self.A, self.B)
         self.delta = float(params.delta)
         self.sigma_w2 = float(params.sigma_w2)
-        group = loop_group(params.key_length)
+        group = params.group()
+        self._rounding = params.encryption().rounding
         self._limit = table_limit(params, self.Phi)
-        self.max_shift = residue_table(group, self._limit).max_shift  # cached: the loop's own table
+        self.max_shift = self._rounding(group, self._limit).max_shift  # cached: the loop's own table
         return group
 
     def on_new_group(self, group: Any) -> None:
         """The loop moved to ``group`` (group rotation, :mod:`encctl_gym.loop.rotation`): the
         encoding's error bound takes that group's largest shift."""
-        self.max_shift = residue_table(group, self._limit).max_shift
+        self.max_shift = self._rounding(group, self._limit).max_shift
 
     def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
         self.K, self.rngs = K, rngs
@@ -233,7 +231,7 @@ class CusumDefender(_InnovationDefender):
 DEFENDERS.update({"noise": NoiseDefender, "audit": AuditDefender, "chi2": DetectorDefender, "cusum": CusumDefender})
 
 
-class CombinedDefender:
+class CombinedDefender(DefenderBase):
     """Several policies at once (registry name ``"all"``: ``{"name": "all", "policies": [...]}``;
     the config keys ``audit_probability`` and ``defense_noise_sigma2`` add theirs this way).
 
@@ -257,9 +255,14 @@ class CombinedDefender:
         if isinstance(policies, (str, bytes)) or not isinstance(policies, Sequence) or len(policies) == 0:
             raise ParameterError(f"policies must be a non-empty list of defender policies, got {policies!r}")
         self.policies = [make_defender(p) for p in policies]
-        self.rotates = any(getattr(p, "rotates", False) for p in self.policies)
+        self.rotates = any(p.rotates for p in self.policies)
 
-    def group(self, params: AttackParams) -> Any:
+    @property
+    def tally(self) -> Any:
+        """The first policy's group-generation tally (``None`` when none generates groups)."""
+        return next((p.tally for p in self.policies if p.tally is not None), None)
+
+    def group(self, params: LoopSpec) -> Any:
         groups = [p.group(params) for p in self.policies]
         return groups[0]
 
@@ -294,15 +297,11 @@ class CombinedDefender:
 
     def on_new_group(self, group: Any) -> None:
         for p in self.policies:
-            hook = getattr(p, "on_new_group", None)
-            if hook is not None:
-                hook(group)
+            p.on_new_group(group)
 
     def close(self) -> None:
         for p in self.policies:
-            close = getattr(p, "close", None)
-            if close is not None:
-                close()
+            p.close()
 
     def __repr__(self) -> str:
         return f"CombinedDefender({self.policies!r})"

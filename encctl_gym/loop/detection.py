@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import as_finite_array, check_int, check_nonnegative
+from .._validation import as_finite_array, check_int, check_nonnegative, check_probability
 from ..errors import ParameterError, ShapeError
 from ..security.defenses import chi2_threshold, cusum_threshold
 
@@ -35,11 +35,8 @@ __all__ = ["Audit", "ChiSquaredDetector", "CusumDetector", "check_audit_rate"]
 
 
 def check_audit_rate(rate: Any, name: str = "audit_rate") -> float:
-    """``rate`` as an audit probability in [0, 1]; the package's error names it otherwise."""
-    rate = check_nonnegative(name, rate)
-    if rate > 1:
-        raise ParameterError(f"{name} must lie in [0, 1], got {rate}")
-    return rate
+    """``rate`` as an audit probability in [0, 1] (:func:`~encctl_gym._validation.check_probability`)."""
+    return check_probability(name, rate)
 
 
 class Audit:

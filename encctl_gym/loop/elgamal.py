@@ -22,16 +22,15 @@ the period's public key.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any, cast
 
 import numpy as np
 
 from ..errors import ParameterError
-from .scheme import EncryptionScheme, make_scheme
-
-if TYPE_CHECKING:
-    from ..envs.config import AttackParams
+from .injection import ADD, REPLACE, SCALE, scale_gain, scale_multipliers
 from .output_feedback import controller_matrix
+from .scheme import EncryptionScheme, MalleableScheme, make_scheme
+from .spec import LoopSpec
 
 __all__ = ["ElGamalLoop", "party_random_sources"]
 
@@ -85,9 +84,7 @@ class ElGamalLoop:
     needs_key_length_group = True
     quantization = None
 
-    def __init__(self, params: AttackParams, group: Any) -> None:
-        from ..attacks.decipherer import make_decipherer
-
+    def __init__(self, params: LoopSpec, group: Any) -> None:
         self.params = params
         self.group = group
         #: the scheme's object (:class:`~encctl_gym.loop.scheme.EncryptionScheme`)
@@ -100,20 +97,28 @@ class ElGamalLoop:
         #: each party's random source (privileged: who holds which randomness), see :func:`party_random_sources`
         self.random_sources = party_random_sources(params.crypto_seed)
         #: how the adversary obtains the secret of each period's key (:mod:`encctl_gym.attacks.decipherer`)
-        self.decipherer = make_decipherer(
-            params.breaker,
-            group,
-            lambda: self.encryption.oracle_secret(self.plant),
-            scheme=self.encryption,
-            adversary=params.adversary,
-            time_limit=params.breaker_time_limit,
-            rng=self.random_sources["breaker"],
-            precomputation=params.breaker_precomputation,
-        )
+        self.decipherer = self.decipherer_for(group, params.breaker_precomputation)
         self.plant: Any = None
         self.server: Any = None
         self.last_state_ciphertexts: list[Any] | None = None
         self.last_output_ciphertexts: Any = None
+
+    def decipherer_for(self, group: Any, precomputation: Any = None) -> Any:
+        """The adversary's decipherer in ``group`` (:func:`~encctl_gym.attacks.decipherer.make_decipherer`):
+        the configured breaker, or the oracle reading the plant's secret of each public key."""
+        from ..attacks.decipherer import make_decipherer
+
+        p = self.params
+        return make_decipherer(
+            p.breaker,
+            group,
+            lambda pk: self.encryption.oracle_secret(self.plant, pk),
+            scheme=self.encryption,
+            adversary=p.adversary,
+            time_limit=p.breaker_time_limit,
+            rng=self.random_sources["breaker"],
+            precomputation=precomputation,
+        )
 
     def start_episode(self) -> None:
         """Fresh keys (KeyGen) and Phi encrypted under ``pk_0``; the server of the scheme is set up."""
@@ -122,9 +127,7 @@ class ElGamalLoop:
 
     def provision(self) -> None:
         """KeyGen in the loop's group and the server of the scheme set up with ``Enc(pk_0, Ecd(Phi))``."""
-        from ..crypto.quantized import QuantizedLinearController
-
-        quant = QuantizedLinearController(self.Phi, self.encoder, self.params.x_bound)
+        quant = self.encryption.quantization(self.Phi, self.encoder, self.params.x_bound)
         self.plant, self.server = self.encryption.parties(quant, self.random_sources["plant"], self.random_sources["server"])
 
     def rotate_group(self, group: Any) -> Any:
@@ -166,9 +169,32 @@ class ElGamalLoop:
 
     def inject(self, a: np.ndarray) -> np.ndarray:
         """The adversary forges the input ciphertexts from public keys only; the plant decrypts."""
-        out = self.encryption.forge(self.plant, self._single(a), self.encoder, self.n, self.random_sources["adversary"])
+        return self.period_input(a, None, REPLACE)
+
+    def period_input(self, a: np.ndarray, x: np.ndarray | None, injection: int) -> np.ndarray:
+        """The input the plant decrypts this period under the injection mode (:mod:`~.injection`):
+        the scheme's forgery of ``a`` (``REPLACE``, from public keys only), or the server's
+        evaluation of ``Enc(x)`` (eq:ec) with ``a`` added by the scheme's :meth:`add` (``ADD``, with
+        the keys the decipherer has broken), its rows scaled by the scheme's :meth:`scale` (``SCALE``,
+        no key) or passed on (``PASS``). No key update (:meth:`tick`)."""
+        scheme = self.encryption
+        if injection == REPLACE:
+            out = scheme.forge(self.plant, self._single(a), self.encoder, self.n, self.random_sources["adversary"])
+        else:
+            if x is None:
+                raise ParameterError("the honest evaluation of this period needs the plant's state x")
+            out = scheme.evaluate(self.server, scheme.encrypt_state(self.plant, self._single(x)))
+            if injection == ADD:
+                out = scheme.add(
+                    self.plant, out, self._single(a), self.encoder, self.decipherer.secret, self.random_sources["adversary"]
+                )
+            elif injection == SCALE:  # no key: the multiplicative homomorphism on the output
+                c = scale_multipliers(self._single(a).tolist(), scale_gain(self.group))
+                out = cast(MalleableScheme, scheme).scale(
+                    self.plant, out, c, self.encoder, self.n, self.random_sources["adversary"]
+                )
         self.last_output_ciphertexts = out
-        return np.asarray(self.encryption.decrypt_output(self.plant, out))[None]
+        return np.asarray(scheme.decrypt_output(self.plant, out))[None]
 
     def tick(self) -> None:
         """The scheme's key update at the end of the period (none for static keys); a token the

@@ -11,18 +11,17 @@ copies; the environment's compiled step runs its per-period arithmetic itself fr
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from .._validation import format_value
 from ..errors import EncodingOverflowError, ResourceLimitError
 from .backend import table_limit
+from .injection import ADD, REPLACE, SCALE, added_row, scale_gain, scale_multipliers
 from .output_feedback import controller_matrix
 from .quantize import OK, Quantization, collect_states, forge_inputs
-
-if TYPE_CHECKING:
-    from ..envs.config import AttackParams
+from .spec import LoopSpec
 
 __all__ = ["IdealLoop", "MAX_TABLE_LIMIT"]
 
@@ -38,10 +37,10 @@ class IdealLoop:
 
     Parameters
     ----------
-    params : AttackParams
+    params : LoopSpec
         The environment's resolved parameters (A, B, Delta, x_bound, u_max).
     group : GroupParams
-        The group whose order-q subgroup the encoder maps to (:func:`~encctl_gym.loop.backend.loop_group`).
+        The group whose order-q subgroup the encoder maps to (the scheme's public parameters, :meth:`~encctl_gym.loop.spec.LoopSpec.group`).
     """
 
     batched = True
@@ -50,19 +49,19 @@ class IdealLoop:
     #: nothing is broken: the time charged is the cost model's
     deciphering_seconds = 0.0
 
-    def __init__(self, params: AttackParams, group: Any) -> None:
+    def __init__(self, params: LoopSpec, group: Any) -> None:
 
         self.delta = float(params.delta)
         self.x_bound = float(params.x_bound)
         self.Phi = controller_matrix(params)  # -K_lqr on x, or the output controller on [x_c; y]
         self.n, self.m = self.Phi.shape[1], params.m  # n: the controller's input xi (x, y or [x_c; y])
         self._params = params
+        self._scheme = params.encryption()  # its encoder's rounding and plaintexts
+        self._encoder: Any = None  # the scheme's encoder, built when an addition needs it
         self.use_group(group)
 
     def use_group(self, group: Any) -> None:
         """The quantisation of ``group`` (its residue table, ``Ecd(Phi)``, ``Ecd(1)``, ``Ecd(0)``)."""
-        from ..crypto.residue_table import residue_table
-
         params = self._params
         self.group = group
         limit = table_limit(params, self.Phi)
@@ -74,13 +73,14 @@ class IdealLoop:
                 "use a smaller x_bound or delta"
             )
         try:
-            self.table = residue_table(group, limit)
+            self.table = self._scheme.rounding(group, limit)
         except ResourceLimitError as exc:
             raise ResourceLimitError(
                 f"the quantisation table for x_bound = {params.x_bound}, Delta = {params.delta}, u_max = "
                 f"{params.u_max:.4g} is too large ({exc}); use a smaller x_bound or delta"
             ) from None
         self.Phi_int = self.encode_int(self.Phi)
+        self._encoder = None
         self.quantization = Quantization(
             delta=self.delta,
             offsets=self.table.offsets,
@@ -137,6 +137,39 @@ class IdealLoop:
         out = np.empty_like(a)
         forge_inputs(self._quant, a, np.empty(a.shape, dtype=np.int64), out)
         return out
+
+    def period_input(self, a: np.ndarray, x: np.ndarray, injection: int) -> np.ndarray:
+        """The input the plant decodes this period under the injection mode (:mod:`~.injection`):
+        :meth:`inject` (``REPLACE``), the controller's products of ``x`` (eq:ec) with ``a`` added
+        by :func:`~encctl_gym.loop.injection.added_row` (``ADD``), or passed on (``PASS``): the
+        same integers the ElGamal backend decrypts, so the same floats."""
+        if injection == REPLACE:
+            return self.inject(a)
+        if not (np.abs(x) <= self.x_bound).all():
+            raise self._overflow(x)
+        products = self.Phi_int[None] * self.encode_int(x)[:, None, :]  # (K, m, n), int64 (|.| < 2^48)
+        if injection == SCALE:
+            return self._scaled(products.sum(-1), a)
+        if injection != ADD:
+            return products.sum(-1) / (self.delta * self.delta)
+        if self._encoder is None:
+            self._encoder = self._scheme.encoder(self.group, self.delta)
+        scheme, enc, one = self._scheme, self._encoder, int(self.encode_int(np.array(1.0)))
+        d2 = int(self.delta) ** 2
+        u = np.empty((products.shape[0], self.m))
+        for k, rows in enumerate(products.tolist()):
+            for i, row in enumerate(rows):
+                added = added_row(row, float(a[k, i]), self.delta, one, lambda v: scheme.nearest_plaintext(enc, v))
+                u[k, i] = sum(added) / d2
+        return u
+
+    def _scaled(self, sums: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """``SCALE``: row ``i`` of the honest sums times ``c_i`` (:func:`~.injection.scale_multipliers`),
+        the forged 0 (:meth:`inject`) where ``c_i = 0``; the integers the ElGamal plant decrypts."""
+        gain = scale_gain(self.group)
+        c = np.array([scale_multipliers(row, gain) for row in np.asarray(a, dtype=float)], dtype=np.int64)
+        u = (c * sums) / (self.delta * self.delta)
+        return np.where(c == 0, self.inject(np.zeros_like(u)), u)
 
     def tick(self) -> None:
         pass

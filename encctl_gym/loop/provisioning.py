@@ -123,23 +123,14 @@ def rotate_elgamal_loop(loop: Any, group: GroupParams) -> ProvisioningCost:
     """Move an :class:`~encctl_gym.loop.elgamal.ElGamalLoop` to ``group``: a new encoder, the
     adversary's decipherer for the group, KeyGen and ``Enc(pk_0', Ecd(Phi))`` to a new server
     (``loop.provision()``); returns what was sent, counted on the server's ciphertexts."""
-    from ..attacks.decipherer import make_decipherer
-
     t0 = time.perf_counter()
     if not isinstance(loop.decipherer, GroupDecipherers):
         loop.decipherer = GroupDecipherers(
             loop.decipherer,
             loop.group,
-            lambda g: make_decipherer(
-                loop.params.breaker,
-                g,
-                lambda: loop.encryption.oracle_secret(loop.plant),
-                scheme=loop.encryption,
-                adversary=loop.params.adversary,
-                time_limit=loop.params.breaker_time_limit,
-                rng=loop.random_sources["breaker"],
-                precomputation=None,  # a saved precomputation belongs to the first group: a new group is precomputed afresh
-            ),
+            lambda g: loop.decipherer_for(
+                g
+            ),  # a saved precomputation belongs to the first group: a new group is precomputed afresh
         )
     loop.group = group
     loop.encoder = loop.encryption.encoder(group, float(loop.params.delta))

@@ -43,10 +43,24 @@ from ..crypto.group import GroupParams, estimate_generation_seconds, generate_sa
 from ..crypto.group.generation import DEFAULT_MAX_GENERATION_SECONDS
 from ..errors import ParameterError, ResourceLimitError
 from ..security.rotation import check_rotation_period
-from .defender import DEFENDERS, DefenderAction, DefenderPolicy, PlantView, make_defender
+from .defender import DEFENDERS, DefenderAction, DefenderBase, DefenderPolicy, PlantView, make_defender
 from .provisioning import GroupDecipherers, RotationRecord
 
-__all__ = ["GroupPool", "GenerationTally", "RotatingDefender", "defender_for", "check_new_group", "move_loop", "rotation_info"]
+__all__ = ["GroupPool", "GenerationTally", "RotatingDefender", "move_loop", "rotation_info", "MAX_AHEAD", "check_ahead"]
+
+#: Most groups a :class:`GroupPool` generates ahead. The worker makes one group at a time and the
+#: episode takes one every ``K`` steps, so a deeper pool only starts sooner: 16 covers a rotation
+#: at every step for 16 steps of generation lag. Each prefetched group draws a seed and queues a
+#: generation at ``reset`` (1000 ahead: a 3.4 s reset at 64 bits; 10**400 never returned).
+MAX_AHEAD = 16
+
+
+def check_ahead(name: str, ahead: Any) -> int:
+    """``ahead`` as an int in ``[0, MAX_AHEAD]``, else a :class:`ParameterError` naming it."""
+    try:
+        return check_int(name, ahead, minimum=0, maximum=MAX_AHEAD)
+    except ParameterError as exc:
+        raise ParameterError(f"{exc} (groups generated ahead of the one taken: MAX_AHEAD)") from None
 
 
 def _generate(bits: int, seed: int, max_seconds: float) -> tuple[GroupParams, float]:
@@ -69,7 +83,8 @@ class GroupPool:
     source : RandomSource
         Where the seeds come from (the plant's group stream, :class:`RotatingDefender`).
     ahead : int, default 2
-        Groups generated ahead of the one taken (0: generate when asked, on the caller's thread's time).
+        Groups generated ahead of the one taken (0: generate when asked, on the caller's thread's
+        time), at most :data:`MAX_AHEAD`.
     max_seconds : float
         Limit on the expected generation time of one group
         (:func:`~encctl_gym.crypto.group.estimate_generation_seconds`, the package's time model).
@@ -83,13 +98,15 @@ class GroupPool:
 
     Raises
     ------
+    ParameterError
+        If ``ahead`` is not an integer in ``[0, MAX_AHEAD]``.
     ResourceLimitError
         If the time model expects a group of ``bits`` to take more than ``max_seconds``.
     """
 
     def __init__(self, bits: int, source: Any, ahead: int = 2, max_seconds: float = DEFAULT_MAX_GENERATION_SECONDS) -> None:
         self.bits = check_int("bits", bits, minimum=16)
-        self.ahead = check_int("ahead", ahead, minimum=0)
+        self.ahead = check_ahead("ahead", ahead)
         self.max_seconds = float(max_seconds)
         self.model_seconds = estimate_generation_seconds(self.bits)
         if self.model_seconds > self.max_seconds:
@@ -175,7 +192,7 @@ class GenerationTally:
     indices: list[int] = field(default_factory=list)
 
 
-class RotatingDefender:
+class RotatingDefender(DefenderBase):
     """Moves the loop to a fresh group every ``every`` attack steps (registry name ``"rotate"``).
 
     Parameters
@@ -185,10 +202,10 @@ class RotatingDefender:
         so samples ``x_{jK} .. x_{(j+1)K - 1}`` lie in group ``j``.
     inner : defender spec, optional
         Another policy composed with the rotation (its noise and alarm pass through; it picks
-        the first group, and its ``on_new_group(group)``, if it has one, is called at every move):
+        the first group, and its ``on_new_group(group)`` is called at every move):
         a name of ``DEFENDERS``, a mapping or a policy object. Default ``"fixed"``.
     ahead : int, default 2
-        Groups the pool generates ahead.
+        Groups the pool generates ahead, at most :data:`MAX_AHEAD`.
     """
 
     name = "rotate"
@@ -199,7 +216,7 @@ class RotatingDefender:
         if isinstance(inner, RotatingDefender):
             raise ParameterError("a rotating defender cannot wrap another rotating defender")
         self.inner: DefenderPolicy = make_defender(inner)
-        self.ahead = check_int("ahead", ahead, minimum=0)
+        self.ahead = check_ahead("ahead", ahead)
         self.pool: GroupPool | None = None
         self.initial_group: GroupParams | None = None
         self.tally = GenerationTally()
@@ -240,79 +257,22 @@ class RotatingDefender:
         t.model_seconds += self.pool.model_seconds
         t.waited += waited
         self._next += 1
-        hook = getattr(self.inner, "on_new_group", None)
-        if hook is not None:  # e.g. the audit's error bound follows the new group's encoding
-            hook(group)
+        self.inner.on_new_group(group)  # e.g. the audit's error bound follows the new group's encoding
         if action is None:
             return DefenderAction(new_group=group)
         return DefenderAction(input_noise=action.input_noise, end=action.end, new_group=group)
 
     def close(self) -> None:
-        """Stop the pool's worker (the environment's ``close``); the inner policy's too, if it has one."""
+        """Stop the pool's worker (the environment's ``close``); the inner policy's too."""
         if self.pool is not None:
             self.pool.close()
-        inner_close = getattr(self.inner, "close", None)
-        if inner_close is not None:
-            inner_close()
+        self.inner.close()
 
     def __repr__(self) -> str:
         return f"RotatingDefender(every={self.every!r}, inner={self.inner!r})"
 
 
 DEFENDERS["rotate"] = RotatingDefender
-
-
-def defender_for(params: Any) -> DefenderPolicy:
-    """The defender of an environment's parameters: the policy ``params.defender`` names, with an
-    :class:`~encctl_gym.loop.defenses.AuditDefender` for ``params.audit_probability`` and a
-    :class:`~encctl_gym.loop.defenses.NoiseDefender` for ``params.defense_noise_sigma2`` added
-    (a :class:`~encctl_gym.loop.defenses.CombinedDefender` when there is more than one), wrapped in
-    a :class:`RotatingDefender` when ``params.rotate_group_every`` is set.
-
-    Raises
-    ------
-    ParameterError
-        For ``rotate_group_every`` together with a defender that rotates already.
-    """
-    from .defenses import AuditDefender, CombinedDefender, NoiseDefender
-
-    policy = make_defender(params.defender)
-    levers: list[DefenderPolicy] = []
-    audit_p = getattr(params, "audit_probability", None)
-    if audit_p is not None:
-        levers.append(AuditDefender(rate=audit_p))
-    noise_d2 = getattr(params, "defense_noise_sigma2", None)
-    if noise_d2 is not None:
-        levers.append(NoiseDefender(sigma_d2=noise_d2))
-    if levers:
-        keep = [] if getattr(policy, "name", None) == "fixed" else [policy]
-        policy = levers[0] if len(keep + levers) == 1 else CombinedDefender(keep + levers)
-    every = getattr(params, "rotate_group_every", None)
-    if every is None:
-        return policy
-    if getattr(policy, "rotates", False):
-        raise ParameterError(
-            f"rotate_group_every = {format_value(every)} and the defender {format_value(policy)}, which rotates "
-            "already: give one of them"
-        )
-    return RotatingDefender(every, inner=policy)
-
-
-def check_new_group(group: Any, current: Any) -> GroupParams:
-    """A defender's ``new_group``, checked: a verified safe-prime group of the current group's size.
-
-    Raises
-    ------
-    ParameterError
-        For anything else (the message names the value).
-    """
-    if not isinstance(group, GroupParams) or not group.is_safe_prime:
-        raise ParameterError(f"DefenderAction.new_group must be a safe-prime GroupParams, got {format_value(group)}")
-    if current is not None and group.bits != current.bits:
-        raise ParameterError(
-            f"DefenderAction.new_group must have the loop's size, {current.bits} bits, got a group of {group.bits} bits"
-        )
-    return group.verify()
 
 
 def move_loop(loop: Any, stepper: Any, group: Any) -> Any:
@@ -343,9 +303,9 @@ def rotation_info(record: RotationRecord, defender: Any, loop: Any, breaker: boo
     (the time model's), ``group_wait_seconds`` (what the control path waited for the pool) and,
     with a breaker, ``breaker_precomputations`` (the precomputations it ran this episode).
     """
-    if not (getattr(defender, "rotates", False) or record.rotations):
+    if not (defender.rotates or record.rotations):
         return {}
-    tally = getattr(defender, "tally", None)
+    tally = defender.tally
     info: dict[str, Any] = {
         "groups": record.rotations + 1,
         "group_rotations": record.rotations,

@@ -9,7 +9,7 @@ Two agents act at every attack step, simultaneously:
   pass the controller's input through (the period runs the encrypted controller of eq:ec; no
   energy is spent, no audit can catch the step, and its regression column is closed-loop data).
 * ``"defender"``, the plant side: ``Box(-1, 1, (len(LEVERS),))``, one entry per lever of
-  :data:`~encctl_gym.multiagent.levers.LEVERS` (audit, input noise, group rotation), and an observation of the
+  :data:`~encctl_gym.multiagent.levers.LEVERS` (audit, input noise, group rotation, verification), and an observation of the
   plant side's own data only (:class:`~encctl_gym.multiagent.levers.DefenderLevers`).
 
 The game runs the same :class:`~encctl_gym.envs.episode.EpisodeCore` as the single environment;
@@ -49,11 +49,11 @@ from gymnasium.utils import seeding
 from pettingzoo import ParallelEnv
 
 from .._validation import as_finite_array, format_value
+from ..envs.builder import build_episode
 from ..envs.config import AttackParams, resolve_params
 from ..envs.encrypted_lti_attack import RESET_OPTIONS, check_seed
-from ..envs.episode import EpisodeCore, EpisodeSchedule, attack_design_for, check_episode_memory
+from ..envs.episode import EpisodeSchedule
 from ..errors import ParameterError
-from ..loop import make_loop
 from .clock import GroupClock
 from .levers import LEVERS, DefenderLevers, GameRules
 
@@ -99,36 +99,20 @@ class EncryptedControlGame(ParallelEnv):
         schedule: EpisodeSchedule | None = None,
         **overrides: Any,
     ) -> None:
-        self.params: AttackParams = resolve_params(config, **overrides)
-        p = self.params
-        if p.defender != "fixed":
-            raise ParameterError(
-                f"the game's defender is its 'defender' agent; leave the configuration's defender at 'fixed', got {format_value(p.defender)}"
-            )
-        for key in ("audit_probability", "defense_noise_sigma2"):
-            if getattr(p, key) is not None:
-                raise ParameterError(
-                    f"{key} = {format_value(getattr(p, key))} acts outside the game's defender; leave it None and use the game's levers"
-                )
-        if p.rotate_group_every is not None:
-            raise ParameterError(
-                f"rotate_group_every = {p.rotate_group_every} rotates outside the game's defender; leave it None and use the rotate lever"
-            )
-        if p.observe != "state":
-            raise ParameterError(
-                f"the game runs on states only (observe='state'); observe={format_value(p.observe)} is not supported: "
-                "the output episode has no defender seam"
-            )
-        p.warn_if_capped()
-        check_episode_memory(p, 1, schedule)
+        params = resolve_params(config, **overrides)
+        _check_game(params)
         self.rules = GameRules.of(rules)
-        self.levers = DefenderLevers(self.rules)
-        self._loop = make_loop(p, self.levers)
-        self.design = attack_design_for(p) if p.gamma_opt else None
-        self.episode = EpisodeCore(p, self._loop, self.design, schedule=schedule, defender=self.levers)
+        self.levers = DefenderLevers(self.rules, params.sigma_u2)
+        built = build_episode(params, defender=self.levers, schedule=schedule)
+        self.params: AttackParams = built.params
+        p = self.params
+        self._loop = built.loop
+        self.design = built.design
+        self.episode = built.core
         self.clock = GroupClock(p)  # the deciphering budget charged per group (multiagent.clock)
         self.possible_agents = list(AGENTS)
         self.agents: list[str] = []
+        self.render_mode: str | None = None  # PettingZoo's attribute (its wrappers read it); no rendering
         low, high = p.observation_bounds()
         x_hi, inf = high[: p.n], np.inf  # states within the encoder's range; decoded inputs and the statistic unbounded
         self._observation_spaces = {
@@ -191,7 +175,7 @@ class EncryptedControlGame(ParallelEnv):
         core, clock = self.episode, self.clock
         if clock.active and not clock.affords(self.levers.rotates_at(core.plant_view.step)):
             core.end_out_of_time()  # the budget cannot pay this step's sample in its group: the attack ends now
-        gains, terminated, truncated = core.step(a[:m], inject=bool(a[m] >= 0.0))
+        gains, terminated, truncated = core.step(a[:m], injection=None if a[m] >= 0.0 else "pass")
         clock.advance(core.collected, self.levers.rotated)
         gain, detected, cost = float(gains[0]), core.stopped, self.levers.cost()
         attacker = gain - self.rules.detection_penalty * float(detected)
@@ -237,6 +221,8 @@ class EncryptedControlGame(ParallelEnv):
             "detected": self.episode.stopped,
             "sigma_d2": lv.decision.sigma_d2,
             "rotations": lv.rotations,
+            "checks": lv.checks,
+            "verified": lv.verified,
         }
 
     def render(self) -> None:
@@ -246,3 +232,25 @@ class EncryptedControlGame(ParallelEnv):
     def close(self) -> None:
         """Stop the defender's group pool (its worker thread)."""
         self.levers.close()
+
+
+def _check_game(p: AttackParams) -> None:
+    """The game's refusals: its defender is the defender agent, on states."""
+    if p.defender != "fixed":
+        raise ParameterError(
+            f"the game's defender is its 'defender' agent; leave the configuration's defender at 'fixed', got {format_value(p.defender)}"
+        )
+    for key in ("audit_probability", "defense_noise_sigma2"):
+        if getattr(p, key) is not None:
+            raise ParameterError(
+                f"{key} = {format_value(getattr(p, key))} acts outside the game's defender; leave it None and use the game's levers"
+            )
+    if p.rotate_group_every is not None:
+        raise ParameterError(
+            f"rotate_group_every = {p.rotate_group_every} rotates outside the game's defender; leave it None and use the rotate lever"
+        )
+    if p.observe != "state":
+        raise ParameterError(
+            f"the game runs on states only (observe='state'); observe={format_value(p.observe)} is not supported: "
+            "the output episode has no defender seam"
+        )

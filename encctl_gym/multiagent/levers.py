@@ -27,6 +27,12 @@ The defender's action is a vector in ``[-1, 1]``, one entry per lever of :data:`
   the attacker's deciphering pays for it (its cost model charges per group: the game's
   :class:`~encctl_gym.multiagent.clock.GroupClock`). Each rotation costs
   :attr:`GameRules.rotation_cost`.
+* ``"verify"`` (> 0: verify): the keyed linear check of the input ``u_{k-1}`` the plant side
+  decrypted last step against the state ``x_{k-1}`` it encrypted
+  (:class:`~encctl_gym.loop.verification.LinearCheckDefender`, secret range
+  :attr:`GameRules.verify_secret_range`, its own spawned streams): a falsified input fails it
+  but with probability ``1 / R`` (never for one input), with no tolerance (unlike an audit), and
+  ends the attack; an honest one never fails. Each check costs :attr:`GameRules.verify_cost`.
 
 A new lever is one more name in :data:`LEVERS`, one more entry of the action, one more field
 of :class:`Decision`, and its cost in :meth:`DefenderLevers.cost`.
@@ -51,16 +57,18 @@ import numpy as np
 from .._validation import as_finite_array, check_bool, check_int, check_nonnegative, check_positive
 from ..crypto.group import GroupParams
 from ..errors import ParameterError
-from ..loop.defender import DefenderAction, PlantView
+from ..loop.defender import DefenderAction, DefenderStreams, PlantView
 from ..loop.defenses import _PlantSidePolicy, audit_tolerance
 from ..loop.detection import Audit, ChiSquaredDetector
-from ..loop.rotation import GenerationTally, GroupPool
+from ..loop.rotation import GenerationTally, GroupPool, check_ahead
+from ..loop.verification import LinearCheckDefender
 from ..security.defenses import noise_defense_price
+from ..security.verification import check_secret_range
 
 __all__ = ["LEVERS", "GameRules", "Decision", "DefenderLevers"]
 
 #: The defender's levers, in the order of its action's entries.
-LEVERS: tuple[str, ...] = ("audit", "noise", "rotate")
+LEVERS: tuple[str, ...] = ("audit", "noise", "rotate", "verify")
 
 
 @dataclass(frozen=True)
@@ -90,7 +98,12 @@ class GameRules:
     rotation_cost : float
         The defender's cost per group rotation.
     rotation_ahead : int
-        Groups the pool generates ahead (off the control path).
+        Groups the pool generates ahead (off the control path), at most
+        :data:`~encctl_gym.loop.rotation.MAX_AHEAD`.
+    verify_cost : float
+        The defender's cost per keyed linear check (the ``"verify"`` lever).
+    verify_secret_range : int
+        ``R`` of the check: a falsified step passes with probability at most ``1 / R``.
     rotation : bool
         The rotate lever is live; ``False`` ignores its entry (a defender without rotation; a
         fresh 712-bit group takes about 0.1 s to generate, which a learner that rotates at random
@@ -108,6 +121,8 @@ class GameRules:
     rotation_cost: float = 0.1
     rotation_ahead: int = 2
     rotation: bool = True
+    verify_cost: float = 0.001
+    verify_secret_range: int = 1 << 64
 
     def __post_init__(self) -> None:
         if self.audit_budget is not None:
@@ -123,8 +138,10 @@ class GameRules:
         if fa >= 1:
             raise ParameterError(f"false_alarm_rate must lie in (0, 1), got {self.false_alarm_rate}")
         check_nonnegative("rotation_cost", self.rotation_cost)
-        check_int("rotation_ahead", self.rotation_ahead, minimum=0)
+        check_ahead("rotation_ahead", self.rotation_ahead)
         check_bool("rotation", self.rotation)
+        check_nonnegative("verify_cost", self.verify_cost)
+        check_secret_range("verify_secret_range", self.verify_secret_range)
 
     @classmethod
     def of(cls, spec: Any) -> GameRules:
@@ -153,11 +170,14 @@ class Decision:
         Variance of the input noise this step.
     rotate : bool
         Move the loop to a fresh group before this step's period.
+    verify : bool
+        Run the keyed linear check on last step's decrypted input.
     """
 
     audit: bool = False
     sigma_d2: float = 0.0
     rotate: bool = False
+    verify: bool = False
 
 
 class DefenderLevers(_PlantSidePolicy):
@@ -167,12 +187,15 @@ class DefenderLevers(_PlantSidePolicy):
     ----------
     rules : GameRules
         Budgets, costs and the detector.
+    sigma_u2 : float
+        The attacker's input variance: the noise lever's ceiling when ``rules.noise_max`` is None.
     """
 
     name = "game"
 
-    def __init__(self, rules: GameRules) -> None:
+    def __init__(self, rules: GameRules, sigma_u2: float = 1.0) -> None:
         self.rules = rules
+        self.noise_max = float(sigma_u2) if rules.noise_max is None else float(rules.noise_max)
         self._decision = Decision()
 
     # ------------------------------------------------------------- the seam
@@ -180,7 +203,6 @@ class DefenderLevers(_PlantSidePolicy):
         group = super().group(params)
         self.n, self.m = self.B.shape
         self.horizon = int(params.horizon)
-        self.noise_max = float(params.sigma_u2) if self.rules.noise_max is None else float(self.rules.noise_max)
         price = noise_defense_price(self.A, self.B, self.Phi, sigma_w2=self.sigma_w2, sigma_d2=1.0)
         self.unit_noise_price = price["cost_increase"] / price["cost_base"]  # per unit sigma_d2 (linear)
         self.pool: GroupPool | None = None
@@ -191,6 +213,12 @@ class DefenderLevers(_PlantSidePolicy):
 
             source = party_random_sources(params.crypto_seed)["plant"].spawn("group-rotation")
             self.pool = GroupPool(group.bits, source, self.rules.rotation_ahead)
+        self._verifier: LinearCheckDefender | None = LinearCheckDefender(self.rules.verify_secret_range)
+        self._no_verifier = ""
+        try:
+            self._verifier.group(params)
+        except ParameterError as exc:  # an output loop, or a Delta too large: the lever is off
+            self._verifier, self._no_verifier = None, str(exc)
         return group
 
     def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
@@ -215,6 +243,10 @@ class DefenderLevers(_PlantSidePolicy):
             self.pool.prefetch(1)
         self.audited = False  # an audit ran at the last step
         self.caught = False
+        if self._verifier is not None:
+            self._verifier.reset(K, n, m, DefenderStreams(rngs))  # its own streams: the other levers' draws are unchanged
+        self.verified = False  # a check ran at the last step
+        self.checks = 0  # checks run this episode
 
     def decide(self, action: Any) -> Decision:
         """Decode the defender's action (one entry per lever of :data:`LEVERS`, in [-1, 1]) as
@@ -227,8 +259,10 @@ class DefenderLevers(_PlantSidePolicy):
         rotate = self.rules.rotation and bool(a[2] > 0.0)
         if rotate and self.pool is None:
             raise ParameterError("the rotate lever needs a loop on a safe-prime group (a shipped or generated one)")
+        if a[3] > 0.0 and self._verifier is None:
+            raise ParameterError(f"the verify lever is off for this loop: {self._no_verifier}")
         sigma_d2 = self.noise_max * float(np.clip(a[1], 0.0, 1.0))
-        self._decision = Decision(audit=bool(a[0] > 0.0), sigma_d2=sigma_d2, rotate=rotate)
+        self._decision = Decision(audit=bool(a[0] > 0.0), sigma_d2=sigma_d2, rotate=rotate, verify=bool(a[3] > 0.0))
         return self._decision
 
     def act(self, view: PlantView) -> DefenderAction | None:
@@ -242,6 +276,12 @@ class DefenderLevers(_PlantSidePolicy):
             tolerance = audit_tolerance(self.Phi, x_prev, self.delta, self.max_shift)
             self.caught = bool(self._audit.check(x_prev, view.last_input, tolerance).any())
             self.audits += 1
+        self.verified = dec.verify and x_prev is not None
+        if self.verified:
+            assert x_prev is not None
+            assert self._verifier is not None
+            self.caught = self._verifier.caught(x_prev, view.last_input) or self.caught
+            self.checks += 1
         noise = None
         if dec.sigma_d2 > 0.0:  # the draws of NoiseDefender
             noise = np.stack([rng.normal(scale=math.sqrt(dec.sigma_d2), size=self.m) for rng in self.rngs[: self.K]])
@@ -270,6 +310,8 @@ class DefenderLevers(_PlantSidePolicy):
         self._next_group += 1
         self.rotations += 1
         self.on_new_group(group)  # the audit's error bound follows the new group's encoding
+        if self._verifier is not None:
+            self._verifier.on_new_group(group)  # so does the check's encoding of Phi
         return group
 
     def close(self) -> None:
@@ -279,12 +321,13 @@ class DefenderLevers(_PlantSidePolicy):
 
     # ------------------------------------------------------------- the game's side
     def cost(self) -> float:
-        """The defender's cost of the last step: the audit run, the noise applied, the rotation."""
+        """The defender's cost of the last step: the audit run, the noise applied, the rotation, the check."""
         r = self.rules
         return (
             r.audit_cost * float(self.audited)
             + r.noise_weight * self.unit_noise_price * self._decision.sigma_d2
             + r.rotation_cost * float(self.rotated)
+            + r.verify_cost * float(self.verified)
         )
 
     @property

@@ -320,62 +320,18 @@ def optimal_attack_design(
     if solver is not None and not isinstance(solver, str):
         raise ParameterError(f"solver must be a cvxpy solver name, got {format_value(solver)}")
     n, m = B.shape
-    p = n + m
-    limit = SDP_MAX_DIMENSION if max_dimension is None else check_int("max_dimension", max_dimension, 2)
-    if p > limit:
-        secs, gb = sdp_estimate(p)
-        raise ResourceLimitError(
-            f"the A-optimal design SDP for n + m = {p} exceeds the limit n + m <= {limit}: estimated "
-            f"{secs:.3g} s and {gb:.3g} GB for one solve (time grows as (n+m)^4.75, memory as (n+m)^4); "
-            "raise max_dimension to attempt it"
-        )
-    import cvxpy as cp
-
+    _check_dimension(n + m, max_dimension)
     r = su / sw
-    # Normalised coordinates. Sigma_hat = Sigma / sigma_w2 depends on R only. We write
-    # Sigma_hat = L S L^T with L = blkdiag(chol(R Psi_u + Psi_w), sqrt(R) I), the Cholesky factor
-    # of the Gaussian design, so that the Gaussian attack is S = I and every scale is O(1):
-    #   stationarity  S_xx = H S H^T + Q,  H = Lx^-1 [A B] L,  Q = Lx^-1 Lx^-T
-    #   budget        tr(S_uu) <= m
-    #   objective     tr(Sigma_hat^-1) = tr(F S^-1 F^T),  F = L^-T  (via [[Y, F], [F^T, S]] >= 0).
-    psi_u, psi_w = controllability_gramian(A, B), noise_gramian(A)
-    Lx = np.linalg.cholesky(r * psi_u + psi_w)
-    sr = float(np.sqrt(r))
-    L = np.zeros((p, p))
-    L[:n, :n] = Lx
-    L[n:, n:] = sr * np.eye(m)
-    Lx_inv = np.linalg.inv(Lx)
-    H = Lx_inv @ np.hstack([A, B]) @ L
-    Q = Lx_inv @ Lx_inv.T
-    Q = 0.5 * (Q + Q.T)
-    F = np.linalg.inv(L).T
-    f_scale = float(np.sqrt(np.trace(F @ F.T)))  # objective of the Gaussian design is f_scale^2
-    F = F / f_scale
-    Y = cp.Variable((p, p), symmetric=True)
+    L, H, Q, F, P, psi_w = _normalised_coordinates(A, B, r)
+    kind = "closed_loop" if feedback else "open_loop"
+    S_value = _solve_design_program(H, Q, F, P, n, m, feedback, solver)
     if feedback:
-        S = cp.Variable((p, p), symmetric=True)
-        cons = [S[:n, :n] == H @ S @ H.T + Q, cp.trace(S[n:, n:]) <= m]
-        S_expr = S
-        kind = "closed_loop"
-    else:
-        Nv = cp.Variable((p, p), symmetric=True)
-        P = np.zeros((p, p))
-        P[:n, :n] = Lx_inv @ psi_w @ Lx_inv.T
-        P = 0.5 * (P + P.T)
-        cons = [Nv >> 0, Nv[:n, :n] == H @ Nv @ H.T, cp.trace(Nv[n:, n:]) <= m]
-        S_expr = Nv + P
-        kind = "open_loop"
-    lmi = cp.bmat([[Y, F], [F.T, S_expr]])
-    cons.append(0.5 * (lmi + lmi.T) >> 0)
-    prob = cp.Problem(cp.Minimize(cp.trace(Y)), cons)
-    _solve(prob, solver)
-    if feedback:
-        Sig_n = L @ np.asarray(S.value, dtype=float) @ L.T
+        Sig_n = L @ S_value @ L.T
         M_n = None
     else:
-        M_n = L @ np.asarray(Nv.value, dtype=float) @ L.T
+        M_n = L @ S_value @ L.T
         M_n = 0.5 * (M_n + M_n.T)
-        offset = np.zeros((p, p))
+        offset = np.zeros((n + m, n + m))
         offset[:n, :n] = psi_w
         Sig_n = M_n + offset
     if not np.all(np.isfinite(Sig_n)):
@@ -396,6 +352,80 @@ def optimal_attack_design(
         K, V = _policy(Mv[:n, :n], Mv[n:, :n], Mv[n:, n:])
         S_u = Mv[:n, :n]
     return AttackDesign(Sigma, K, V, trace_inv, su, sw, kind, S_u)
+
+
+def _check_dimension(p: int, max_dimension: int | None) -> None:
+    """Refuse an SDP of ``n + m = p`` above ``max_dimension`` (default :data:`SDP_MAX_DIMENSION`)
+    before the solve, with its estimated time and memory (:func:`sdp_estimate`)."""
+    limit = SDP_MAX_DIMENSION if max_dimension is None else check_int("max_dimension", max_dimension, 2)
+    if p > limit:
+        secs, gb = sdp_estimate(p)
+        raise ResourceLimitError(
+            f"the A-optimal design SDP for n + m = {p} exceeds the limit n + m <= {limit}: estimated "
+            f"{secs:.3g} s and {gb:.3g} GB for one solve (time grows as (n+m)^4.75, memory as (n+m)^4); "
+            "raise max_dimension to attempt it"
+        )
+
+
+def _normalised_coordinates(
+    A: np.ndarray, B: np.ndarray, r: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(L, H, Q, F, P, Psi_w)`` of the normalised program at ``R_sigma = r``.
+
+    ``Sigma_hat = Sigma / sigma_w2`` depends on ``r`` only. We write ``Sigma_hat = L S L^T`` with
+    ``L = blkdiag(chol(r Psi_u + Psi_w), sqrt(r) I)``, the Cholesky factor of the Gaussian
+    design, so that the Gaussian attack is ``S = I`` and every scale is O(1)::
+
+        stationarity  S_xx = H S H^T + Q,  H = Lx^-1 [A B] L,  Q = Lx^-1 Lx^-T
+        budget        tr(S_uu) <= m
+        objective     tr(Sigma_hat^-1) = tr(F S^-1 F^T),  F = L^-T  (via [[Y, F], [F^T, S]] >= 0).
+
+    ``F`` is scaled to unit Frobenius norm (the Gaussian design's objective is its square);
+    ``P = blkdiag(Lx^-1 Psi_w Lx^-T, 0)`` is the noise part of the open-loop ``S``.
+    """
+    n, m = B.shape
+    p = n + m
+    psi_u, psi_w = controllability_gramian(A, B), noise_gramian(A)
+    Lx = np.linalg.cholesky(r * psi_u + psi_w)
+    sr = float(np.sqrt(r))
+    L = np.zeros((p, p))
+    L[:n, :n] = Lx
+    L[n:, n:] = sr * np.eye(m)
+    Lx_inv = np.linalg.inv(Lx)
+    H = Lx_inv @ np.hstack([A, B]) @ L
+    Q = Lx_inv @ Lx_inv.T
+    Q = 0.5 * (Q + Q.T)
+    F = np.linalg.inv(L).T
+    f_scale = float(np.sqrt(np.trace(F @ F.T)))  # objective of the Gaussian design is f_scale^2
+    F = F / f_scale
+    P = np.zeros((p, p))
+    P[:n, :n] = Lx_inv @ psi_w @ Lx_inv.T
+    P = 0.5 * (P + P.T)
+    return L, H, Q, F, P, psi_w
+
+
+def _solve_design_program(
+    H: np.ndarray, Q: np.ndarray, F: np.ndarray, P: np.ndarray, n: int, m: int, feedback: bool, solver: str | None
+) -> np.ndarray:
+    """Solve the normalised SDP (:func:`_normalised_coordinates`); return ``S`` (closed loop) or
+    the input part ``N`` of ``S = N + P`` (open loop)."""
+    import cvxpy as cp
+
+    p = n + m
+    Y = cp.Variable((p, p), symmetric=True)
+    if feedback:
+        S = cp.Variable((p, p), symmetric=True)
+        cons = [S[:n, :n] == H @ S @ H.T + Q, cp.trace(S[n:, n:]) <= m]
+        S_expr = S
+    else:
+        S = cp.Variable((p, p), symmetric=True)
+        cons = [S >> 0, S[:n, :n] == H @ S @ H.T, cp.trace(S[n:, n:]) <= m]
+        S_expr = S + P
+    lmi = cp.bmat([[Y, F], [F.T, S_expr]])
+    cons.append(0.5 * (lmi + lmi.T) >> 0)
+    prob = cp.Problem(cp.Minimize(cp.trace(Y)), cons)
+    _solve(prob, solver)
+    return np.asarray(S.value, dtype=float)
 
 
 def gamma_opt(

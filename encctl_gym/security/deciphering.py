@@ -60,7 +60,7 @@ from .cost_models import DECIPHERING_MODELS, KeyBreakCost, PaperModel, check_sec
 from .exact import decimal_fraction, exact_number
 
 __all__ = [
-    "SCHEMES",
+    "KEY_HANDLINGS",
     "ADVERSARIES",
     "DECIPHERING_MODELS",
     "KeyBreakCost",
@@ -77,7 +77,8 @@ __all__ = [
     "check_security_parameter",
 ]
 
-SCHEMES: tuple[str, ...] = ("modified", "token", "static")
+#: The paper's key handlings (the module table); a scheme object answers for itself.
+KEY_HANDLINGS: tuple[str, ...] = ("modified", "token", "static")
 ADVERSARIES: tuple[str, ...] = ("eavesdropper", "server")
 
 
@@ -96,7 +97,7 @@ def independent_keys(scheme: str | KeyExposure = "modified", adversary: str = "e
     Parameters
     ----------
     scheme : str or KeyExposure
-        One of the paper's schemes :data:`SCHEMES` (the module table), or a scheme object that
+        One of the paper's schemes :data:`KEY_HANDLINGS` (the module table), or a scheme object that
         answers for itself (``scheme.independent_keys(adversary)``, the scheme seam of
         :mod:`encctl_gym.loop.scheme`).
     adversary : {"eavesdropper", "server"}
@@ -107,8 +108,8 @@ def independent_keys(scheme: str | KeyExposure = "modified", adversary: str = "e
         For an unknown scheme or adversary (named in the message).
     """
     exposure = not isinstance(scheme, (str, type)) and isinstance(scheme, KeyExposure)
-    if not exposure and (not isinstance(scheme, str) or scheme not in SCHEMES):
-        raise ParameterError(f"unknown scheme {format_value(scheme)}; expected one of {', '.join(SCHEMES)}")
+    if not exposure and (not isinstance(scheme, str) or scheme not in KEY_HANDLINGS):
+        raise ParameterError(f"unknown scheme {format_value(scheme)}; expected one of {', '.join(KEY_HANDLINGS)}")
     if not isinstance(adversary, str) or adversary not in ADVERSARIES:
         raise ParameterError(f"unknown adversary {format_value(adversary)}; expected one of {', '.join(ADVERSARIES)}")
     if exposure:

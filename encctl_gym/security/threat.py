@@ -127,6 +127,20 @@ class ThreatModel:
             raise ParameterError(f"this design needs {', '.join(missing)} in the threat model, which has none")
         return self
 
+    @classmethod
+    def of(cls, preset: Any, cost_model: Any = "paper") -> ThreatModel:
+        """The variances and design parameters of a preset (:class:`~encctl_gym.presets.SystemPreset`:
+        ``sigma_u2``, ``sigma_w2``, ``sigma_x2``, ``gamma_c``, ``tau_c``, ``upsilon``) under ``cost_model``."""
+        return cls(
+            sigma_u2=preset.sigma_u2,
+            sigma_w2=preset.sigma_w2,
+            sigma_x2=preset.sigma_x2,
+            gamma_c=preset.gamma_c,
+            tau_c=preset.tau_c,
+            upsilon=preset.upsilon,
+            cost_model=cost_model,
+        )
+
     def replace(self, **changes: Any) -> ThreatModel:
         """A copy with some fields changed (checked again)."""
         return dataclasses.replace(self, **changes)

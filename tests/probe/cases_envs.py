@@ -104,7 +104,7 @@ def _config_cases() -> list[Case]:
         "input_history": BAD["int0"] + explicit([10**9, 10**7, HUGE], "hang"),
         "gamma_opt": "bool",
         "crypto_seed": "seed?",
-        "deciphering_model": "name",
+        "deciphering_model": "name?",  # None: the scheme's baseline model
         "gnfs_correction": explicit(["bogus", NAN, -1.0, HUGE, 1e308, True, None]),
         "deciphering_clock": explicit(["bogus", 3, None, "MODEL"]),
         "bogus_key": explicit([1], "silent"),
