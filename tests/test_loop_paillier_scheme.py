@@ -1,0 +1,101 @@
+"""loop.paillier_scheme standalone: a period's round trip through the scheme's methods, forge and
+add from the public key alone, rotation, reveal with a broken key, the breaker it accepts."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from encctl_gym.cryptanalysis.factoring import Factorer
+from encctl_gym.cryptanalysis.paillier_keys import break_paillier_key
+from encctl_gym.crypto import arith
+from encctl_gym.errors import EncodingOverflowError, ParameterError
+from encctl_gym.loop import SCHEMES, EncryptionScheme, make_scheme
+from encctl_gym.loop.paillier_scheme import PaillierParameters, PaillierScheme
+
+PHI = np.array([[0.5, -1.25, 0.1], [2.0, 0.0, -0.7]])
+DELTA = 2.0**10
+
+
+def _setup(bits: int = 96, rotation_period: int | None = None, seed: int = 1):
+    scheme = PaillierScheme(rotation_period)
+    params = scheme.public_parameters(bits)
+    enc = scheme.encoder(params, DELTA)
+    quant = SimpleNamespace(Phi=PHI, x_bound=10.0, encoder=enc)
+    src = arith.seeded_random(seed)
+    plant, server = scheme.parties(quant, src.spawn("plant"), src.spawn("server"))
+    return scheme, params, enc, plant, server, src
+
+
+def _exact(x: np.ndarray) -> np.ndarray:
+    # the quantised computation in Z, decoded once with Delta^2 (independent of the scheme)
+    phi = [[round(DELTA * v) for v in row] for row in PHI.tolist()]
+    xb = [round(DELTA * v) for v in x.tolist()]
+    return np.array([sum(a * b for a, b in zip(row, xb)) / DELTA**2 for row in phi])
+
+
+def test_the_scheme_is_registered_and_built_by_name() -> None:
+    s = SCHEMES.build("paillier", rotation_period=3)
+    assert isinstance(s, PaillierScheme) and s.rotation_period == 3 and s.family == "factoring"
+    assert isinstance(make_scheme("paillier"), EncryptionScheme)  # the runtime protocol of the seam
+    assert "paper" in s.cost_models and s.baseline_model == "paper" and "ecm" in s.breakers
+
+
+def test_a_period_round_trips_through_the_schemes_methods() -> None:
+    scheme, _, _, plant, server, _ = _setup()
+    rnd = np.random.default_rng(2)
+    for _ in range(5):
+        x = rnd.uniform(-10, 10, 3)
+        out = scheme.evaluate(server, scheme.encrypt_state(plant, x))
+        assert len(out) == 2  # one ciphertext per row: the row sum is homomorphic
+        np.testing.assert_array_equal(scheme.decrypt_output(plant, out), _exact(x))
+        assert scheme.update_keys(plant, server) is None
+
+
+def test_forge_and_add_need_the_public_key_only() -> None:
+    scheme, _, enc, plant, server, src = _setup()
+    a = np.array([3.5, -1.25])
+    forged = scheme.forge(plant, a, enc, 3, src)
+    np.testing.assert_array_equal(scheme.decrypt_output(plant, forged), a)
+    x = np.array([1.0, 2.0, -3.0])
+    honest = scheme.evaluate(server, scheme.encrypt_state(plant, x))
+    added = scheme.add(plant, honest, a, enc, lambda pk: pytest.fail("add must not ask for a secret"), src)
+    np.testing.assert_array_equal(scheme.decrypt_output(plant, added), _exact(x) + a)
+
+
+def test_rotation_every_k_steps_gives_the_server_the_fresh_key() -> None:
+    scheme, _, _, plant, server, _ = _setup(rotation_period=2)
+    seen = []
+    for _ in range(4):
+        seen.append(plant.pk.n)
+        x = np.array([1.0, 0.0, -1.0])
+        np.testing.assert_array_equal(
+            scheme.decrypt_output(plant, scheme.evaluate(server, scheme.encrypt_state(plant, x))), _exact(x)
+        )
+        scheme.update_keys(plant, server)
+        assert server.pk.n == plant.pk.n
+    assert seen[0] == seen[1] != seen[2] == seen[3]
+    assert PaillierScheme(1).independent_keys("eavesdropper") and not PaillierScheme(2).independent_keys("eavesdropper")
+
+
+def test_a_broken_key_reveals_the_state() -> None:
+    scheme, params, enc, plant, _, src = _setup(bits=64)
+    factorer = scheme.breaker_for("ecm", "eavesdropper", arith.seeded_random(3))
+    assert isinstance(factorer, Factorer)
+    got = break_paillier_key(factorer, scheme.public_key(plant), rng=arith.seeded_random(4))
+    x = np.array([1.5, -2.25, 7.0])
+    cts = scheme.encrypt_state(plant, x)
+    assert [scheme.reveal(params, got.secret, ct, enc) for ct in cts] == x.tolist()
+    assert scheme.oracle_secret(plant).lam == got.secret.lam
+
+
+def test_bad_input_gets_the_packages_error() -> None:
+    with pytest.raises(ParameterError):
+        PaillierScheme().breaker_for("index-calculus", "eavesdropper", None)
+    with pytest.raises(ParameterError):
+        PaillierParameters(8)
+    with pytest.raises(EncodingOverflowError, match="too small"):
+        _setup(bits=20)
+    assert PaillierScheme().provisioning_bytes(PaillierParameters(64), 10) == 0
