@@ -1,0 +1,320 @@
+"""Verification of the server's output: the keyed linear check (any scheme, the multiplicative
+ElGamal loop's defender ``"linear-check"``) and the linearly homomorphic MAC of the additive
+Paillier scheme, with real integers and real ciphertexts (the bounds and the argument are in
+:mod:`encctl_gym.security.verification`).
+
+**The keyed linear check** (:class:`KeyedLinearCheck`, Freivalds' check over the integers). On the
+multiplicative scheme the server returns the products ``P_ij = E_ij X_j`` under encryption and the
+plant sums them after decryption (``Sum`` of eq:ec); on the additive one it returns the row sums.
+Either way the plant ends with the integers ``S_i`` it decodes with ``Delta^2``. The plant side
+keeps ``r`` (uniform in ``{1..R}^m``, never sent) and ``w = r^T E`` and accepts iff
+``r^T S = w^T X``: ``n + m`` integer products per step, no ciphertext, nothing sent, so the check
+reveals nothing to the server but its verdict (a failure ends the attack). It needs what the
+plant side has anyway: the state it encrypted and ``E`` (on ElGamal the decrypted products
+``P_ij / X_j`` show ``E`` to the plant whatever it holds).
+
+What the server could compute homomorphically instead (a tag row ``Enc(c)``, ``c ~ r^T E``,
+evaluated against ``Enc(X)`` like Phi's rows) would give the plant ``c_j X_j`` after decryption,
+which it can form from ``c`` and ``X`` in ``n`` products without the server: on this loop a
+server-side tag costs ``n`` decryptions more and checks nothing more.
+
+**The MAC** (:class:`PaillierMac`) is for a verifier that does not hold ``E``: the plant side keeps
+``alpha``, ``gamma``, ``delta = E gamma mod n`` (provisioned once) and a fresh ``beta_t`` per step;
+it sends ``Enc(alpha X_j + gamma_j)`` beside ``Enc(X_j)`` and ``Enc(beta_t)``; the server
+evaluates the tag rows with the same plaintext coefficients (:func:`evaluate_tags`).
+
+:class:`LinearCheckDefender` runs the keyed linear check in the environment: every attack step it
+checks the input the plant decoded last step against the state it encrypted then (the integers
+``S`` recovered exactly from the decoded input), and ends the attack at the first failure.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from .._validation import check_int, format_value
+from ..errors import ParameterError
+from ..security.verification import check_secret_range, linear_check_pass_bound, mac_pass_bound
+from .defender import DEFENDERS, DefenderAction, PlantView
+from .defenses import _PlantSidePolicy
+from .spec import LoopSpec
+
+__all__ = [
+    "KeyedLinearCheck",
+    "LinearCheckDefender",
+    "PaillierMac",
+    "evaluate_tags",
+    "uniform_below",
+    "row_sums_of",
+    "measure_check_seconds",
+]
+
+#: Integers below this are recovered exactly from their decoded double (``|S| < 2^52``).
+EXACT_SUM_LIMIT = 1 << 52
+
+
+def uniform_below(rng: Any, bound: int) -> int:
+    """A uniform integer in ``[0, bound)`` from ``rng`` (a NumPy generator, or anything with
+    ``below(bound)`` like :class:`~encctl_gym.crypto.arith.RandomSource`), by rejection of
+    uniform bit strings (unbiased for every ``bound``)."""
+    bound = check_int("bound", bound, minimum=1)
+    below = getattr(rng, "below", None)
+    if callable(below):
+        return int(below(bound))
+    bits = (bound - 1).bit_length()
+    if bits == 0:
+        return 0
+    nbytes = (bits + 7) // 8
+    mask = (1 << bits) - 1
+    while True:
+        v = int.from_bytes(rng.bytes(nbytes), "little") & mask
+        if v < bound:
+            return v
+
+
+class KeyedLinearCheck:
+    """Freivalds' check ``r^T S = (r^T E) X`` over the integers (module docstring).
+
+    Parameters
+    ----------
+    E : matrix of int, shape (m, n)
+        The signed integers of Phi (``QuantizedLinearController.phi_int``, ``Phi_bar`` of Paillier).
+    secret_range : int
+        ``R >= 2``: each ``r_i`` is uniform in ``{1, ..., R}``.
+    rng : numpy.random.Generator or RandomSource
+        The plant side's own stream.
+
+    Attributes
+    ----------
+    epsilon : float
+        The largest probability that a falsified step passes (:func:`~encctl_gym.security.verification.linear_check_pass_bound`).
+    """
+
+    def __init__(self, E: Any, secret_range: int, rng: Any) -> None:
+        rows = [[int(v) for v in row] for row in E]
+        if not rows or not rows[0] or any(len(r) != len(rows[0]) for r in rows):
+            raise ParameterError(f"E must be a non-empty rectangular integer matrix, got {format_value(E)}")
+        self.R = check_secret_range("secret_range", secret_range)
+        self.m, self.n = len(rows), len(rows[0])
+        self._r = [1 + uniform_below(rng, self.R) for _ in range(self.m)]
+        self.rekey(rows)
+        self.epsilon = linear_check_pass_bound(self.m, self.R)
+
+    def rekey(self, E: Any) -> None:
+        """``w = r^T E`` for a new encoding of Phi (a new group), the same ``r``."""
+        rows = [[int(v) for v in row] for row in E]
+        self._w = [sum(ri * row[j] for ri, row in zip(self._r, rows)) for j in range(self.n)]
+
+    def passes(self, sums: Sequence[int], X: Sequence[int]) -> bool:
+        """Whether the decrypted row sums ``S'`` agree with the encoded state ``X``: ``r^T S' = w^T X``.
+
+        Raises
+        ------
+        ParameterError
+            For sums or a state of another length.
+        """
+        if len(sums) != self.m or len(X) != self.n:
+            raise ParameterError(f"the check takes {self.m} row sums and {self.n} state integers, got {len(sums)} and {len(X)}")
+        lhs = sum(ri * int(s) for ri, s in zip(self._r, sums))
+        return lhs == sum(wj * int(x) for wj, x in zip(self._w, X))
+
+    def __repr__(self) -> str:
+        return f"KeyedLinearCheck(m={self.m}, n={self.n}, secret_range={self.R})"
+
+
+def row_sums_of(u: Any, delta: int) -> list[int]:
+    """The integers ``S`` a decoded input ``u = Dcd(S; Delta^2)`` came from: ``round(u Delta^2)``
+    in exact rational arithmetic (exact for ``|S| < 2^52``, where the decoder's one rounding to
+    a double loses less than half a unit)."""
+    d2 = int(delta) ** 2
+    return [round(Fraction(float(v)) * d2) for v in np.asarray(u, dtype=float).ravel()]
+
+
+class LinearCheckDefender(_PlantSidePolicy):
+    """The keyed linear check at every attack step (registry name ``"linear-check"``).
+
+    Before the period of step ``k`` it checks the input the plant decoded at step ``k - 1``
+    against the state ``x_{k-1}`` it encrypted then, each copy with its own ``r``; a failure in
+    any copy ends the attack (``info["detected"]``). The integers of the check are those of the
+    loop's own encoding (the scheme's quantization on the loop's group), so an honest server never
+    fails it, on either backend.
+
+    Parameters
+    ----------
+    secret_range : int, default 2**64
+        ``R``: a falsified step passes with probability at most ``1 / R`` (``m >= 2``), never
+        (``m = 1``).
+
+    Raises
+    ------
+    ParameterError
+        For ``R < 2``, a loop that sends outputs (the controller's input is then ``[x_c; y]``,
+        not the state the plant view holds), or an encoding whose row sums could reach ``2^52``.
+    """
+
+    name = "linear-check"
+
+    def __init__(self, secret_range: int = 1 << 64) -> None:
+        self.secret_range = check_secret_range("secret_range", secret_range)
+        self.checks = self.failures = 0
+
+    def group(self, params: LoopSpec) -> Any:
+        if params.observe != "state":
+            raise ParameterError(
+                f"the linear check verifies the state-feedback loop; observe = {params.observe!r} is not supported"
+            )
+        group = super().group(params)
+        self._params = params
+        self._quantize(group)
+        return group
+
+    def _quantize(self, group: Any) -> None:
+        scheme = self._params.encryption()
+        encoder = scheme.encoder(group, self.delta)
+        self.quantization = scheme.quantization(self.Phi, encoder, float(self._params.x_bound))
+        E = self.quantization.phi_int
+        x_max = int(round(self.delta * float(self._params.x_bound))) + int(self.max_shift) + 1
+        if max(sum(abs(int(v)) for v in row) for row in E) * x_max >= EXACT_SUM_LIMIT:
+            raise ParameterError(
+                f"the linear check recovers the row sums from the decoded input exactly only below 2^52; "
+                f"Delta = {self.delta:g} with x_bound = {self._params.x_bound:g} exceeds it"
+            )
+
+    def on_new_group(self, group: Any) -> None:
+        super().on_new_group(group)
+        self._quantize(group)
+        for check in getattr(self, "_checks", []):
+            check.rekey(self.quantization.phi_int)
+
+    def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
+        super().reset(K, n, m, rngs)
+        self._checks = [KeyedLinearCheck(self.quantization.phi_int, self.secret_range, rngs[i]) for i in range(K)]
+        self.checks = self.failures = 0
+
+    @property
+    def epsilon(self) -> float:
+        """The largest probability that one falsified step passes."""
+        return linear_check_pass_bound(self.B.shape[1], self.secret_range)
+
+    def caught(self, x_prev: np.ndarray, last_input: np.ndarray) -> bool:
+        """Check every copy's decoded input ``u_{k-1}`` against its state ``x_{k-1}``; whether any
+        failed (the game's ``"verify"`` lever calls it at the steps the defender asks for)."""
+        failed = False
+        for k, check in enumerate(self._checks):
+            X = self.quantization.encode_state(x_prev[k])
+            ok = check.passes(row_sums_of(last_input[k], int(self.delta)), X)
+            self.checks += 1
+            self.failures += not ok
+            failed = failed or not ok
+        return failed
+
+    def act(self, view: PlantView) -> DefenderAction | None:
+        x_prev, self._x_prev = self._x_prev, np.array(view.state, dtype=float)
+        if x_prev is None:
+            return None
+        return DefenderAction(end=True) if self.caught(x_prev, view.last_input) else None
+
+    def __repr__(self) -> str:
+        return f"LinearCheckDefender(secret_range={self.secret_range!r})"
+
+
+DEFENDERS.update({"linear-check": LinearCheckDefender})
+
+
+# ---------------------------------------------------------------------- the Paillier MAC
+class PaillierMac:
+    """The plant side of the linearly homomorphic MAC on Paillier's scheme (module docstring of
+    :mod:`encctl_gym.security.verification`).
+
+    Parameters
+    ----------
+    sk : PaillierSecretKey
+        The plant's key (the tags are under the loop's own key).
+    E : matrix of int, shape (m, n)
+        ``Phi_bar``; used once, for ``delta = E gamma mod n`` (the provisioning), then dropped.
+    alpha_range : int, optional
+        ``A``: ``alpha`` uniform in ``{1, ..., A}`` (default ``n - 1``: every unit-size residue).
+    rng : RandomSource or numpy.random.Generator
+        The plant side's stream (secrets and encryption randomness).
+    """
+
+    def __init__(self, sk: Any, E: Any, rng: Any, alpha_range: int | None = None) -> None:
+        self.sk, self.pk = sk, sk.public
+        n = self.pk.n
+        self.A = n - 1 if alpha_range is None else check_secret_range("alpha_range", alpha_range)
+        if self.A >= n:
+            raise ParameterError(f"alpha_range must be below the modulus n, got {format_value(self.A)}")
+        rows = [[int(v) for v in row] for row in E]
+        self.m, self.n = len(rows), len(rows[0])
+        self._rng = rng
+        self._alpha = 1 + uniform_below(rng, self.A)
+        self._gamma = [uniform_below(rng, n) for _ in range(self.n)]
+        self._delta = [sum(e * g for e, g in zip(row, self._gamma)) % n for row in rows]
+        self._beta: list[int] | None = None
+        self.epsilon = mac_pass_bound(self.A, self.pk.bits)
+
+    def tag_state(self, X: Sequence[int]) -> tuple[list[Any], list[Any]]:
+        """What the plant sends this step beside ``Enc(X_j)``: ``Enc(alpha X_j + gamma_j)`` and the
+        fresh ``Enc(beta_t,i)`` (``n + m`` encryptions); the step's ``beta_t`` replaces the last."""
+        from ..crypto.paillier import encrypt_with_secret
+
+        n = self.pk.n
+        if len(X) != self.n:
+            raise ParameterError(f"the MAC takes {self.n} state integers, got {len(X)}")
+        self._beta = [uniform_below(self._rng, n) for _ in range(self.m)]
+        tagged = [encrypt_with_secret(self.sk, (self._alpha * int(x) + g) % n, self._rng) for x, g in zip(X, self._gamma)]
+        masks = [encrypt_with_secret(self.sk, b, self._rng) for b in self._beta]
+        return tagged, masks
+
+    def passes(self, rows: Sequence[Any], tags: Sequence[Any]) -> bool:
+        """``Dec(tau_i) = alpha Dec(c_i) + delta_i + beta_t,i (mod n)`` for every row, with this
+        step's ``beta_t`` (``2 m`` decryptions); before any :meth:`tag_state` nothing passes."""
+        from ..crypto.paillier import decrypt
+
+        if self._beta is None or len(rows) != self.m or len(tags) != self.m:
+            return False
+        n = self.pk.n
+        for c, t, d, b in zip(rows, tags, self._delta, self._beta):
+            if decrypt(self.sk, t) != (self._alpha * decrypt(self.sk, c) + d + b) % n:
+                return False
+        return True
+
+    def __repr__(self) -> str:
+        return f"PaillierMac(m={self.m}, n={self.n}, alpha_range={self.A}, modulus_bits={self.pk.bits})"
+
+
+def evaluate_tags(E: Any, tagged: Sequence[Any], masks: Sequence[Any]) -> list[Any]:
+    """The server's tag rows ``tau_i = sum_j E_ij Enc(alpha X_j + gamma_j) + Enc(beta_t,i)``
+    (Paillier's Eval with the plaintext coefficients it holds; ``m n`` exponentiations)."""
+    out = []
+    for row, mask in zip(E, masks):
+        acc = mask
+        for e, ct in zip(row, tagged):
+            acc = acc + ct * int(e)
+        out.append(acc)
+    return out
+
+
+def measure_check_seconds(m: int, n: int, *, secret_range: int = 1 << 64, entry_bits: int = 24, repeats: int = 2000) -> float:
+    """The median time of one keyed linear check of an ``m x n`` controller whose integers have
+    ``entry_bits`` bits (the plant side's added work per step), in seconds."""
+    m = check_int("m", m, minimum=1)
+    n = check_int("n", n, minimum=1)
+    repeats = check_int("repeats", repeats, minimum=1, maximum=10**7)
+    rng = np.random.default_rng(0)
+    lim = 1 << check_int("entry_bits", entry_bits, minimum=1, maximum=4096)
+    E = [[uniform_below(rng, lim) for _ in range(n)] for _ in range(m)]
+    X = [uniform_below(rng, lim) for _ in range(n)]
+    S = [sum(e * x for e, x in zip(row, X)) for row in E]
+    check = KeyedLinearCheck(E, secret_range, rng)
+    times = np.empty(repeats)
+    for i in range(repeats):
+        t0 = time.perf_counter()
+        check.passes(S, X)
+        times[i] = time.perf_counter() - t0
+    return float(np.median(times))
