@@ -52,12 +52,26 @@ class ProgressCallback(BaseCallback):
         The requested training steps.
     desc : str
         Label of the bar.
+    status : callable, optional
+        ``status()`` -> str, shown after the bar's counts (tqdm's postfix) whenever it changes:
+        the stopping rule's state (:meth:`agents.stopping.OracleStopper.status`), since the bar
+        counts to a budget the rule may stop short of.
     """
 
-    def __init__(self, total: int, desc: str) -> None:
+    def __init__(self, total: int, desc: str, status: Callable[[], str] | None = None) -> None:
         super().__init__()
         self.total, self.desc = int(total), desc
+        self.status = status
         self.bar: Any = None
+        self._shown = ""
+
+    def _show_status(self) -> None:
+        if self.status is None:
+            return
+        text = self.status()
+        if text != self._shown:
+            self._shown = text
+            self.bar.set_postfix_str(text, refresh=False)
 
     def _on_training_start(self) -> None:
         from tqdm import tqdm
@@ -72,8 +86,10 @@ class ProgressCallback(BaseCallback):
             file=sys.stderr,
             ascii=not tty,
         )
+        self._show_status()
 
     def _on_step(self) -> bool:
+        self._show_status()
         self.bar.update(min(self.num_timesteps, self.total) - self.bar.n)
         return True
 
@@ -83,6 +99,7 @@ class ProgressCallback(BaseCallback):
         done = max(self.num_timesteps, self.bar.n)
         if done > self.bar.total:  # the last rollout ran past the request: say so, do not overshoot
             self.bar.total = done
+        self._show_status()
         self.bar.update(done - self.bar.n)
         self.bar.close()
 

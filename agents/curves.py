@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from encctl_gym._validation import format_count
 from encctl_gym.errors import ConfigError
 from encctl_gym.plotting import save_figure
 
@@ -220,9 +221,26 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
     ]
     if not cs:
         raise ConfigError("no learning curve to plot")
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    groups = list(dict.fromkeys((c.algo, c.system, c.design_kind) for c in cs))
     fig, ax = plt.subplots(figsize=(11.5, 4.8))
+    _draw_curves(ax, cs, names, plt.rcParams["axes.prop_cycle"].by_key()["color"])
+    _draw_references(ax, cs)
+    ax.set_xlabel("training steps")
+    _set_ratio_limits(ax, cs)
+    ax.set_ylabel("E[eps(N)] / gamma_opt(N)  (evaluation episodes)")
+    ax.set_title(title or "Learning curves: evaluation error over the optimum", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    fig.tight_layout()
+    path = Path(path)
+    save_figure(fig, path, dpi=110, tight=True)
+    plt.close(fig)
+    return path
+
+
+def _draw_curves(ax: Any, cs: Sequence[LearningCurve], names: Sequence[str | None], colors: Sequence[str]) -> None:
+    """One line (with its 95 % band) per curve: a colour per algorithm, system and design, a line
+    style per run within it."""
+    groups = list(dict.fromkeys((c.algo, c.system, c.design_kind) for c in cs))
     styles = ("-", "--", "-.", ":")
     for i, (c, name) in enumerate(zip(cs, names)):
         key = (c.algo, c.system, c.design_kind)
@@ -239,10 +257,15 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
             ms=3,
             lw=1.4,
             label=(f"{name}: " if name else "") + f"{c.algo}, {c.system}, {c.design_kind}, seed {c.seed} "
-            f"(N = {c.N}, {c.epsilon.shape[1]} episodes)",
+            f"(N = {c.N}, {format_count(c.epsilon.shape[1], 'episode')})",
         )
         if np.all(np.isfinite(lo)):
             ax.fill_between(c.timesteps, lo, hi, color=col, alpha=0.15, lw=0)
+
+
+def _draw_references(ax: Any, cs: Sequence[LearningCurve]) -> None:
+    """The horizontal references of each system: the paper's ``gamma(N)``, the Gaussian attack's
+    exact error, and 1 (the optimal design), all over ``gamma_opt(N)``."""
     for system in dict.fromkeys((c.system, c.design_kind, c.N) for c in cs):
         ref = next(c for c in cs if (c.system, c.design_kind, c.N) == system)
         ax.axhline(
@@ -260,7 +283,11 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
             label=f"{ref.system}, {ref.design_kind}: Gaussian attack, exact rate / gamma_opt(N)",
         )
     ax.axhline(1.0, color="k", lw=1.0, label="1: the optimal design (gamma_opt, same power)")
-    ax.set_xlabel("training steps")
+
+
+def _set_ratio_limits(ax: Any, cs: Sequence[LearningCurve]) -> None:
+    """The y range: near 1 with early evaluations far above it cut (said in the plot), or a log axis when
+    a curve's last evaluation would be cut away."""
     # the interesting range is near 1: a policy that starts at zero input (ARS) has an error many
     # orders above the optimum at first, and those points are cut at the top (said in the plot)
     refs = [c.gamma_gauss / c.gamma_opt for c in cs] + [c.gamma / c.gamma_opt for c in cs]
@@ -275,7 +302,7 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
         ax.text(
             0.5,
             0.98,
-            f"cut at {top:.2g}: early evaluations up to {peak:.3g}",
+            f"y axis cut at a ratio of {top:.2g} to the optimum: early evaluations reach {peak:.3g}",
             transform=ax.transAxes,
             fontsize=7,
             va="top",
@@ -284,15 +311,6 @@ def plot_learning_curves(curves: Sequence[LearningCurve | str | Path], path: str
     elif peak > top:
         ax.set_yscale("log")
         ax.set_ylim(low, 1.5 * peak)
-    ax.set_ylabel("E[eps(N)] / gamma_opt(N)  (evaluation episodes)")
-    ax.set_title(title or "Learning curves: evaluation error over the optimum", fontsize=10)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
-    fig.tight_layout()
-    path = Path(path)
-    save_figure(fig, path, dpi=110, tight=True)
-    plt.close(fig)
-    return path
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -64,7 +64,7 @@ def budget_config(config: dict[str, Any], N: int) -> dict[str, Any]:
         return cfg
     cfg.pop("max_samples", None)
     if cfg.get("key_length") is None:  # pin the key the configuration resolved to
-        if base.deciphering_model == "paper":
+        if base.deciphering_model == base.loop.encryption().baseline_model:
             cfg["security_parameter"] = base.security_parameter
         else:
             cfg.pop("security_parameter", None)
@@ -194,83 +194,19 @@ def rollout(
     -------
     Rollout
     """
-    from encctl_gym.envs import EncryptedLTIAttackEnv
-    from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
-
     episodes = check_int("episodes", episodes, minimum=1)
     cfg = dict(config)
     params = resolve_params(cfg)
     if (params.n, params.m, params.input_history) != (attacker.params.n, attacker.params.m, attacker.params.input_history):
         raise ParameterError("the attacker was built for a different observation layout than this environment")
     t0 = time.perf_counter()
-    eps_rows, en_rows, finals, powers, energies = [], [], [], [], []
-    d = params.n + params.m
-    gram, columns = np.zeros((d, d)), 0
-
-    def add_gram(core: Any, take: int) -> None:
-        nonlocal gram, columns
-        X, U = core.delivered_data()
-        Z = np.concatenate([X[:take, :-1], U[:take]], axis=2)
-        gram = gram + np.einsum("eti,etj->ij", Z, Z)
-        columns += Z.shape[0] * Z.shape[1]
-
-    N_steps: np.ndarray | None = None
+    tally = _Tally(params.n + params.m)
     if params.crypto == "ideal":
         B = min(episodes, 64) if batch is None else check_int("batch", batch, minimum=1)
-        env = EncryptedLTIAttackVectorEnv(B, config=cfg)
-        done_eps = 0
-        chunk = 0
-        while done_eps < episodes:
-            obs, info = env.reset(seed=seed + done_eps)
-            attacker.reset(seed=np.random.SeedSequence([seed, chunk]))
-            eps_t, en_t, Ns = [], [], []
-            while True:
-                obs, _, te, tr, info = env.step(attacker.act(obs))
-                if record:
-                    eps_t.append(info["epsilon"])
-                    en_t.append(info["input_energy"])
-                    Ns.append(int(info["samples_delivered"][0]))
-                if progress is not None:
-                    progress.update(B)
-                if te[0] or tr[0]:
-                    break
-            take = min(B, episodes - done_eps)
-            if covariance:
-                add_gram(env.episode, take)
-            eps_rows.append(np.stack(eps_t, axis=1)[:take] if record else info["epsilon"][:take, None])
-            en_rows.append(np.stack(en_t, axis=1)[:take] if record else info["input_energy"][:take, None])
-            if N_steps is None:
-                N_steps = np.array(Ns if record else [int(info["samples_delivered"][0])])
-            finals.append(info["epsilon"][:take])
-            powers.append(info["average_power"][:take])
-            energies.append(info["input_energy"][:take])
-            done_eps += take
-            chunk += 1
+        _play_batches(tally, attacker, cfg, B, episodes, seed, record=record, progress=progress, covariance=covariance)
     else:
-        env1 = EncryptedLTIAttackEnv(config=cfg)
-        for e in range(episodes):
-            obs, info = env1.reset(seed=seed + e)
-            attacker.reset(seed=np.random.SeedSequence([seed, e]))
-            eps_t, en_t, Ns = [], [], []
-            while True:
-                obs, _, te1, tr1, info = env1.step(attacker.act(obs))
-                if record:
-                    eps_t.append(info["epsilon"])
-                    en_t.append(info["input_energy"])
-                    Ns.append(info["samples_delivered"])
-                if progress is not None:
-                    progress.update(1)
-                if te1 or tr1:
-                    break
-            if covariance:
-                add_gram(env1.episode, 1)
-            eps_rows.append(np.array(eps_t if record else [info["epsilon"]])[None])
-            en_rows.append(np.array(en_t if record else [info["input_energy"]])[None])
-            if N_steps is None:
-                N_steps = np.array(Ns if record else [info["samples_delivered"]])
-            finals.append(np.array([info["epsilon"]]))
-            powers.append(np.array([info["average_power"]]))
-            energies.append(np.array([info["input_energy"]]))
+        _play_single(tally, attacker, cfg, episodes, seed, record=record, progress=progress, covariance=covariance)
+    N_steps = tally.N_steps
     assert N_steps is not None
     gamma = np.full(N_steps.shape, np.inf)
     ok = N_steps >= 2
@@ -278,16 +214,132 @@ def rollout(
     return Rollout(
         attacker=attacker.name,
         N=N_steps,
-        epsilon=np.concatenate(eps_rows, axis=0),
-        energy=np.concatenate(en_rows, axis=0),
-        final_epsilon=np.concatenate(finals),
-        average_power=np.concatenate(powers),
-        input_energy=np.concatenate(energies),
+        epsilon=np.concatenate(tally.eps_rows, axis=0),
+        energy=np.concatenate(tally.en_rows, axis=0),
+        final_epsilon=np.concatenate(tally.finals),
+        average_power=np.concatenate(tally.powers),
+        input_energy=np.concatenate(tally.energies),
         gamma=gamma,
         seconds=time.perf_counter() - t0,
         crypto=params.crypto,
-        covariance=gram / columns if covariance and columns else None,
+        covariance=tally.gram / tally.columns if covariance and tally.columns else None,
     )
+
+
+class _Tally:
+    """What :func:`rollout` collects episode by episode: the per-step rows, the final values
+    and the Gram matrix of the delivered regressors ``z_t = [x_t; u_t]``."""
+
+    def __init__(self, d: int) -> None:
+        self.eps_rows: list[np.ndarray] = []
+        self.en_rows: list[np.ndarray] = []
+        self.finals: list[np.ndarray] = []
+        self.powers: list[np.ndarray] = []
+        self.energies: list[np.ndarray] = []
+        self.gram = np.zeros((d, d))
+        self.columns = 0
+        self.N_steps: np.ndarray | None = None
+
+    def add_gram(self, core: Any, take: int) -> None:
+        """Add the first ``take`` copies' delivered data of an episode core."""
+        X, U = core.delivered_data()
+        Z = np.concatenate([X[:take, :-1], U[:take]], axis=2)
+        self.gram = self.gram + np.einsum("eti,etj->ij", Z, Z)
+        self.columns += Z.shape[0] * Z.shape[1]
+
+    def add_finals(self, info: dict[str, Any], take: int | None) -> None:
+        """The final error, average power and input energy (of the first ``take`` copies; None: one
+        copy of the single environment)."""
+        if take is None:
+            self.finals.append(np.array([info["epsilon"]]))
+            self.powers.append(np.array([info["average_power"]]))
+            self.energies.append(np.array([info["input_energy"]]))
+        else:
+            self.finals.append(info["epsilon"][:take])
+            self.powers.append(info["average_power"][:take])
+            self.energies.append(info["input_energy"][:take])
+
+
+def _play_batches(
+    tally: _Tally,
+    attacker: Attacker,
+    cfg: dict[str, Any],
+    B: int,
+    episodes: int,
+    seed: int,
+    *,
+    record: bool,
+    progress: Any,
+    covariance: bool,
+) -> None:
+    """The ideal backend: ``episodes`` episodes in batches of ``B`` copies of the vector environment."""
+    from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
+
+    env = EncryptedLTIAttackVectorEnv(B, config=cfg)
+    done_eps = 0
+    chunk = 0
+    while done_eps < episodes:
+        obs, info = env.reset(seed=seed + done_eps)
+        attacker.reset(seed=np.random.SeedSequence([seed, chunk]))
+        eps_t, en_t, Ns = [], [], []
+        while True:
+            obs, _, te, tr, info = env.step(attacker.act(obs))
+            if record:
+                eps_t.append(info["epsilon"])
+                en_t.append(info["input_energy"])
+                Ns.append(int(info["samples_delivered"][0]))
+            if progress is not None:
+                progress.update(B)
+            if te[0] or tr[0]:
+                break
+        take = min(B, episodes - done_eps)
+        if covariance:
+            tally.add_gram(env.episode, take)
+        tally.eps_rows.append(np.stack(eps_t, axis=1)[:take] if record else info["epsilon"][:take, None])
+        tally.en_rows.append(np.stack(en_t, axis=1)[:take] if record else info["input_energy"][:take, None])
+        if tally.N_steps is None:
+            tally.N_steps = np.array(Ns if record else [int(info["samples_delivered"][0])])
+        tally.add_finals(info, take)
+        done_eps += take
+        chunk += 1
+
+
+def _play_single(
+    tally: _Tally,
+    attacker: Attacker,
+    cfg: dict[str, Any],
+    episodes: int,
+    seed: int,
+    *,
+    record: bool,
+    progress: Any,
+    covariance: bool,
+) -> None:
+    """A cryptographic backend: ``episodes`` episodes one at a time through the single environment."""
+    from encctl_gym.envs import EncryptedLTIAttackEnv
+
+    env1 = EncryptedLTIAttackEnv(config=cfg)
+    for e in range(episodes):
+        obs, info = env1.reset(seed=seed + e)
+        attacker.reset(seed=np.random.SeedSequence([seed, e]))
+        eps_t, en_t, Ns = [], [], []
+        while True:
+            obs, _, te1, tr1, info = env1.step(attacker.act(obs))
+            if record:
+                eps_t.append(info["epsilon"])
+                en_t.append(info["input_energy"])
+                Ns.append(info["samples_delivered"])
+            if progress is not None:
+                progress.update(1)
+            if te1 or tr1:
+                break
+        if covariance:
+            tally.add_gram(env1.episode, 1)
+        tally.eps_rows.append(np.array(eps_t if record else [info["epsilon"]])[None])
+        tally.en_rows.append(np.array(en_t if record else [info["input_energy"]])[None])
+        if tally.N_steps is None:
+            tally.N_steps = np.array(Ns if record else [info["samples_delivered"]])
+        tally.add_finals(info, None)
 
 
 def design_efficiency(covariance: np.ndarray, design: Any) -> float:

@@ -24,7 +24,10 @@ algorithm (the smaller the optimum's gain over the Gaussian attack, the flatter 
 each of ``steps_per_iteration`` environment steps, capped by ``n_timesteps``.
 
 Every decision is a :class:`StoppingDecision` (its reason, the numbers behind it), recorded in
-the run's ``run.json`` and printed by ``encctl-gym train``.
+the run's ``run.json`` and printed by ``encctl-gym train``; while training runs, the progress bar
+(which counts to the budget, a ceiling) shows the last decision in brief
+(:meth:`OracleStopper.status`: the ratio to the oracle against its bar, and what the plateau test
+promises), so a run that stops short of its bar says why it may.
 """
 
 from __future__ import annotations
@@ -112,6 +115,20 @@ class StoppingDecision:
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
+
+    def status(self, rule: StoppingRule) -> str:
+        """The decision in a few words for a progress bar: the ratio to the oracle with its
+        interval against the bar ``1 + tolerance``, and where the plateau test stands."""
+        head = f"oracle ratio {self.ratio:.3f} [{self.low:.3f}, {self.high:.3f}] (stops at <= {1 + rule.tolerance:.3f})"
+        if self.reason == "continue" and self.evaluation + 1 < rule.min_evaluations:
+            return f"{head}; evaluation {self.evaluation + 1} of {rule.min_evaluations} before a decision"
+        if self.slope_pessimistic is None:
+            return f"{head}; plateau test at {rule.window} evaluations ({self.evaluation + 1} so far)"
+        gain = -self.slope_pessimistic * rule.window
+        return (
+            f"{head}; another {rule.window} evaluations may gain {100 * math.expm1(max(gain, 0.0)):.1f} % "
+            f"(plateau below {100 * rule.plateau_gain:g} %)" + ("" if self.reason == "continue" else f": stop ({self.reason})")
+        )
 
 
 def _slope_interval(y: np.ndarray) -> tuple[float, float]:
@@ -231,6 +248,13 @@ class OracleStopper:
         if self.log is not None and decision.stop:
             self.log(f"stopping rule: stop ({decision.reason}) {decision.message}")
         return not decision.stop
+
+    def status(self) -> str:
+        """Where the rule stands, for the progress bar (:meth:`StoppingDecision.status` of the
+        last decision): the bar counts to the budget, a ceiling the rule may stop short of."""
+        if not self.decisions:
+            return "stopping rule: the budget is a ceiling; first evaluation pending"
+        return "stopping rule: " + self.decisions[-1].status(self.rule)
 
     def final(self) -> StoppingDecision | None:
         """The last decision; a run that never stopped ends with reason ``"budget"``."""

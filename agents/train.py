@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from encctl_gym._validation import format_value
+from encctl_gym._validation import format_count, format_value
 from encctl_gym.envs.config import resolve_params
 from encctl_gym.errors import ConfigError
 from encctl_gym.resources import check_memory
@@ -120,8 +120,6 @@ def train(
     import torch
     from stable_baselines3.common.callbacks import CallbackList
 
-    from .callbacks import AttackMetricsCallback, LearningCurveCallback, ProgressCallback
-
     cfg = copy.deepcopy(cfg)
     if seed is not None:
         cfg["seed"] = seed
@@ -131,16 +129,98 @@ def train(
     hp = make_schedules(cfg["hyperparams"])
     hp["policy_kwargs"] = policy_kwargs(algo_cls, cfg["policy"], hp.get("policy_kwargs"))
     torch.set_num_threads(1)
-    n_envs = int(cfg["n_envs"])
     env_cfg = env_config(cfg)
     params = resolve_params(env_cfg)
-    env = _make_env(cfg, env_cfg, n_envs, cfg["reward_scaling"])
+    env = _make_env(cfg, env_cfg, int(cfg["n_envs"]), cfg["reward_scaling"])
     ev = cfg["eval"]
     n_eval = int(ev["episodes"])
-    eval_env = _make_env(cfg, env_cfg, n_eval, "none")  # eval returns are the true log eps_0 - log eps_N
+    eval_env = _make_eval_env(cfg, env_cfg, n_eval)
+    model = _build_model(cfg, algo_cls, hp, env, seed, verbose)
+    run_dir = new_run_dir(out, name or run_name(cfg, seed), overwrite=overwrite)
+    model.tensorboard_log = str(run_dir / "tb") if tensorboard else None
+    meta = _initial_meta(cfg, env_cfg, seed)
+    _write_meta(run_dir, meta)
+    curve = curve_for(params, cfg["observation"], algo=cfg["algo"], system=cfg["system"], seed=seed)
+    total, budget = training_budget(cfg, curve)
+    meta["n_timesteps"] = total
+    meta["budget"] = budget
+    stopper = _oracle_stopper(cfg, params, env_cfg, n_eval, int(ev["seed"]), log=print if progress else None)
+    callbacks = _callbacks(cfg, eval_env, curve, run_dir, verbose=verbose, on_evaluation=_both(stopper, on_evaluation))
+    if progress:
+        callbacks.append(_progress_bar(total, budget, run_dir.name, stopper))
+    t0 = time.perf_counter()
+    model.learn(total_timesteps=total, callback=CallbackList(callbacks), tb_log_name="run")
+    seconds = time.perf_counter() - t0
+    _save_model(model, env, curve, run_dir)
+    stopped = int(model.num_timesteps) < total
+    meta.update(
+        status="stopped" if stopped else "finished",
+        timesteps_done=int(model.num_timesteps),
+        train_seconds=round(seconds, 1),
+        steps_per_second=round(model.num_timesteps / seconds, 1),
+        torch_threads=torch.get_num_threads(),
+        learning_curve=_curve_summary(curve),
+    )
+    if stopper is not None:
+        meta["stopping"] = _stopping_summary(cfg, stopper)
+    _write_meta(run_dir, meta)
+    env.close()
+    return run_dir
+
+
+def _progress_bar(total: int, budget: dict[str, Any], label: str, stopper: Any) -> Any:
+    """The training's progress bar; with a stopping rule, first one line saying that the bar
+    counts to the budget, a ceiling the rule may stop before."""
+    from .callbacks import ProgressCallback
+
+    if stopper is not None:
+        print(
+            f"{budget.get('text', f'budget {total} steps')}; the bar counts to it, and the stopping rule (oracle) may stop before "
+            "(its state follows the bar's counts)",
+            flush=True,
+        )
+    return ProgressCallback(total, label, status=None if stopper is None else stopper.status)
+
+
+def _make_eval_env(cfg: dict[str, Any], env_cfg: dict[str, Any], n_eval: int) -> Any:
+    """The evaluation copies: unscaled rewards (the true ``log eps_0 - log eps_N``) and, when
+    observations are normalised, statistics frozen."""
+    eval_env = _make_env(cfg, env_cfg, n_eval, "none")
     if hasattr(eval_env, "training"):
         eval_env.training = False
         eval_env.norm_reward = False
+    return eval_env
+
+
+def _save_model(model: Any, env: Any, curve: Any, run_dir: Path) -> None:
+    """Write ``model.zip``, ``vecnormalize.npz`` (when observations are normalised) and the
+    learning-curve figure (when there was an evaluation)."""
+    model.save(str(run_dir / "model.zip"))
+    if hasattr(env, "obs_rms"):
+        save_vecnormalize(env, run_dir / VECNORMALIZE_FILE)
+    if len(curve.timesteps):
+        plot_learning_curves([curve], run_dir / "learning_curve.png", title=f"{run_dir.name}: evaluation error over the optimum")
+
+
+def _initial_meta(cfg: dict[str, Any], env_cfg: dict[str, Any], seed: int) -> dict[str, Any]:
+    """The ``run.json`` written before training starts (``status: "training"``)."""
+    return {
+        "status": "training",
+        "algo": cfg["algo"],
+        "observation": cfg["observation"],
+        "system": cfg["system"],
+        "env": env_cfg,
+        "seed": seed,
+        "n_timesteps": int(cfg["n_timesteps"]),
+        "n_envs": int(cfg["n_envs"]),
+        "config": cfg,
+    }
+
+
+def _build_model(cfg: dict[str, Any], algo_cls: Any, hp: dict[str, Any], env: Any, seed: int, verbose: int) -> Any:
+    """The algorithm's model on ``env`` with the hyperparameters ``hp``: policy networks checked
+    against the memory limit first, the algorithm's and PyTorch's refusals turned into
+    :class:`ConfigError`."""
     n_in = int(np.prod(env.observation_space.shape))
     n_out = int(np.prod(env.action_space.shape))
     net_arch = (cfg["hyperparams"].get("policy_kwargs") or {}).get("net_arch")
@@ -150,7 +230,7 @@ def train(
         advice="use smaller layers (hyperparams.policy_kwargs.net_arch)",
     )
     try:
-        model = algo_cls(cfg["policy"], env, seed=seed, verbose=verbose, device="cpu", **hp)
+        return algo_cls(cfg["policy"], env, seed=seed, verbose=verbose, device="cpu", **hp)
     except (AssertionError, ValueError, TypeError) as exc:  # stable-baselines3's own checks of the values
         raise ConfigError(f"{cfg['algo']} rejected the hyperparameters {format_value(cfg['hyperparams'])}: {exc}") from exc
     except (RuntimeError, MemoryError) as exc:  # PyTorch could not allocate the networks
@@ -159,27 +239,17 @@ def train(
             f"{cfg['algo']} could not build its model with the hyperparameters {format_value(cfg['hyperparams'])}: "
             f"{type(exc).__name__}: {format_value(first[0] if first else '')}"
         ) from None
-    run_dir = new_run_dir(out, name or run_name(cfg, seed), overwrite=overwrite)
-    model.tensorboard_log = str(run_dir / "tb") if tensorboard else None
-    meta: dict[str, Any] = {
-        "status": "training",
-        "algo": cfg["algo"],
-        "observation": cfg["observation"],
-        "system": cfg["system"],
-        "env": env_cfg,
-        "seed": seed,
-        "n_timesteps": int(cfg["n_timesteps"]),
-        "n_envs": n_envs,
-        "config": cfg,
-    }
-    _write_meta(run_dir, meta)
-    curve = curve_for(params, cfg["observation"], algo=cfg["algo"], system=cfg["system"], seed=seed)
-    total, budget = training_budget(cfg, curve)
-    meta["n_timesteps"] = total
-    meta["budget"] = budget
-    stopper = _oracle_stopper(cfg, params, env_cfg, n_eval, int(ev["seed"]), log=print if progress else None)
-    hook = _both(stopper, on_evaluation)
-    callbacks: list[Any] = [
+
+
+def _callbacks(
+    cfg: dict[str, Any], eval_env: Any, curve: Any, run_dir: Path, *, verbose: int, on_evaluation: Callable[[Any], bool] | None
+) -> list[Any]:
+    """The training callbacks: attack metrics, and the learning curve's periodic evaluation."""
+    from .callbacks import AttackMetricsCallback, LearningCurveCallback
+
+    ev = cfg["eval"]
+    n_eval = int(ev["episodes"])
+    return [
         AttackMetricsCallback(),
         LearningCurveCallback(
             eval_env,
@@ -187,56 +257,42 @@ def train(
             curve_path=run_dir / CURVE_FILE,
             eval_seed=int(ev["seed"]),
             n_eval_episodes=n_eval,
-            eval_freq=max(int(ev["freq"]) // n_envs, 1),
+            eval_freq=max(int(ev["freq"]) // int(cfg["n_envs"]), 1),
             log_path=str(run_dir),
             best_model_save_path=str(run_dir),
             deterministic=False,
             verbose=verbose,
-            on_evaluation=hook,
+            on_evaluation=on_evaluation,
         ),
     ]
-    if progress:
-        callbacks.append(ProgressCallback(total, run_dir.name))
-    t0 = time.perf_counter()
-    model.learn(total_timesteps=total, callback=CallbackList(callbacks), tb_log_name="run")
-    seconds = time.perf_counter() - t0
-    model.save(str(run_dir / "model.zip"))
-    if hasattr(env, "obs_rms"):
-        save_vecnormalize(env, run_dir / VECNORMALIZE_FILE)
-    if len(curve.timesteps):
-        plot_learning_curves([curve], run_dir / "learning_curve.png", title=f"{run_dir.name}: evaluation error over the optimum")
-    stopped = int(model.num_timesteps) < total
-    meta.update(
-        status="stopped" if stopped else "finished",
-        timesteps_done=int(model.num_timesteps),
-        train_seconds=round(seconds, 1),
-        steps_per_second=round(model.num_timesteps / seconds, 1),
-        torch_threads=torch.get_num_threads(),
-        learning_curve={
-            "N": curve.N,
-            "gamma": curve.gamma,
-            "gamma_gauss": curve.gamma_gauss,
-            "gamma_opt": curve.gamma_opt,
-            "design": curve.design_kind,
-            "evaluations": int(len(curve.timesteps)),
-            "last_ratio_to_gamma_opt": float(curve.ratio()[0][-1]) if len(curve.timesteps) else None,
-        },
-    )
-    if stopper is not None:
-        final = stopper.final()
-        meta["stopping"] = {
-            "rule": dict(cfg["stopping"]),
-            "oracle": stopper.oracle_name,
-            "oracle_mean_epsilon": float(np.mean(stopper.oracle_epsilon)),
-            "decision": final.as_dict() if final is not None else None,
-            "curve": [
-                {"timestep": d.timestep, "ratio": d.ratio, "low": d.low, "high": d.high, "reason": d.reason}
-                for d in stopper.decisions
-            ],
-        }
-    _write_meta(run_dir, meta)
-    env.close()
-    return run_dir
+
+
+def _curve_summary(curve: Any) -> dict[str, Any]:
+    """The ``learning_curve`` entry of ``run.json``."""
+    return {
+        "N": curve.N,
+        "gamma": curve.gamma,
+        "gamma_gauss": curve.gamma_gauss,
+        "gamma_opt": curve.gamma_opt,
+        "design": curve.design_kind,
+        "evaluations": int(len(curve.timesteps)),
+        "last_ratio_to_gamma_opt": float(curve.ratio()[0][-1]) if len(curve.timesteps) else None,
+    }
+
+
+def _stopping_summary(cfg: dict[str, Any], stopper: Any) -> dict[str, Any]:
+    """The ``stopping`` entry of ``run.json``: the rule, the oracle and every decision."""
+    final = stopper.final()
+    return {
+        "rule": dict(cfg["stopping"]),
+        "oracle": stopper.oracle_name,
+        "oracle_mean_epsilon": float(np.mean(stopper.oracle_epsilon)),
+        "decision": final.as_dict() if final is not None else None,
+        "curve": [
+            {"timestep": d.timestep, "ratio": d.ratio, "low": d.low, "high": d.high, "reason": d.reason}
+            for d in stopper.decisions
+        ],
+    }
 
 
 def steps_per_iteration(cfg: dict[str, Any], horizon: int) -> int:
@@ -513,7 +569,7 @@ def run(args: argparse.Namespace) -> int:
         ev = final_evaluation(run_dir)
         g = ev["gaussian"]
         print(
-            f"evaluation ({ev['episodes']} episodes, N = {ev['N']}): gaussian mean epsilon {g['mean_epsilon']:.4g} "
+            f"evaluation ({format_count(ev['episodes'], 'episode')}, N = {ev['N']}): gaussian mean epsilon {g['mean_epsilon']:.4g} "
             f"(power {g['mean_average_power']:.3g})"
         )
         for which in ("final", "best"):
@@ -527,7 +583,7 @@ def run(args: argparse.Namespace) -> int:
         el = ev.get("elgamal")
         if el:
             print(
-                f"  elgamal ({el['episodes']} episodes, N = {el['N']}, {el['key_length']}-bit key): mean epsilon "
+                f"  elgamal ({format_count(el['episodes'], 'episode')}, N = {el['N']}, {el['key_length']}-bit key): mean epsilon "
                 f"{el['mean_epsilon']:.4g}, {1000 * el['seconds_per_step']:.1f} ms/step"
             )
     return 0

@@ -221,7 +221,7 @@ def tune(
         import optuna
     except ModuleNotFoundError as exc:
         raise EncctlError("encctl-gym tune needs Optuna; install the extra: pip install 'encctl-gym[optuna]'") from exc
-    from .train import train
+    from .train import train  # before the study exists: a missing [rl] extra fails here
 
     algo = cfg["algo"]
     if algo not in SEARCH_SPACES:
@@ -239,6 +239,19 @@ def tune(
         sampler=optuna.samplers.TPESampler(seed=sampler_seed),
         pruner=pruner,
     )
+    study.optimize(_objective(optuna, train, cfg, out, episodes=episodes, progress=progress), n_trials=trials, catch=())
+    return study, _write_best(optuna, study, cfg, name, out, episodes=episodes)
+
+
+def _objective(
+    optuna: Any, train: Callable[..., Path], cfg: dict[str, Any], out: Path, *, episodes: int, progress: bool
+) -> Callable[[Any], float]:
+    """The study's objective: ``train`` (:func:`agents.train.train`) the trial's drawn
+    configuration (pruned by its learning curve) and return its paired error ratio to the
+    oracle (:func:`objective_ratio`)."""
+    from .runs import read_run
+
+    algo = cfg["algo"]
 
     def objective(trial: Any) -> float:
         trial_cfg = copy.deepcopy(cfg)
@@ -262,15 +275,19 @@ def tune(
         )
         trial.set_user_attr("run_dir", str(run_dir))
         trial.set_user_attr("config", {k: trial_cfg[k] for k in TUNED_KEYS if k in trial_cfg})
-        from .runs import read_run
-
         if read_run(run_dir).meta.get("status") == "stopped":
             raise optuna.TrialPruned()
         ratio, se = objective_ratio(run_dir, episodes=episodes)
         trial.set_user_attr("ratio_se_log", se)
         return ratio
 
-    study.optimize(objective, n_trials=trials, catch=())
+    return objective
+
+
+def _write_best(optuna: Any, study: Any, cfg: dict[str, Any], name: str, out: Path, *, episodes: int) -> Path:
+    """Write the best completed trial's configuration as ``{out}/{algo}_{system}.yaml`` with a
+    header saying how it was found; return its path."""
+    algo = cfg["algo"]
     done = [t for t in study.trials if t.state == optuna.trial.TrialState.COMPLETE]
     if not done:
         raise ConfigError(f"study {name!r} has no completed trial (all pruned or failed)")
@@ -286,7 +303,7 @@ def tune(
     ]
     path = out / f"{algo}_{cfg['system']}.yaml"
     path.write_text(_yaml_text(tuned, header))
-    return study, path
+    return path
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

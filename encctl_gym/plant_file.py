@@ -30,18 +30,18 @@ Reading is bounded: files over :data:`MAX_FILE_BYTES` are refused before they ar
 read by :func:`encctl_gym.safe_yaml.load_yaml`, with aliases allowed but counted expanded within
 :data:`MAX_YAML_NODES` nodes before any Python object is built (a few hundred bytes of nested
 aliases would otherwise take gigabytes), nesting at most :data:`MAX_YAML_DEPTH` levels; NPZ members are checked
-for their uncompressed size and loaded without pickles. Numbers must be real and finite in
+for their uncompressed size and for the size their ``.npy`` headers declare (shape times itemsize) before any
+array is allocated, and loaded without pickles (:func:`encctl_gym._npz.read_npz`); a corrupt archive is a
+:class:`~encctl_gym.errors.ConfigError`. Numbers must be real and finite in
 float64: booleans, strings, NaN, infinities, complex data and integers beyond the float range
 (``10**400``) are refused, naming the field and the position of the first bad entry (``A[1][0]``).
 """
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import numbers
-import zipfile
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -49,6 +49,7 @@ from typing import Any
 
 import numpy as np
 
+from ._npz import read_npz
 from ._validation import (
     FLOAT_MAX,
     as_finite_array,
@@ -69,6 +70,8 @@ __all__ = [
     "load_plant_file",
     "load_system",
     "PLANT_FIELDS",
+    "FIELD_MEANINGS",
+    "fields_help",
     "MAX_FILE_BYTES",
     "MAX_YAML_NODES",
     "MAX_YAML_DEPTH",
@@ -79,6 +82,27 @@ __all__ = [
 OUTPUT_FIELDS: tuple[str, ...] = ("C", "sigma_v2")
 #: Every field a plant file may hold.
 PLANT_FIELDS: tuple[str, ...] = ("A", "B", *OUTPUT_FIELDS, *DESIGN_FIELDS)
+#: One line per field of :data:`PLANT_FIELDS` (the table of the module docstring), for ``--help``.
+FIELD_MEANINGS: dict[str, str] = {
+    "A": "required: n x n system matrix (Schur stable for a design)",
+    "B": "required: n x m input matrix (a flat list of n numbers is one column)",
+    "C": "p x n output matrix of y = C x + v, (A, C) observable (a flat list is one output); without it the state is measured",
+    "sigma_v2": "measurement noise variance of v (>= 0, default 0)",
+    "sigma_u2": "attack input power per channel (> 0)",
+    "sigma_w2": "process noise variance (> 0)",
+    "sigma_x2": "variance of x_0 (>= 0)",
+    "gamma_c": "acceptable estimation error (> 0)",
+    "tau_c": "defense period: seconds or a duration such as 10y",
+    "upsilon": "adversary computing speed in FLOPS (> 0)",
+}
+
+
+def fields_help() -> str:
+    """The plant-file fields as lines of text (``encctl-gym design --help``)."""
+    width = max(map(len, PLANT_FIELDS))
+    return "\n".join(f"  {name:<{width}}  {FIELD_MEANINGS[name]}" for name in PLANT_FIELDS)
+
+
 #: Largest plant file read (bytes): room for matrices of about 1000 x 1000 in text.
 MAX_FILE_BYTES: int = 64 * 2**20
 #: Largest number of YAML nodes after alias expansion.
@@ -153,23 +177,13 @@ def _refuse_duplicate_keys(path: Path, keys: list[Any]) -> None:
 
 
 def _load_npz(path: Path, raw: bytes) -> dict[str, Any]:
-    try:
-        with zipfile.ZipFile(io.BytesIO(raw)) as zf:
-            infos = zf.infolist()
-    except (zipfile.BadZipFile, OSError) as exc:
-        raise _fail(path, f"not a readable NPZ archive ({format_value(str(exc))})") from None
-    if len(infos) > _MAX_NPZ_MEMBERS:
-        raise _fail(path, f"holds {len(infos)} arrays; a plant file has at most {_MAX_NPZ_MEMBERS}")
-    total = sum(i.file_size for i in infos)
-    if total > MAX_FILE_BYTES:
-        raise ResourceLimitError(
-            f"system file {str(path)!r}: its arrays take {total} bytes uncompressed; the limit is {MAX_FILE_BYTES}"
-        )
-    try:
-        with np.load(io.BytesIO(raw), allow_pickle=False) as z:
-            return {k: z[k] for k in z.files}
-    except ValueError as exc:
-        raise _fail(path, f"cannot load its arrays without pickles ({format_value(str(exc))})") from None
+    return read_npz(
+        raw,
+        where=f"system file {str(path)!r}",
+        max_bytes=MAX_FILE_BYTES,
+        max_members=_MAX_NPZ_MEMBERS,
+        limit_name="MAX_FILE_BYTES",
+    )
 
 
 def _json_object(path: Path, pairs: list[tuple[str, Any]]) -> dict[str, Any]:

@@ -166,3 +166,41 @@ def test_the_ars_default_budget_is_scaled_to_the_plant_and_an_explicit_one_is_fi
     assert how["how"] == "plant" and how["steps_per_iteration"] == per and str(total) in how["text"]
     apply_override(cfg, "stopping.budget=fixed")
     assert training_budget(cfg, c) == (cfg["n_timesteps"], {"how": "fixed", "n_timesteps": cfg["n_timesteps"]})
+
+
+def test_the_stoppers_status_says_what_the_rule_is_doing():
+    """Issue 34 item 6: the bar counts to the budget, a ceiling; its status says where the rule
+    stands: the ratio to the oracle against its bar, then what the plateau test promises."""
+    rule = StoppingRule(tolerance=0.02, window=3, plateau_gain=0.02, min_evaluations=2)
+    oracle = np.exp(np.full(K, -9.0))
+    st = OracleStopper(rule, oracle)
+    assert "ceiling" in st.status() and "pending" in st.status()
+
+    class Curve:
+        timesteps = np.arange(1) * 10
+        epsilon = np.exp(curve(np.array([0.5])) - 9.0)
+
+    st(Curve)
+    text = st.status()
+    assert f"oracle ratio {math.exp(0.5):.3f}" in text and "stops at <= 1.020" in text and "1 of 2" in text
+    Curve.timesteps, Curve.epsilon = np.arange(3) * 10, np.exp(curve(np.array([0.5, 0.3, 0.1])) - 9.0)
+    assert st(Curve) is True
+    slope_gain = -st.decisions[-1].slope_pessimistic * 3
+    assert f"may gain {100 * math.expm1(slope_gain):.1f} %" in st.status() and "plateau below 2 %" in st.status()
+
+
+def test_the_progress_bar_shows_the_status_as_it_changes(capsys):
+    pytest.importorskip("stable_baselines3", reason="the progress bar is a stable-baselines3 callback (rl extra)")
+    from encctl_gym.agents.callbacks import ProgressCallback
+
+    said = ["first evaluation pending"]
+    bar = ProgressCallback(1000, "run", status=lambda: said[0])
+    bar.num_timesteps = 0
+    bar._on_training_start()
+    bar.num_timesteps = 400
+    said[0] = "oracle ratio 1.234"
+    bar._on_step()
+    bar.num_timesteps = 500
+    bar._on_training_end()
+    err = capsys.readouterr().err
+    assert "oracle ratio 1.234" in err and "500/1000" in err

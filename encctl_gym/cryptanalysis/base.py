@@ -456,10 +456,16 @@ class Breaker(abc.ABC):
         self.check_feasible(group)
         self._check_group(group)
         self._check_thread()
-        deadline = Deadline(_check_time_limit(time_limit), f"{self.name} precomputation", progress)
+        limit = _check_time_limit(time_limit)
+        self._prepare(group)  # before the clock: what the process loads once is not the attack's time
+        deadline = Deadline(limit, f"{self.name} precomputation", progress)
         pre, ops = self._precompute(group, deadline)
         pre.cost = deadline.cost(ops)
         return pre
+
+    def _prepare(self, group: GroupParams) -> None:
+        """Work of the process, not of the attack, done before :meth:`precompute` starts its
+        clock (the index calculus loads its compiled sieve); none by default."""
 
     @abc.abstractmethod
     def _precompute(self, group: GroupParams, deadline: Deadline) -> tuple[Precomputation, Mapping[str, int]]:

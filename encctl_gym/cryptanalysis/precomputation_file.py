@@ -18,8 +18,9 @@ arrays: the logarithms and right-hand sides as little-endian bytes of the width 
 ``coefs``). The file is written to a temporary name and renamed, so an interrupted write
 leaves the previous file whole.
 
-Reading is bounded (:data:`MAX_FILE_BYTES` of arrays, uncompressed, checked before they are
-read) and checked: every field's type and range, every logarithm against
+Reading is bounded (:data:`MAX_FILE_BYTES` of arrays, uncompressed and as the ``.npy`` headers
+declare them, checked before they are allocated; :func:`encctl_gym._npz.read_npz`), a corrupt
+archive is a :class:`~encctl_gym.errors.ConfigError`, and the content is checked: every field's type and range, every logarithm against
 ``g^lambda(l) = l^n (mod p)`` and every relation against ``(prod l^e)^n = g^rhs (mod p)``, so a
 corrupt or edited file raises :class:`~encctl_gym.errors.ConfigError` naming the file and the
 entry, never a wrong key later. :meth:`SavedPrecomputation.check_group` refuses a file of
@@ -33,23 +34,31 @@ import json
 import os
 import tempfile
 import time
-import zipfile
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import gmpy2
 import numpy as np
 
-from .._validation import check_regular_file, format_value
+from .._npz import read_npz
+from .._validation import check_int, check_nonnegative, check_regular_file, format_value
 from ..crypto.arith import format_int
 from ..crypto.group import GroupParams
-from ..errors import ConfigError, EncctlError
-from ..resources import check_memory
+from ..errors import ConfigError, EncctlError, ParameterError, ResourceLimitError
 from .base import Cost
 from .relations import Relation, RelationWalk
 from .smoothness import check_bound, primes_up_to
 
-__all__ = ["SavedPrecomputation", "PrecomputationInterrupted", "load_precomputation", "FORMAT", "VERSION", "MAX_FILE_BYTES"]
+__all__ = [
+    "SavedPrecomputation",
+    "PrecomputationInterrupted",
+    "load_precomputation",
+    "FORMAT",
+    "VERSION",
+    "MAX_FILE_BYTES",
+    "max_relations",
+]
 
 #: The ``format`` of the header.
 FORMAT = "encctl-gym index-calculus precomputation"
@@ -213,25 +222,14 @@ def _fail(path: str, what: str) -> ConfigError:
 
 
 def _read_arrays(path: str) -> dict[str, np.ndarray]:
-    try:
-        with zipfile.ZipFile(path) as zf:
-            infos = zf.infolist()
-    except (zipfile.BadZipFile, OSError) as exc:
-        raise _fail(path, f"is not a precomputation file: not a readable NPZ archive ({format_value(str(exc))})") from None
-    names = {i.filename.removesuffix(".npy") for i in infos}
-    if names != _MEMBERS:
-        raise _fail(path, f"is not a precomputation file: it holds {sorted(names)}, expected {sorted(_MEMBERS)}")
-    check_memory(
-        f"the arrays of the precomputation file {format_value(path)}",
-        sum(i.file_size for i in infos),
-        MAX_FILE_BYTES,
-        "(MAX_FILE_BYTES)",
+    return read_npz(
+        path,
+        where=f"the precomputation file {format_value(path)}",
+        max_bytes=MAX_FILE_BYTES,
+        max_members=len(_MEMBERS),
+        limit_name="MAX_FILE_BYTES",
+        members=_MEMBERS,
     )
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            return {k: z[k] for k in z.files}
-    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
-        raise _fail(path, f"cannot be read without pickles ({format_value(str(exc))})") from None
 
 
 def _header(path: str, arrays: dict[str, np.ndarray]) -> dict[str, Any]:
@@ -259,6 +257,83 @@ def _array(path: str, arrays: dict[str, np.ndarray], name: str, kind: str, ndim:
     return a
 
 
+#: Largest operation count a header may hold (2^63: far above any count a run reaches).
+MAX_OPERATIONS = 1 << 63
+
+
+def _cost(header: dict[str, Any]) -> tuple[Cost, list[dict[str, float]]]:
+    """The header's cost and per-phase seconds: seconds finite and >= 0 (a NaN, a negative or a
+    10^400 would become the deciphering time of a measured clock), counts integers in
+    ``[0, MAX_OPERATIONS]``; a bad one raises :class:`~encctl_gym.errors.ParameterError` naming it."""
+    raw = header["cost"]
+    if not isinstance(raw, dict) or not all(isinstance(header[f], dict) for f in ("phase_seconds", "phase_cpu_seconds")):
+        raise ParameterError("cost, phase_seconds and phase_cpu_seconds must be mappings")
+    if not isinstance(raw["operations"], dict):
+        raise ParameterError(f"cost.operations must be a mapping, got {format_value(raw['operations'])}")
+    cost = Cost(
+        check_nonnegative("cost.seconds", raw["seconds"]),
+        {str(k): check_int(f"cost.operations.{k}", v, minimum=0, maximum=MAX_OPERATIONS) for k, v in raw["operations"].items()},
+        check_nonnegative("cost.cpu_seconds", raw["cpu_seconds"]),
+    )
+    phases = [
+        {str(k): check_nonnegative(f"{f}.{k}", v) for k, v in header[f].items()} for f in ("phase_seconds", "phase_cpu_seconds")
+    ]
+    return cost, phases
+
+
+def max_relations(primes: int) -> int:
+    """The most relations a file for a factor base of ``primes`` primes may hold: twice the primes
+    plus 1000. The collection stops at ``k (1 + EXTRA_FRACTION) + EXTRA_CONSTANT`` relations and adds
+    at most ``MAX_ROUNDS`` rounds of ``max(EXTRA_CONSTANT, EXTRA_FRACTION k)`` (about ``1.35 k + 140``);
+    more cannot come from :meth:`SavedPrecomputation.save`, and each costs a check and a dict."""
+    return 2 * primes + 1000
+
+
+def _relations(name: str, arrays: dict[str, np.ndarray], group: GroupParams, primes: Sequence[int], width: int) -> list[Relation]:
+    """The relations of an interrupted collection, each checked against ``(prod l^e)^n = g^rhs (mod p)``.
+
+    At most :func:`max_relations` of them, each of at most ``2 (bits(p) + 16)`` primes: a row is
+    ``lambda(|a|) - lambda(|b|)`` for a sieve pair with ``|a|, |b| < 2^(bits(p)/2 + 14)``
+    (:func:`~.relations.sieve_region`), and ``|a|`` has fewer distinct prime factors than bits."""
+    q, p, g, n = group.q, group.p, group.g, group.cofactor
+    rhs = _array(name, arrays, "rhs", "u", 2)
+    count, limit = rhs.shape[0], max_relations(len(primes))
+    if count > limit:
+        raise ResourceLimitError(
+            f"the precomputation file {format_value(name)} holds {count} relations; a factor base of {len(primes)} "
+            f"primes needs fewer than {limit} (max_relations)"
+        )
+    relations: list[Relation] = []
+    indptr = _array(name, arrays, "indptr", "i", 1)
+    cols, coefs = _array(name, arrays, "cols", "i", 1), _array(name, arrays, "coefs", "i", 1)
+    if (
+        indptr.shape != (count + 1,)
+        or rhs.shape[1:] != (width,)
+        or indptr[0] != 0
+        or np.any(np.diff(indptr) < 0)
+        or indptr[-1] != cols.size
+        or cols.size != coefs.size
+        or (cols.size and (cols.min() < 0 or cols.max() >= len(primes)))
+    ):
+        raise _fail(name, "has relation arrays that do not fit together")
+    longest, most = (int(np.diff(indptr).max()) if count else 0), 2 * (p.bit_length() + 16)
+    if longest > most:
+        raise _fail(name, f"has a relation of {longest} primes; a pair a, b of the sieve has at most {most}")
+    for i, r in enumerate(_from_bytes(rhs)):
+        a, b = indptr[i], indptr[i + 1]
+        row = dict(zip(cols[a:b].tolist(), coefs[a:b].tolist()))
+        num = den = gmpy2.mpz(1)
+        for j, e in row.items():
+            if e > 0:
+                num = num * gmpy2.powmod(primes[j], e, p) % p
+            else:
+                den = den * gmpy2.powmod(primes[j], -e, p) % p
+        if r >= q or gmpy2.powmod(num, n, p) != gmpy2.powmod(g, r, p) * gmpy2.powmod(den, n, p) % p:
+            raise _fail(name, f"has a wrong relation (number {i})")
+        relations.append(Relation((row, r)))
+    return relations
+
+
 def load_precomputation(path: str | os.PathLike[str]) -> SavedPrecomputation:
     """Read and check a file written by :meth:`SavedPrecomputation.save`.
 
@@ -277,14 +352,9 @@ def load_precomputation(path: str | os.PathLike[str]) -> SavedPrecomputation:
     try:
         group = GroupParams.from_dict(header["group"]).verify()
         bound = check_bound(header["bound"])
-        cost = Cost(
-            float(header["cost"]["seconds"]),
-            {str(k): int(v) for k, v in header["cost"]["operations"].items()},
-            float(header["cost"]["cpu_seconds"]),
-        )
-        phases = [{str(k): float(v) for k, v in header[f].items()} for f in ("phase_seconds", "phase_cpu_seconds")]
+        cost, phases = _cost(header)
         walk = None if header["walk"] is None else RelationWalk(*(int(v, 16) for v in header["walk"]))
-    except (EncctlError, KeyError, TypeError, ValueError, AttributeError) as exc:
+    except (EncctlError, KeyError, TypeError, ValueError, AttributeError, OverflowError) as exc:
         raise _fail(name, f"has a bad header entry: {format_value(str(exc))}") from None
     q, p, g, n = group.q, group.p, group.g, group.cofactor
     width = max(1, (q.bit_length() + 7) // 8)
@@ -302,32 +372,7 @@ def load_precomputation(path: str | os.PathLike[str]) -> SavedPrecomputation:
     elif header["complete"] is False and walk is not None:
         if not (0 < walk.e < q and 0 < walk.c < q):
             raise _fail(name, "has a residue walk outside [1, q)")
-        indptr = _array(name, arrays, "indptr", "i", 1)
-        cols, coefs = _array(name, arrays, "cols", "i", 1), _array(name, arrays, "coefs", "i", 1)
-        rhs = _array(name, arrays, "rhs", "u", 2)
-        count = rhs.shape[0]
-        if (
-            indptr.shape != (count + 1,)
-            or rhs.shape[1:] != (width,)
-            or indptr[0] != 0
-            or np.any(np.diff(indptr) < 0)
-            or indptr[-1] != cols.size
-            or cols.size != coefs.size
-            or (cols.size and (cols.min() < 0 or cols.max() >= len(primes)))
-        ):
-            raise _fail(name, "has relation arrays that do not fit together")
-        for i, r in enumerate(_from_bytes(rhs)):
-            a, b = indptr[i], indptr[i + 1]
-            row = dict(zip(cols[a:b].tolist(), coefs[a:b].tolist()))
-            num = den = gmpy2.mpz(1)
-            for j, e in row.items():
-                if e > 0:
-                    num = num * gmpy2.powmod(primes[j], e, p) % p
-                else:
-                    den = den * gmpy2.powmod(primes[j], -e, p) % p
-            if r >= q or gmpy2.powmod(num, n, p) != gmpy2.powmod(g, r, p) * gmpy2.powmod(den, n, p) % p:
-                raise _fail(name, f"has a wrong relation (number {i})")
-            relations.append(Relation((row, r)))
+        relations = _relations(name, arrays, group, primes, width)
     else:
         raise _fail(name, "has a header that is neither complete nor a relation collection with its walk")
     return SavedPrecomputation(group, bound, logs, relations, walk, cost, phases[0], phases[1], name, time.perf_counter() - start)

@@ -176,6 +176,27 @@ def break_sequence(
             "break its keys without a scheduler"
         )
     progress = check_bool("progress", progress)
+    pre = _precomputation(breaker, group, pre, time_limit=time_limit, progress=progress)
+    if tokens is not None:
+        if not hasattr(pre, "add_tokens"):
+            raise ParameterError(f"update tokens are used only by the token-chain breaker, not by {breaker.name!r}")
+        pre.add_tokens(tokens)
+    if scheduler is None and n_jobs == 1:
+        keys = []
+        for h in tqdm(hs, desc=f"{breaker.name} keys", disable=not progress, leave=False):
+            keys.append(breaker.break_key(h, pre, time_limit=time_limit))
+        return BreakReport(breaker.name, group, pre.cost, keys)
+    keys = _break_in_tasks(
+        breaker, pre, hs, time_limit, scheduler=scheduler, n_jobs=n_jobs, chunks=chunks, seed=seed, progress=progress
+    )
+    return BreakReport(breaker.name, group, pre.cost, keys)
+
+
+def _precomputation(
+    breaker: Breaker, group: GroupParams, pre: Precomputation | None, *, time_limit: float | None, progress: bool
+) -> Precomputation:
+    """The group's precomputation: ``pre`` checked to be of this breaker and group, or computed
+    (with the phases' progress bars when asked)."""
     if pre is None:
         bars = PhaseBars(prefix=f"{breaker.name} ") if progress else None
         try:
@@ -187,23 +208,30 @@ def break_sequence(
         raise ParameterError(f"pre must be a Precomputation, got {format_value(pre)}")
     elif pre.breaker != breaker.name or pre.group != group:
         raise ParameterError(f"pre is a precomputation of {pre.breaker!r} for another group or breaker")
-    if tokens is not None:
-        if not hasattr(pre, "add_tokens"):
-            raise ParameterError(f"update tokens are used only by the token-chain breaker, not by {breaker.name!r}")
-        pre.add_tokens(tokens)
-    if scheduler is None and n_jobs == 1:
-        keys = []
-        for h in tqdm(hs, desc=f"{breaker.name} keys", disable=not progress, leave=False):
-            keys.append(breaker.break_key(h, pre, time_limit=time_limit))
-        return BreakReport(breaker.name, group, pre.cost, keys)
+    return pre
+
+
+def _break_in_tasks(
+    breaker: Breaker,
+    pre: Precomputation,
+    hs: list[int],
+    time_limit: float | None,
+    *,
+    scheduler: Any,
+    n_jobs: int,
+    chunks: int | None,
+    seed: int | np.random.SeedSequence,
+    progress: bool,
+) -> list[Any]:
+    """The parallel path: runs of consecutive keys, each task with a copy of ``pre``, through
+    :func:`~encctl_gym.parallel.run_tasks`; the keys in order."""
+    from ..parallel import run_tasks
+
     workers = (os.cpu_count() or 1) if n_jobs == -1 else n_jobs
     n_chunks = max(1, min(len(hs), chunks if chunks is not None else workers))
     bounds = np.linspace(0, len(hs), n_chunks + 1).round().astype(int)
     tasks = [(pre, hs[a:b], time_limit) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
-    from ..parallel import run_tasks
-
     parts = run_tasks(
         _break_chunk, tasks, seed=seed, n_jobs=n_jobs, scheduler=scheduler, progress=progress, desc=f"{breaker.name} keys"
     )
-    keys = [k for part in parts for k in part]
-    return BreakReport(breaker.name, group, pre.cost, keys)
+    return [k for part in parts for k in part]

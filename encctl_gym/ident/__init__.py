@@ -12,6 +12,8 @@
 * :mod:`.grid` -- the error on a grid of ``N`` for least squares or any estimator by name.
 * :mod:`.subspace` -- identification from outputs ``y = C x + D u + v``: N4SID, PO-MOESP and
   ARX on batches of runs, and the basis-free Markov-parameter error.
+* :mod:`.output_estimators` -- N4SID and PO-MOESP behind the estimator protocol (states, and
+  online on outputs), and the online ARX least squares of the environment on outputs.
 * :mod:`.tails` -- when the error's mean and variance exist (the tail rule), the Hill
   estimator, and summaries that report medians and flag a mean that does not exist.
 
@@ -32,6 +34,7 @@ from .grid import *  # noqa: F403
 from .instrumental import *  # noqa: F403
 from .least_squares import *  # noqa: F403
 from .ordinary import *  # noqa: F403
+from .output_estimators import *  # noqa: F403
 from .registry import *  # noqa: F403
 from .subspace import *  # noqa: F403
 from .tails import *  # noqa: F403
@@ -51,6 +54,7 @@ __all__ = list(
             "registry",
             "grid",
             "subspace",
+            "output_estimators",
             "tails",
         )
         for name in sys.modules[f"{__name__}.{module}"].__all__

@@ -16,10 +16,14 @@ name           estimator                                       parameters (defau
                                                                scale by empirical Bayes)
 ``forgetting`` least squares with exponential forgetting       ``forgetting_factor`` (0.999)
 ``iv``         instrumental variables, lagged inputs           ``lags`` (ceil(n / m))
+``n4sid``      N4SID (subspace), on states ``y = x``, the      ``block_rows`` (max(2, 2 n))
+               estimate in the plant's basis; on outputs too
+``moesp``      PO-MOESP (subspace), as ``n4sid``               ``block_rows`` (max(2, 2 n))
 =============  ==============================================  =================================
 
-Total least squares and subspace methods are not in the registry: see ``docs/ident.md`` for why
-they mean nothing for this full-state problem.
+The subspace methods (:mod:`~encctl_gym.ident.output_estimators`) are there for the plant measured
+through outputs (``observe="output"``); on states they are a slower, less efficient route to the
+same ``[A B]`` (see ``docs/ident.md``). Total least squares is not in the registry.
 """
 
 from __future__ import annotations
@@ -34,12 +38,14 @@ from .estimator import Estimator, MomentEstimator
 from .forgetting import ForgettingLeastSquares
 from .instrumental import InstrumentalVariables
 from .ordinary import OrdinaryLeastSquares
+from .output_estimators import MOESPEstimator, N4SIDEstimator
 
 __all__ = ["ESTIMATORS", "DEFAULT_ESTIMATOR", "estimator_names", "make_estimator", "estimator_spec"]
 
 #: name -> class (:class:`~encctl_gym.registry.Registry`); each class validates its own parameters.
-ESTIMATORS: Registry[type[MomentEstimator]] = Registry(
-    "estimator", [OrdinaryLeastSquares, BayesianLeastSquares, ForgettingLeastSquares, InstrumentalVariables]
+ESTIMATORS: Registry[type[MomentEstimator] | type[N4SIDEstimator] | type[MOESPEstimator]] = Registry(
+    "estimator",
+    [OrdinaryLeastSquares, BayesianLeastSquares, ForgettingLeastSquares, InstrumentalVariables, N4SIDEstimator, MOESPEstimator],
 )
 
 #: The paper's estimator (eq:estimate).

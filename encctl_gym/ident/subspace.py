@@ -19,7 +19,8 @@ The phases are separate functions, each testable alone:
 3. :func:`select_order` -- the order from the singular values, reported with them.
 4. The system matrices by least squares: N4SID from the estimated state sequence,
    ``[x[t+1]; y[t]] = [A B; C D] [x[t]; u[t]]``; PO-MOESP from the shift invariance of the
-   observability matrix (``A``, ``C``) and a linear regression of the outputs on ``(x0, B, D)``.
+   observability matrix (``A``, ``C``) and a least-squares fit of ``(B, D)`` to the part of the
+   future outputs the future inputs explain, with the states projected out.
 
 :func:`arx` is the simple baseline: least squares on ``y[t] = sum_k a_k y[t-k] + b_k u[t-k]``.
 
@@ -139,15 +140,20 @@ def oblique_projection_factors(u: np.ndarray, y: np.ndarray, i: int) -> tuple[np
     L32 : ndarray, shape (R, p i, (m + p) i)
     L21 : ndarray, shape (R, (m + p) i, m i)
     """
+    L, a, b = _lq_of_windows(u, y, i)
+    return L[:, a:b, a:b], L[:, b:, a:b], L[:, a:b, :a]
+
+
+def _lq_of_windows(u: np.ndarray, y: np.ndarray, i: int) -> tuple[np.ndarray, int, int]:
+    """The whole lower factor ``L`` of ``[U_f; W_p; Y_f] / sqrt(j)`` and the first rows ``a``, ``b``
+    of ``W_p`` and ``Y_f`` (so ``L11 = L[:, :a, :a]``, ``L31 = L[:, b:, :a]``, ...)."""
     R, N, m = u.shape
     p = y.shape[2]
     j = N - 2 * i + 1
     Up, Uf = block_hankel(u, 0, i, j), block_hankel(u, i, i, j)
     Yp, Yf = block_hankel(y, 0, i, j), block_hankel(y, i, i, j)
     M = np.concatenate([Uf, Up, Yp, Yf], axis=1) / np.sqrt(j)
-    L = _lower_factor(M)
-    a, b = m * i, m * i + (m + p) * i
-    return L[:, a:b, a:b], L[:, b:, a:b], L[:, a:b, :a]
+    return _lower_factor(M), m * i, m * i + (m + p) * i
 
 
 def _lower_factor(M: np.ndarray) -> np.ndarray:
@@ -209,8 +215,8 @@ def _check_design(u: np.ndarray, y: np.ndarray, order: int | None, block_rows: i
 def _factor(u: Any, y: Any, order: int | None, block_rows: int | None) -> tuple[Any, ...]:
     u, y, single = _as_batch(u, y)
     i, order = _check_design(u, y, order, block_rows)
-    L22, L32, L21 = oblique_projection_factors(u, y, i)
-    return u, y, single, i, order, L22, L32, L21
+    L, a, b = _lq_of_windows(u, y, i)
+    return u, y, single, i, order, L, a, b
 
 
 def n4sid(
@@ -244,7 +250,8 @@ def n4sid(
     ParameterError
         If the data are too short for the windows or the order exceeds ``p i``.
     """
-    u, y, single, i, order, L22, L32, _ = _factor(u, y, order, block_rows)
+    u, y, single, i, order, L, a, b = _factor(u, y, order, block_rows)
+    L22, L32 = L[:, a:b, a:b], L[:, b:, a:b]
     N = u.shape[1]
     cols = N - i + 1
     W = np.concatenate([block_hankel(u, 0, i, cols), block_hankel(y, 0, i, cols)], axis=1)
@@ -266,26 +273,35 @@ def moesp(
 
     The first ``n`` left singular vectors of ``L32`` span the extended observability matrix
     ``Gamma_i = [C; C A; ...; C A^{i-1}]``; ``C`` is its first block row and ``A`` solves the shift
-    equation ``Gamma_i[:-p] A = Gamma_i[p:]`` by least squares. ``B``, ``D`` and the initial state
-    then enter the outputs linearly,
+    equation ``Gamma_i[:-p] A = Gamma_i[p:]`` by least squares. Where that ``A`` is stable,
+    ``B``, ``D`` and the initial state enter the outputs linearly,
     ``y[t] = C A^t x0 + sum_{k<t} C A^{t-1-k} B u[k] + D u[t]``, and are fitted by least squares
-    (Verhaegen and Verdult, Sec. 9.2.4 and 9.6). Parameters and returns as :func:`n4sid`.
+    over the whole run (Verhaegen and Verdult, Sec. 9.2.4). Where its spectral radius ``rho`` is
+    1 or more, that regression grows like ``rho^N`` (it swamped ``B``, which came out 0, or
+    overflowed); ``B`` and ``D`` then solve ``Gamma_perp^T L31 = Gamma_perp^T T_i(B, D) L11`` by
+    least squares (:func:`_input_matrices`), with ``Gamma_perp`` the remaining left singular
+    vectors and ``T_i`` the block Toeplitz matrix of ``D, C B, ..., C A^{i-2} B`` (Sec. 9.3 and
+    9.6), where no power of ``A`` above ``i - 2`` enters. Parameters and returns as :func:`n4sid`.
     """
-    u, y, single, i, order, _, L32, _ = _factor(u, y, order, block_rows)
+    u, y, single, i, order, L, a, b = _factor(u, y, order, block_rows)
     p = y.shape[2]
-    Us, s, _ = np.linalg.svd(L32, full_matrices=False)
+    Us, s, _ = np.linalg.svd(L[:, b:, a:b], full_matrices=False)
     n = order or select_order(s, max_order)
     if n > p * (i - 1):
         raise ParameterError(f"order = {n} needs block_rows >= {-(-n // p) + 1} for the shift equation (block_rows = {i})")
     G = Us[:, :, :n] * np.sqrt(s[:, None, :n])
     C = G[:, :p]
     A = _batched_lstsq(G[:, :-p], G[:, p:])
-    B, D = _input_matrices(u, y, A, C)
+    B, D = _input_matrices(Us[:, :, n:], L[:, :a, :a], L[:, b:, :a], A, C)
+    stable = np.max(np.abs(np.linalg.eigvals(A)), axis=1) < 1.0
+    if stable.any():
+        B[stable], D[stable] = _input_matrices_run(u[stable], y[stable], A[stable], C[stable])
     return _estimate(A, B, C, D, s, n, i, "moesp", single)
 
 
-def _input_matrices(u: np.ndarray, y: np.ndarray, A: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``B`` and ``D`` (and the initial state) by least squares on the output equation."""
+def _input_matrices_run(u: np.ndarray, y: np.ndarray, A: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``B`` and ``D`` (and the initial state) by least squares on the output equation over the
+    whole run (:func:`moesp`; only for estimates of ``A`` with spectral radius below 1)."""
     R, N, m = u.shape
     p, n = C.shape[1], C.shape[2]
     # regressor of y[t]: [C A^t | C Z_t | u[t]^T kron I_p], Z_{t+1} = A Z_t + u[t]^T kron I_n
@@ -304,6 +320,36 @@ def _input_matrices(u: np.ndarray, y: np.ndarray, A: np.ndarray, C: np.ndarray) 
     B = theta[:, n : n + n * m].reshape(R, m, n).transpose(0, 2, 1)  # vec(B): columns stacked
     D = theta[:, n + n * m :].reshape(R, m, p).transpose(0, 2, 1)
     return B, D
+
+
+def _input_matrices(
+    perp: np.ndarray, L11: np.ndarray, L31: np.ndarray, A: np.ndarray, C: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """``B`` and ``D`` minimising ``||perp^T (L31 - T_i(B, D) L11)||_F`` (:func:`moesp`).
+
+    ``Y_f = Gamma_i X_f + T_i U_f + noise`` with ``U_f = L11 Q1`` and ``Y_f Q1^T = L31``; ``perp``
+    (``(R, p i, q)``, orthonormal, ``perp^T Gamma_i = 0``) removes the states, and future noise is
+    uncorrelated with future inputs. ``T_i`` has ``D`` on its block diagonal and
+    ``C A^{r-c-1} B`` in block ``(r, c)``, ``r > c``: linear in ``(B, D)``, so the regressor is
+    built column by column of the unknowns.
+    """
+    R, p, n = C.shape
+    m = L11.shape[1] // (L31.shape[1] // p)
+    i = L31.shape[1] // p
+    P = perp.transpose(0, 2, 1)  # (R, q, p i)
+    obs = [C]
+    for _ in range(i - 2):
+        obs.append(obs[-1] @ A)  # C A^k, k = 0 .. i - 2
+    coef_B = np.zeros((R, P.shape[1], m * i, n, m))
+    coef_D = np.zeros((R, P.shape[1], m * i, p, m))
+    for r in range(i):
+        Pr = P[:, :, r * p : (r + 1) * p]
+        coef_D += np.einsum("Rqp,Rbk->Rqkpb", Pr, L11[:, r * m : (r + 1) * m])
+        for c in range(r):
+            coef_B += np.einsum("Rqp,Rpn,Rbk->Rqknb", Pr, obs[r - c - 1], L11[:, c * m : (c + 1) * m])
+    X = np.concatenate([coef_B.reshape(R, -1, n * m), coef_D.reshape(R, -1, p * m)], axis=2)
+    theta = _batched_lstsq(X, (P @ L31).reshape(R, -1, 1))[..., 0]
+    return theta[:, : n * m].reshape(R, n, m), theta[:, n * m :].reshape(R, p, m)
 
 
 def arx(u: Any, y: Any, na: int = 2, nb: int = 2) -> SubspaceEstimate:
@@ -327,7 +373,7 @@ def arx(u: Any, y: Any, na: int = 2, nb: int = 2) -> SubspaceEstimate:
     return _estimate(A, B, C, D, np.zeros((R, 0)), p * q, q, "arx", single)
 
 
-def arx_realisation(theta: np.ndarray, na: int, nb: int, p: int, m: int) -> tuple[np.ndarray, ...]:
+def arx_realisation(theta: np.ndarray, na: int, nb: int, p: int, m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``(A, B, C, D)`` of ARX coefficients in observer canonical form (block companion, order ``p max(na, nb)``).
 
     ``theta`` of shape ``(R, na p + nb m, p)`` stacks ``a_1^T .. a_na^T`` then ``b_1^T .. b_nb^T``

@@ -47,18 +47,25 @@ OUTPUT_ESTIMATORS = {
 OUTPUT_ATTACKS: tuple[str, ...] = ("gaussian", "prbs", "optimal-ol")
 
 
-def attack_inputs(plant: LinearPlant, attack: str, *, N: int, runs: int, sigma_u2: float, seed: Any) -> np.ndarray:
+def attack_inputs(
+    plant: LinearPlant, attack: str, *, N: int, runs: int, sigma_u2: float, seed: Any, design: Any = None
+) -> np.ndarray:
     """The inputs ``(runs, N, m)`` of an open-loop attack of :data:`OUTPUT_ATTACKS` other than
     ``"gaussian"`` (which :func:`~encctl_gym.sim.plant.simulate_gaussian_attack` draws), each of
-    average power ``sigma_u2`` per channel."""
+    average power ``sigma_u2`` per channel. ``"optimal-ol"`` plays ``design``, the open-loop
+    design of :func:`encctl_gym.security.attack_design.optimal_attack_design` (``feedback=False``)
+    at that ``sigma_u2`` (the simulator takes it given: the design is the security layer's)."""
     rng = np.random.default_rng(seed)
     m, n = plant.m, plant.n
     if attack == "prbs":
         return np.sqrt(sigma_u2) * (2.0 * rng.integers(0, 2, size=(runs, N, m)) - 1.0)
     if attack == "optimal-ol":
-        from ..security.attack_design import optimal_attack_design
-
-        d = optimal_attack_design(plant.A, plant.B, sigma_u2=sigma_u2, sigma_w2=plant.sigma_w2, feedback=False)
+        if design is None:
+            raise ParameterError(
+                "the optimal-ol attack plays a given design: pass design=optimal_attack_design(A, B, "
+                "sigma_u2=..., sigma_w2=..., feedback=False) (encctl_gym.security.attack_design)"
+            )
+        d = design
         Lv = np.linalg.cholesky(d.V + 1e-15 * np.eye(m))
         S = d.input_state_cov if d.input_state_cov is not None else np.zeros((n, n))
         w, V = np.linalg.eigh(S)
@@ -84,6 +91,7 @@ def output_attack_errors(
     order: int | None = None,
     markov_length: int = 20,
     attack: str = "gaussian",
+    design: Any = None,
 ) -> dict[str, np.ndarray]:
     """Errors of ``runs`` attacks identified from outputs, on a grid of sample sizes.
 
@@ -111,6 +119,8 @@ def output_attack_errors(
     attack : str
         The attack's inputs (:data:`OUTPUT_ATTACKS`; default the paper's Gaussian attack, whose
         trajectories are :func:`~encctl_gym.sim.plant.simulate_gaussian_attack`'s).
+    design : AttackDesign, optional
+        The open-loop design ``"optimal-ol"`` plays (:func:`attack_inputs`).
 
     Returns
     -------
@@ -146,7 +156,7 @@ def output_attack_errors(
         sim = simulate_gaussian_attack(plant, N=int(grid[-1]), runs=runs, sigma_u2=sigma_u2, seed=traj_seed)
     else:
         input_seed, plant_seed = traj_seed.spawn(2)
-        u = attack_inputs(plant, attack, N=int(grid[-1]), runs=runs, sigma_u2=sigma_u2, seed=input_seed)
+        u = attack_inputs(plant, attack, N=int(grid[-1]), runs=runs, sigma_u2=sigma_u2, seed=input_seed, design=design)
         sim = simulate(plant, u, plant_seed)
     rng = np.random.default_rng(noise_seed)
     y = sim.states @ C.T + np.sqrt(sv) * rng.normal(size=(runs, sim.N, C.shape[0]))
