@@ -86,6 +86,7 @@ def elgamal_seconds_per_step(steps: int) -> float:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Measure and print every figure; with ``--record`` write them for the README table."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer steps (a smoke test)")
     parser.add_argument("--record", action="store_true", help="record the figures for the README table")
@@ -95,6 +96,33 @@ def main(argv: list[str] | None = None) -> int:
     repeats = 1 if args.quick else 5
     num_envs = 1024
 
+    best, our_acts, vec_acts = _throughput(n_single, n_vec, repeats, num_envs)
+    our_sps, pend_sps, vec_sps, one_sps, par_sps = best["ours"], best["pend"], best["vec"], best["one"], best["par"]
+    print(f"single env (ideal, paper-example)  : {our_sps:12,.0f} steps/s")
+    print(f"Pendulum-v1 (same wrappers)         : {pend_sps:12,.0f} steps/s")
+    print(f"ratio ours / Pendulum               : {our_sps / pend_sps:12.2f}   (target >= 1)")
+    print(f"vector env, {num_envs} copies (default)   : {vec_sps:12,.0f} env-steps/s  ({n_vec} steps a pass)")
+    print(f"ratio vector / single               : {vec_sps / our_sps:12.1f}   (target >= 50)")
+    print(f"  the same on one thread            : {one_sps:12,.0f} env-steps/s  (helper_thread=False)")
+    print(f"  ratio one-thread vector / single  : {one_sps / our_sps:12.1f}")
+    print(f"  parallel=True (all cores)         : {par_sps:12,.0f} env-steps/s")
+    print(f"  ratio parallel vector / single    : {par_sps / our_sps:12.1f}")
+
+    est_rows = _estimator_rows(our_acts[: n_single // 4], vec_acts, num_envs, max(n_vec // 4, 16), our_sps, vec_sps)
+
+    floor = powmod_seconds(712)
+    per_step = elgamal_seconds_per_step(5 if args.quick else 30)
+    print(f"elgamal backend, 712 bits           : {per_step * 1e3:12.2f} ms/step")
+    print(f"one gmpy2.powmod at 712 bits        : {floor * 1e6:12.1f} us")
+    print(f"step / powmod (crypto floor)        : {per_step / floor:12.1f}")
+    if args.record:
+        _record(best, per_step, floor, est_rows, num_envs, n_vec, argv)
+    return 0
+
+
+def _throughput(n_single: int, n_vec: int, repeats: int, num_envs: int) -> tuple[dict[str, float], np.ndarray, np.ndarray]:
+    """Best steps per second of ``Pendulum-v1``, the single environment and the vector
+    environment (helper thread, one thread, ``parallel=True``), and the actions played."""
     rng = np.random.default_rng(0)
     pend = gym.make("Pendulum-v1")
     ours = gym.make(ENV_ID, config=CONFIG)
@@ -121,22 +149,17 @@ def main(argv: list[str] | None = None) -> int:
     vector_steps_per_second(pvenv, vec_acts[:30])
     for _ in range(repeats):
         best["par"] = max(best["par"], vector_steps_per_second(pvenv, vec_acts))
-    our_sps, pend_sps, vec_sps, one_sps, par_sps = best["ours"], best["pend"], best["vec"], best["one"], best["par"]
-    print(f"single env (ideal, paper-example)  : {our_sps:12,.0f} steps/s")
-    print(f"Pendulum-v1 (same wrappers)         : {pend_sps:12,.0f} steps/s")
-    print(f"ratio ours / Pendulum               : {our_sps / pend_sps:12.2f}   (target >= 1)")
-    print(f"vector env, {num_envs} copies (default)   : {vec_sps:12,.0f} env-steps/s  ({n_vec} steps a pass)")
-    print(f"ratio vector / single               : {vec_sps / our_sps:12.1f}   (target >= 50)")
-    print(f"  the same on one thread            : {one_sps:12,.0f} env-steps/s  (helper_thread=False)")
-    print(f"  ratio one-thread vector / single  : {one_sps / our_sps:12.1f}")
-    print(f"  parallel=True (all cores)         : {par_sps:12,.0f} env-steps/s")
-    print(f"  ratio parallel vector / single    : {par_sps / our_sps:12.1f}")
+    return best, our_acts, vec_acts
 
+
+def _estimator_rows(
+    our_acts: np.ndarray, vec_acts: np.ndarray, num_envs: int, est_steps: int, our_sps: float, vec_sps: float
+) -> list[tuple[str, float, float]]:
+    """Steps per second of the estimators other than least squares, single and vector environment."""
     est_rows = []
-    est_steps = max(n_vec // 4, 16)
     for est in ("bayes", "forgetting", "iv"):
         cfg = {**CONFIG, "estimator": est}
-        single = steps_per_second(gym.make(ENV_ID, config=cfg), our_acts[: n_single // 4])
+        single = steps_per_second(gym.make(ENV_ID, config=cfg), our_acts)
         vec = EncryptedLTIAttackVectorEnv(num_envs=num_envs, config=cfg)
         vector_steps_per_second(vec, vec_acts[:4])
         vsps = vector_steps_per_second(vec, vec_acts[:est_steps])
@@ -146,49 +169,55 @@ def main(argv: list[str] | None = None) -> int:
             f"estimator {est:<10}: single {single:10,.0f} steps/s ({single / our_sps:.2g}x ls), "
             f"vector {vsps:12,.0f} env-steps/s ({vsps / vec_sps:.2g}x ls)"
         )
+    return est_rows
 
-    floor = powmod_seconds(712)
-    per_step = elgamal_seconds_per_step(5 if args.quick else 30)
-    print(f"elgamal backend, 712 bits           : {per_step * 1e3:12.2f} ms/step")
-    print(f"one gmpy2.powmod at 712 bits        : {floor * 1e6:12.1f} us")
-    print(f"step / powmod (crypto floor)        : {per_step / floor:12.1f}")
-    if args.record:
-        from record import write
 
-        figures = {
-            "single_sps": our_sps,
-            "pendulum_sps": pend_sps,
-            "vector_sps": vec_sps,
-            "one_thread_sps": one_sps,
-            "parallel_sps": par_sps,
-            "elgamal_step_s": per_step,
-            "powmod_s": floor,
-        }
-        write(
-            "bench_env",
-            figures,
-            [
-                (
-                    "environment (ideal backend) vs `Pendulum-v1`, both through `gymnasium.make`",
-                    f"{our_sps / pend_sps:.2f}x the steps per second ({our_sps:,.0f} steps/s)",
-                ),
-                (
-                    f"native vector environment, {num_envs} copies, vs the single environment ({n_vec}-step passes)",
-                    f"{vec_sps / our_sps:.1f}x as constructed (helper thread); {one_sps / our_sps:.1f}x with `helper_thread=False`; "
-                    f"{par_sps / our_sps:.1f}x with `parallel=True`",
-                ),
-                (
-                    "environment step through real ElGamal at 712 bits",
-                    f"{per_step * 1e3:.2f} ms = {per_step / floor:.1f} powmod times",
-                ),
-                (
-                    "estimators other than least squares: steps per second, single env / vector env (their share of least squares')",
-                    "; ".join(f"`{e}` {s1:,.0f} ({s1 / our_sps:.2g}x) / {v:,.0f} ({v / vec_sps:.2g}x)" for e, s1, v in est_rows),
-                ),
-            ],
-            argv,
-        )
-    return 0
+def _record(
+    best: dict[str, float],
+    per_step: float,
+    floor: float,
+    est_rows: list[tuple[str, float, float]],
+    num_envs: int,
+    n_vec: int,
+    argv: list[str] | None,
+) -> None:
+    """Write the figures and the README rows (:func:`record.write`)."""
+    our_sps, pend_sps, vec_sps, one_sps, par_sps = best["ours"], best["pend"], best["vec"], best["one"], best["par"]
+    from record import write
+
+    figures = {
+        "single_sps": our_sps,
+        "pendulum_sps": pend_sps,
+        "vector_sps": vec_sps,
+        "one_thread_sps": one_sps,
+        "parallel_sps": par_sps,
+        "elgamal_step_s": per_step,
+        "powmod_s": floor,
+    }
+    write(
+        "bench_env",
+        figures,
+        [
+            (
+                "environment (ideal backend) vs `Pendulum-v1`, both through `gymnasium.make`",
+                f"{our_sps / pend_sps:.2f}x the steps per second ({our_sps:,.0f} steps/s)",
+            ),
+            (
+                f"native vector environment, {num_envs} copies, vs the single environment ({n_vec}-step passes)",
+                f"{vec_sps / our_sps:.1f}x as constructed (helper thread); {one_sps / our_sps:.1f}x with `helper_thread=False`; "
+                f"{par_sps / our_sps:.1f}x with `parallel=True`",
+            ),
+            (
+                "environment step through real ElGamal at 712 bits",
+                f"{per_step * 1e3:.2f} ms = {per_step / floor:.1f} powmod times",
+            ),
+            (
+                "estimators other than least squares: steps per second, single env / vector env (their share of least squares')",
+                "; ".join(f"`{e}` {s1:,.0f} ({s1 / our_sps:.2g}x) / {v:,.0f} ({v / vec_sps:.2g}x)" for e, s1, v in est_rows),
+            ),
+        ],
+        argv,
+    )
 
 
 if __name__ == "__main__":

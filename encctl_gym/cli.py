@@ -80,7 +80,9 @@ def build_parser(selected: str | None = None) -> argparse.ArgumentParser:
                     "(pip install 'encctl-gym[rl]')"
                 )
 
-            p.set_defaults(_run=_unavailable)
+            # its options are unknown without its module: whatever is given, the answer is the extra
+            p.set_defaults(_run=_unavailable, _missing_module=missing)
+            p.epilog = f"Not available here: the module {missing!r} is not installed (pip install 'encctl-gym[rl]')."
             continue
         module.add_arguments(p)
         p.set_defaults(_run=module.run)
@@ -93,7 +95,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     selected = next((a for a in args_list if a in SUBCOMMANDS), None)
     parser = build_parser(selected)
     args, unknown = parser.parse_known_args(args_list)
-    if unknown:
+    if unknown and not getattr(args, "_missing_module", None):
         _refuse_unknown(parser, getattr(args, "command", None), unknown)
     if not getattr(args, "_run", None):
         parser.print_help()

@@ -7,7 +7,9 @@ the two things they share:
 - :func:`layout_problems` measures a drawn figure: tick labels of one axis that overlap each other,
   text that falls outside the saved canvas, legends drawn over the data points of their axes, and
   curves cut away entirely by the axis limits.
-- :func:`save_figure` thins tick labels that would overlap (on a log axis spanning less than a
+- :func:`plain_log_ticks` labels a log axis spanning less than two decades with plain numbers at
+  1, 2 and 5 per decade (``1 2 5 10 20``) instead of matplotlib's lone ``10^1``.
+- :func:`save_figure` applies it, thins tick labels that would overlap (on a log axis spanning less than a
   decade matplotlib labels every minor tick: ``2x10^1 3x10^1 4x10^1 ...``), saves the PNG and
   warns with :class:`FigureLayoutWarning` for every problem that is left, so a figure that a
   reader cannot read is never saved silently. The test suite turns that warning into an error.
@@ -21,7 +23,12 @@ import warnings
 from pathlib import Path
 from typing import Any
 
-__all__ = ["FigureLayoutWarning", "layout_problems", "legend_below", "save_figure", "thin_tick_labels"]
+__all__ = ["FigureLayoutWarning", "layout_problems", "legend_below", "plain_log_ticks", "save_figure", "thin_tick_labels"]
+
+#: A log axis spanning fewer decades than this (and within :data:`_PLAIN_RANGE`) gets plain labels.
+_PLAIN_DECADES = 2.0
+#: The values whose plain spelling (``{v:g}``) is short.
+_PLAIN_RANGE = (1e-2, 1e5)
 
 #: Overlaps or overhangs smaller than this many pixels are rounding, not a problem.
 _SLACK_PX = 1.0
@@ -64,6 +71,27 @@ def _overlapping_pairs(labels: list[Any], renderer: Any) -> list[tuple[Any, Any]
 def _renderer(fig: Any) -> Any:
     fig.canvas.draw()
     return fig.canvas.get_renderer()
+
+
+def plain_log_ticks(fig: Any) -> None:
+    """Label every log axis of ``fig`` that spans less than :data:`_PLAIN_DECADES` decades within
+    :data:`_PLAIN_RANGE` at 1, 2 and 5 per decade with plain numbers (``5 10 20 50``); over such a
+    range matplotlib shows one power of ten or none (``10^1`` alone under a curve from 5 to 40).
+    Axes with a formatter of their own are left alone."""
+    import math
+
+    from matplotlib.ticker import FuncFormatter, LogFormatterSciNotation, LogLocator, NullFormatter
+
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            if axis.get_scale() != "log" or type(axis.get_major_formatter()) is not LogFormatterSciNotation:
+                continue
+            lo, hi = sorted(axis.get_view_interval())
+            if not (_PLAIN_RANGE[0] <= lo and hi <= _PLAIN_RANGE[1] and math.log10(hi / lo) < _PLAIN_DECADES):
+                continue
+            axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+            axis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v:g}"))
+            axis.set_minor_formatter(NullFormatter())
 
 
 def thin_tick_labels(fig: Any) -> None:
@@ -178,7 +206,9 @@ def _in_bbox(pts: Any, bbox: Any) -> Any:
 
 def save_figure(fig: Any, path: str | Path, *, dpi: int = 110, tight: bool = False) -> Path:
     """Thin overlapping tick labels, save ``fig`` as ``path`` and warn (:class:`FigureLayoutWarning`)
-    for each layout problem left (:func:`layout_problems`). Returns the path."""
+    for each layout problem left (:func:`layout_problems`), short log axes labelled with plain
+    numbers first (:func:`plain_log_ticks`). Returns the path."""
+    plain_log_ticks(fig)
     thin_tick_labels(fig)
     problems = layout_problems(fig, tight=tight)
     path = Path(path)

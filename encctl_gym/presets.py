@@ -110,21 +110,6 @@ class SystemPreset:
 
         return Plant(self.A, self.B, C=self.C, sigma_v2=self.sigma_v2)
 
-    def threat(self, cost_model: Any = "paper") -> Any:
-        """The preset's variances and design parameters as a
-        :class:`~encctl_gym.security.threat.ThreatModel` (under ``cost_model``)."""
-        from .security.threat import ThreatModel
-
-        return ThreatModel(
-            sigma_u2=self.sigma_u2,
-            sigma_w2=self.sigma_w2,
-            sigma_x2=self.sigma_x2,
-            gamma_c=self.gamma_c,
-            tau_c=self.tau_c,
-            upsilon=self.upsilon,
-            cost_model=cost_model,
-        )
-
 
 def _diag_system(a: float, b: float, n: int = 4) -> tuple[np.ndarray, np.ndarray]:
     return a * np.eye(n), b * np.eye(n)

@@ -28,7 +28,16 @@ import numpy as np
 from encctl_gym.errors import ParameterError
 from encctl_gym.plotting import save_figure
 
-__all__ = ["LpFit", "fit_lp_half", "lp_half_exponent", "model_curves", "plot_models", "format_lp_fits", "FIT_MIN_BITS"]
+__all__ = [
+    "LpFit",
+    "fit_lp_half",
+    "lp_half_exponent",
+    "model_curves",
+    "plot_models",
+    "sequence_ratio",
+    "format_lp_fits",
+    "FIT_MIN_BITS",
+]
 
 #: Smallest bit length in the L_p[1/2, c] fit.
 FIT_MIN_BITS = 64
@@ -194,7 +203,8 @@ def _first_key_panel(
     ax: Any, fits: Sequence[dict[str, Any]], curves: dict[str, dict[str, np.ndarray]], grid_bits: np.ndarray
 ) -> None:
     # T_first against the bit length: the measured points, the L_p[1/2, c] fits (with the band of
-    # the interval of c, a at its fit), the index calculus's own calibrated cost model (seconds),
+    # the interval of c, a at its fit), the index calculus's own cost model in seconds at its
+    # documented constants (the estimates of ``crack`` also time lattices of the group: not here),
     # and the shapes of the package's deciphering-cost models, scaled to the index calculus's
     # first measured size in range (they count operations, not seconds).
     from encctl_gym.cryptanalysis.index_calculus import choose_bound, cost_model
@@ -216,8 +226,11 @@ def _first_key_panel(
     if ic:
         lo_bits = max(int(grid_bits[0]), 24)
         b = np.arange(lo_bits, int(grid_bits[-1]) + 1)
-        ax.semilogy(b, [cost_model(int(k), choose_bound(int(k)))["first"] for k in b], color="tab:blue", ls="-.", lw=1.0,
-                    label="index-calculus cost model (calibrated seconds)")  # fmt: skip
+        model = [cost_model(int(k), choose_bound(int(k)))["first"] for k in b]
+        ax.semilogy(b, model, color="tab:blue", ls="-.", lw=1.0,
+                    label="index-calculus cost model (documented constants)")  # fmt: skip
+        # the model at the measured sizes stays inside the axes, however fast this machine is
+        measured += [m for k, m in zip(b, model) if any(int(f["bits"]) == int(k) for f in ic) and m > 0]
         anchor = next((f for f in ic if f["bits"] >= FIT_MIN_BITS), ic[-1])
         for name, (color, ls) in _STYLES.items():
             first = curves[name]["first"]
@@ -226,13 +239,28 @@ def _first_key_panel(
                 continue  # the precomputation model's first key is the paper's
             ax.semilogy(grid_bits, anchor["T_first"] * np.exp2(first - first[at]), color=color, ls=ls, lw=1.2,
                         label=f"model {name}: shape, scaled at {anchor['bits']} bits")  # fmt: skip
-    if measured:  # the models' shapes leave the measured range quickly: keep the data readable
-        ax.set_ylim(min(measured) / 10, max(measured) * 100)
+    if measured:  # the models' shapes leave the measured range quickly: keep the data (and the IC model) readable
+        ax.set_ylim(min(measured) / 3, max(measured) * 30)  # room above for the legend
     ax.set_xlabel("bit length of $p$")
     ax.set_ylabel("first key $T_{first}$ (CPU seconds)")
     ax.set_title(r"one key from scratch: measured, fitted $L_p[1/2, c]$ and the cost models", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, ncol=2, frameon=False)
+
+
+def sequence_ratio(rows: Sequence[dict[str, Any]], breaker: str, bits: int) -> tuple[np.ndarray, np.ndarray]:
+    """``N`` and ``tau(N) / tau(1)`` of the breaker's key sequence at ``bits``: ``T_first`` is the
+    first key of the same sequence (its precomputation and key 1), not the mean first key of the
+    fresh groups (:func:`experiments.deciphering_time.fit`), so every curve starts at 1. Empty
+    without a row at ``N = 1``."""
+    seq = sorted(
+        (r for r in rows if r["breaker"] == breaker and int(r["bits"]) == bits and r["kind"] == "sequence"),
+        key=lambda r: int(r["N"]),
+    )
+    if not seq or int(seq[0]["N"]) != 1:
+        return np.zeros(0, dtype=int), np.zeros(0)
+    n = np.array([int(r["N"]) for r in seq])
+    return n, np.array([float(r["tau"]) for r in seq]) / float(seq[0]["tau"])
 
 
 def plot_models(
@@ -244,7 +272,8 @@ def plot_models(
     Top: the first key's CPU time against the bit length, measured, the :func:`fit_lp_half` fits
     and the cost models. Bottom left: ``T_1 / T_first`` against the bit length, measured per
     breaker (markers) and predicted by the ``paper``, ``precomputation`` and ``generic`` models
-    (lines). Bottom right: ``tau(N) / T_first`` of each breaker's largest size against N, with the
+    (lines). Bottom right: ``tau(N) / T_first`` of each breaker's largest size against N, ``T_first``
+    being ``tau(1)`` of the same sequence (so every curve starts at 1), with the
     models' ``tau(N) / T_first`` at ``model_bits``. The ratios compare directly; the first key's
     models count operations and are drawn as shapes only.
     """
@@ -268,12 +297,10 @@ def plot_models(
         ratio = np.array([f["ratio"] for f in mine])
         ax1.semilogy([f["bits"] for f in mine], np.where(ratio > 0, ratio, np.nan), "o", ms=5, label=f"measured: {breaker}")
         bits = max(f["bits"] for f in mine)
-        t_first = next(f["T_first"] for f in mine if f["bits"] == bits)
-        seq = sorted(
-            (r for r in rows if r["breaker"] == breaker and int(r["bits"]) == bits and r["kind"] == "sequence"),
-            key=lambda r: int(r["N"]),
-        )
-        ax2.loglog([int(r["N"]) for r in seq], [float(r["tau"]) / t_first for r in seq], "o-", ms=3, lw=1.2,
+        n, ratio = sequence_ratio(rows, breaker, bits)
+        if not n.size:
+            continue
+        ax2.loglog(n, ratio, "o-", ms=3, lw=1.2,
                    label=f"{breaker}, {bits} bits")  # fmt: skip
     for name, (color, ls) in _STYLES.items():
         if name not in curves:

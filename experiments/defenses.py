@@ -31,7 +31,7 @@ Figure 1 (c) (``fig1-c``):
   against every attacker at attack powers ``sigma_u2 / sigma_w2`` in :data:`ENERGY_RATIOS`
   (``defenses_detection.md`` and the figure ``defenses_detection.png``).
 
-    python -m encctl_gym.experiments.defenses [--measure] [--ars RUN_DIR] [--delays] [--rotation] [--elgamal] [--episodes 20] [--out results/defenses] [--figures figures]
+    python -m encctl_gym.experiments.defenses [--measure] [--ars RUN_DIR] [--delays] [--rotation] [--elgamal] [--episodes 20] [--out results/defenses] [--figures DIR]
 
 Prints the tables and writes them as ``defenses_analytic.md`` (and ``defenses_measured.md``,
 ``defenses_rotation.md``, ``defenses_elgamal.md``, ``defenses_ars.md``).
@@ -62,6 +62,7 @@ from encctl_gym.experiments.defenses_rotation import format_rotation, rotation_r
 from encctl_gym.loop.backend import lqr_gain
 from encctl_gym.presets import get_preset
 from encctl_gym.security.defenses import minimum_audit_rate, noise_defense_design, noise_defense_price
+from encctl_gym.security.threat import ThreatModel
 
 SYSTEMS = ("paper-example", "fig1-c")
 DELTAS = (1e-2, 1e-3, 1e-6)
@@ -74,7 +75,7 @@ def noise_rows() -> list[dict[str, float | int | str]]:
         p = get_preset(system)
         Phi = -lqr_gain(p.A, p.B)
         for label, sd in (("0", 0.0), ("sigma_w2", p.sigma_w2), ("10 sigma_w2", 10 * p.sigma_w2), ("sigma_u2", p.sigma_u2)):
-            d = noise_defense_design(p.plant(), p.threat(), sigma_d2=sd)
+            d = noise_defense_design(p.plant(), ThreatModel.of(p), sigma_d2=sd)
             price = noise_defense_price(p.A, p.B, Phi, sigma_w2=p.sigma_w2, sigma_d2=sd)
             rows.append(
                 {
@@ -238,17 +239,54 @@ def plot_delays(rows: list[dict[str, Any]], path: Path) -> Path:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """``python -m encctl_gym.experiments.defenses``: compute the tables asked for, then write them."""
+    args = _parser().parse_args(argv)
+    if not _check_args(args):
+        return 2
+    from encctl_gym.experiments.defenses_elgamal import ars_rows, elgamal_rows
+
+    try:
+        noise = noise_rows()
+        text = format_tables(noise, audit_rows(noise))
+        measured = [r for system in SYSTEMS for r in measure(system, args.episodes, args.seed)] if args.measure else []
+        ars = ars_rows(args.ars, "paper-example", episodes=args.episodes, seed=args.seed) if args.ars is not None else []
+        rotation = rotation_rows(args.rotation_samples, args.seed) if args.rotation else None
+        elgamal = (
+            elgamal_rows(samples=args.elgamal_samples, episodes=args.elgamal_episodes, seed=args.seed) if args.elgamal else None
+        )
+        delays = [r for system in SYSTEMS for r in detection_delays(system, args.episodes, args.seed)] if args.delays else []
+    except EncctlError as exc:
+        print(f"defenses: {exc}", file=sys.stderr)
+        return 2
+    _write_tables(args, text, measured, rotation, ars, elgamal, delays)
+    return 0
+
+
+def _parser() -> argparse.ArgumentParser:
+    """The options of ``python -m encctl_gym.experiments.defenses``."""
     parser = argparse.ArgumentParser(prog="python -m encctl_gym.experiments.defenses", description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path("results/defenses"))
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=Path("results/defenses"),
+        help="directory of the Markdown pages (default results/defenses; the recorded ones: docs/results/defenses)",
+    )
     parser.add_argument(
         "--measure", action="store_true", help="also measure every defender against every attacker in the environment"
     )
     parser.add_argument(
         "--delays", action="store_true", help="also measure the detectors' delay against the attack power (table and figure)"
     )
-    parser.add_argument("--figures", type=Path, default=Path("figures"), help="directory of the detection-delay figure")
+    parser.add_argument(
+        "--figures", type=Path, default=None, help="directory of the detection-delay figure (default: the --out directory)"
+    )
     parser.add_argument("--episodes", type=int, default=20, help="episodes per defender and attacker (default 20)")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="seed (default 0): episode e of a measured row plays seed + e; also the crypto_seed of the ElGamal and rotation rows",
+    )
     parser.add_argument(
         "--rotation", action="store_true", help="also the group-rotation tables (real ElGamal and a breaker at 64 bits)"
     )
@@ -268,35 +306,39 @@ def main(argv: list[str] | None = None) -> int:
         metavar="RUN_DIR",
         help="also a trained ARS run against every defender (design example, ideal backend)",
     )
-    args = parser.parse_args(argv)
+    return parser
+
+
+def _check_args(args: argparse.Namespace) -> bool:
+    """False (after one line on stderr) when a count is out of range."""
     if args.episodes < 1:
         print(f"defenses: --episodes must be >= 1, got {args.episodes}", file=sys.stderr)
-        return 2
+        return False
     if args.elgamal_episodes < 1 or args.elgamal_samples < 9:
         print(
             f"defenses: --elgamal-episodes must be >= 1 and --elgamal-samples >= 9 (n + m + 1), got "
             f"{args.elgamal_episodes} and {args.elgamal_samples}",
             file=sys.stderr,
         )
-        return 2
+        return False
     if args.rotation_samples < 9:
         print(f"defenses: --rotation-samples must be >= 9 (n + m + 1), got {args.rotation_samples}", file=sys.stderr)
-        return 2
-    from encctl_gym.experiments.defenses_elgamal import ars_rows, elgamal_rows, format_elgamal
+        return False
+    return True
 
-    try:
-        noise = noise_rows()
-        text = format_tables(noise, audit_rows(noise))
-        measured = [r for system in SYSTEMS for r in measure(system, args.episodes, args.seed)] if args.measure else []
-        ars = ars_rows(args.ars, "paper-example", episodes=args.episodes, seed=args.seed) if args.ars is not None else []
-        rotation = rotation_rows(args.rotation_samples, args.seed) if args.rotation else None
-        elgamal = (
-            elgamal_rows(samples=args.elgamal_samples, episodes=args.elgamal_episodes, seed=args.seed) if args.elgamal else None
-        )
-        delays = [r for system in SYSTEMS for r in detection_delays(system, args.episodes, args.seed)] if args.delays else []
-    except EncctlError as exc:
-        print(f"defenses: {exc}", file=sys.stderr)
-        return 2
+
+def _write_tables(
+    args: argparse.Namespace,
+    text: str,
+    measured: list[dict[str, Any]],
+    rotation: dict[str, list[dict[str, Any]]] | None,
+    ars: list[dict[str, Any]],
+    elgamal: Any,
+    delays: list[dict[str, Any]],
+) -> None:
+    """Write the pages asked for under ``--out`` (and the detection-delay figure under ``--figures``)."""
+    from encctl_gym.experiments.defenses_elgamal import format_elgamal
+
     args.out.mkdir(parents=True, exist_ok=True)
     cmd = "python -m encctl_gym.experiments.defenses"
     write_recorded_table(args.out / "defenses_analytic.md", "The defender's levers in closed form", cmd, text)
@@ -343,9 +385,9 @@ def main(argv: list[str] | None = None) -> int:
             format_delays(delays),
             f" (seed {args.seed}; decipher_delay = 0, ideal backend, attacks of at most 2000 steps)",
         )
-        args.figures.mkdir(parents=True, exist_ok=True)
-        print(f"  wrote {plot_delays(delays, args.figures / 'defenses_detection.png')}")
-    return 0
+        figures = args.out if args.figures is None else args.figures
+        figures.mkdir(parents=True, exist_ok=True)
+        print(f"  wrote {plot_delays(delays, figures / 'defenses_detection.png')}")
 
 
 if __name__ == "__main__":

@@ -73,7 +73,7 @@ def compute() -> list[tuple[str, SecurityDesign]]:
         and ``("plant paper-example, eq:sic2", ...)``.
     """
     p = get_preset("paper-example")
-    plant = design_security_parameter(p.plant(), p.threat())
+    plant = design_security_parameter(p.plant(), ThreatModel.of(p))
     return [
         ("traces, eq:sic2 (paper)", paper_design_example("asymptotic")),
         ("traces, eq:sic", paper_design_example("exact")),

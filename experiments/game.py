@@ -21,9 +21,12 @@ at every other step):
   mean), one panel per side.
 
     python -m encctl_gym.experiments.game [--N 128] [--episodes 30] [--steps 20000] [--rounds 2] [--algo ppo]
-        [--out docs/results/game] [--figure docs/figures/game_learning_curves_ALGO.png]
+        [--out results/game] [--figure FILE] [--record]
 
-Writes ``game_ALGO.md`` (the tables), ``game_ALGO_cells.csv`` (one row per cell) and the figure.
+Writes ``game_ALGO.md`` (the tables), ``game_ALGO_cells.csv`` (one row per cell) and the figure
+``game_learning_curves_ALGO.png`` under ``--out`` (default ``results/game``). ``--record`` writes
+the recorded pages of the documentation instead: the tables under ``docs/results/game`` and the
+figure under ``docs/figures`` (an explicit ``--out`` or ``--figure`` still wins).
 
 **Static only** (``--static-only``, no training): the static defenders with the rotate lever on
 (group rotation every ``K`` of :data:`ROTATION_PERIODS` steps, the chi-squared detector's audit
@@ -32,9 +35,9 @@ optimal design, pass-through, sparse Gaussian), under ``--deciphering-model`` (d
 ``precomputation``: the attacker pays one precomputation per group it meets, charged by the
 game's :class:`~encctl_gym.multiagent.clock.GroupClock`, so rotation shortens its attack; under
 the paper's model every key costs the same and rotation changes nothing). Writes
-``game_static.md`` and ``game_static_cells.csv``.
+``game_static.md`` and ``game_static_cells.csv`` (under ``--out``, or ``docs/results/game`` with ``--record``).
 
-    python -m encctl_gym.experiments.game --static-only [--N 128] [--episodes 30]
+    python -m encctl_gym.experiments.game --static-only [--N 128] [--episodes 30] [--record]
 """
 
 from __future__ import annotations
@@ -72,6 +75,12 @@ from encctl_gym.experiments.compare.statistics import wilson_interval
 from encctl_gym.experiments.identification_strategies import replicate_interval
 from encctl_gym.multiagent import GameRules
 from encctl_gym.plotting import legend_below, save_figure
+
+#: Default output directory (untracked results).
+OUT_DIR = "results/game"
+#: Where ``--record`` writes the tables, and the figure.
+RECORDED_OUT_DIR = "docs/results/game"
+RECORDED_FIGURE_DIR = "docs/figures"
 
 METRICS = (
     ("epsilon", "the attacker's final error epsilon"),
@@ -215,7 +224,7 @@ def run_static(args: argparse.Namespace) -> int:
         "# The game's static defenders with group rotation (recorded by experiments/game.py --static-only)",
         "",
         f"Command: `python -m encctl_gym.experiments.game --static-only --N {args.N} --episodes {args.episodes} "
-        f"--deciphering-model {args.deciphering_model}{key} --seed {args.seed}` ({time.time() - t0:.0f} s).",
+        f"--deciphering-model {args.deciphering_model}{key} --seed {args.seed}{_record_flag(args)}` ({time.time() - t0:.0f} s).",
         "",
         f"Plant `{args.preset}`, ideal backend, {params.key_length}-bit groups, `deciphering_model = {args.deciphering_model}`: "
         f"one key costs {float(c.next):.3g} operations, the first key of a group {float(c.first):.3g} (its precomputation), "
@@ -229,7 +238,7 @@ def run_static(args: argparse.Namespace) -> int:
     body = [metric_table(k, title, rows, cols, cells) for k, title in METRICS]
     text = "\n".join(header) + "\n\n" + "\n\n".join(body) + "\n"
     print(text)
-    out = ensure_out_dir(args.out)
+    out = ensure_out_dir(out_dir(args))
     md, cells_csv = out / "game_static.md", out / "game_static_cells.csv"
     md.write_text(text)
     write_cells(cells_csv, cells)
@@ -291,7 +300,8 @@ def run(args: argparse.Namespace) -> int:
         "# The attacker-defender game (recorded by experiments/game.py)",
         "",
         f"Command: `python -m encctl_gym.experiments.game --N {args.N} --episodes {args.episodes} --steps {args.steps} "
-        f"--rounds {args.rounds} --algo {args.algo} --seed {args.seed}` ({t_train:.0f} s of training, {time.time() - t0:.0f} s in all).",
+        f"--rounds {args.rounds} --algo {args.algo} --seed {args.seed}{_record_flag(args)}` ({t_train:.0f} s of training, "
+        f"{time.time() - t0:.0f} s in all).",
         "",
         f"Plant `{args.preset}`, attacks of N = {args.N} samples (deciphering budget), ideal backend; rules: audit_cost = {r.audit_cost}, "
         f"audit_budget = {r.audit_budget}, noise_max = sigma_u2 = {params.sigma_u2:g}, noise_weight = {r.noise_weight}, "
@@ -312,11 +322,11 @@ def run(args: argparse.Namespace) -> int:
     body = [metric_table(key, title, rows, cols, cells) for key, title in METRICS]
     text = "\n".join(header) + "\n\n" + "\n\n".join(body) + "\n"
     print(text)
-    out = ensure_out_dir(args.out)
+    out = ensure_out_dir(out_dir(args))
     md, cells_csv = out / f"game_{args.algo}.md", out / f"game_{args.algo}_cells.csv"
     md.write_text(text)
     write_cells(cells_csv, cells)
-    fig = plot_curves(curves, args.figure or f"docs/figures/game_learning_curves_{args.algo}.png")
+    fig = plot_curves(curves, figure_path(args))
     print(f"wrote {md}, {cells_csv} and {fig}")
     return 0
 
@@ -332,13 +342,42 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--rounds", type=positive("rounds"), default=2)
     parser.add_argument("--algo", choices=("ppo", "ars"), default="ppo")
     parser.add_argument("--seed", type=_checked(lambda t: check_int("seed", int(t), minimum=0), "seed"), default=0)
-    parser.add_argument("--out", default="docs/results/game")
+    parser.add_argument("--out", default=None, help=f"output directory (default {OUT_DIR}; with --record {RECORDED_OUT_DIR})")
+    parser.add_argument(
+        "--record",
+        action="store_true",
+        help=f"write the documentation's recorded pages ({RECORDED_OUT_DIR}, the figure under {RECORDED_FIGURE_DIR})",
+    )
     parser.add_argument("--static-only", action="store_true", help="the static table with rotation, no training")
     parser.add_argument("--deciphering-model", default="precomputation", help="with --static-only (default: precomputation)")
     parser.add_argument(
         "--key-length", type=_checked(lambda t: check_int("key_length", int(t), minimum=16), "key_length"), default=None
     )
-    parser.add_argument("--figure", default=None, help="default: docs/figures/game_learning_curves_ALGO.png")
+    parser.add_argument(
+        "--figure",
+        default=None,
+        help=f"learning-curve figure (default OUT/game_learning_curves_ALGO.png; with --record under {RECORDED_FIGURE_DIR})",
+    )
+
+
+def out_dir(args: argparse.Namespace) -> str:
+    """``--out``, else the recorded directory with ``--record``, else :data:`OUT_DIR`."""
+    return args.out or (RECORDED_OUT_DIR if args.record else OUT_DIR)
+
+
+def figure_path(args: argparse.Namespace) -> str:
+    """``--figure``, else ``game_learning_curves_ALGO.png`` under the recorded figures with
+    ``--record`` (and no ``--out``), else under the output directory."""
+    name = f"game_learning_curves_{args.algo}.png"
+    if args.figure:
+        return str(args.figure)
+    if args.record and not args.out:
+        return f"{RECORDED_FIGURE_DIR}/{name}"
+    return f"{out_dir(args)}/{name}"
+
+
+def _record_flag(args: argparse.Namespace) -> str:
+    return " --record" if args.record else ""
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -134,62 +134,28 @@ def plot(result: Result, out: Path) -> list[Path]:
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     labels = [e.label for e in result.estimators]  # type: ignore[attr-defined]
     color = {lab: colors[i % len(colors)] for i, lab in enumerate(labels)}
+    return [_plot_errors(plt, result, color, out), _plot_ratios(plt, result, color, out)]
+
+
+def _plot_errors(plt: Any, result: Result, color: dict[str, str], out: Path) -> Path:
+    """``identification_strategies.png``: each estimator's error against N, a panel per system
+    and attacker."""
     by = {s.system: s for s in result.settings}
-    paths = []
     fig, axes, systems, attackers = _grid_axes(plt, result)
     for i, system in enumerate(systems):
-        s = by[system]
         for j, att in enumerate(attackers):
             ax = axes[i, j]
             cs = [c for c in result.curves[system] if c.attacker == att]
             if not cs:
                 ax.axis("off")
                 continue
-            N = cs[0].N
-            Nl = np.unique(np.round(np.geomspace(N[0], N[-1], 200)).astype(int))
-            for c in cs:
-                mean, se = c.mean, c.se
-                ok = np.isfinite(mean)
-                top = c.estimator == "ls"  # the paper's estimator on top of the others
-                # where the mean does not exist or is unreliable: the median (open marker), no band
-                sms = c.summaries
-                bare = np.array([sm is not None and not sm.mean_ok for sm in sms])
-                med = np.array([sm.median if sm is not None else np.nan for sm in sms])
-                y = np.where(bare, med, mean)
-                ax.plot(
-                    c.N[ok],
-                    y[ok],
-                    color=color[c.estimator],
-                    lw=2.0 if top else 1.2,
-                    marker="o",
-                    ms=2,
-                    label=c.estimator,
-                    zorder=3 if top else 2,
-                    ls="--" if top else "-",
-                )
-                if bare.any():
-                    ax.plot(c.N[bare], med[bare], ls="none", marker="o", ms=5, mfc="none", color=color[c.estimator], zorder=4)
-                band = ok & ~bare
-                lo = np.maximum(mean - 1.96 * se, 0.05 * mean)
-                ax.fill_between(c.N[band], lo[band], (mean + 1.96 * se)[band], color=color[c.estimator], alpha=0.2, lw=0)
-            ax.plot(Nl, s.params.gamma(Nl), "k--", lw=1.0, label="gamma(N), eq:sic")
-            ax.plot(Nl, s.design.gamma(Nl), "k:", lw=1.4, label="gamma_opt(N)")
-            ax.set(xscale="log", yscale="log")
-            ax.grid(True, which="major", alpha=0.3)
+            _error_panel(ax, by[system], cs, color)
             if i == 0:
                 ax.set_title(f"{att}{' (oracle)' if cs[0].oracle else ''}", fontsize=9)
             if j == 0:
                 ax.set_ylabel(f"{system}\nE[eps(N)]", fontsize=9)
             if i == len(systems) - 1:
                 ax.set_xlabel("attack length N", fontsize=9)
-            shown = [
-                np.array([(sm.mean if sm.mean_ok else sm.median) if sm is not None else np.nan for sm in c.summaries]) for c in cs
-            ]
-            lo_y = float(np.nanmin([np.nanmin(v) for v in shown] + [float(np.min(s.design.gamma(Nl)))]))
-            hi_y = float(np.nanmax([np.nanmax(v[np.isfinite(v)]) if np.isfinite(v).any() else lo_y for v in shown]))
-            ax.set_ylim(0.5 * lo_y, 2.0 * max(hi_y, lo_y))
-            if 0.5 * lo_y <= s.base.gamma_c <= 2.0 * max(hi_y, lo_y):  # short runs end above gamma_c
-                ax.axhline(s.base.gamma_c, color="0.5", lw=0.7, ls="-.", label="gamma_c")
     bottom = legend_below(fig, axes)
     E = result.curves[systems[0]][0].errors.shape[0]
     fig.suptitle(
@@ -206,8 +172,53 @@ def plot(result: Result, out: Path) -> list[Path]:
     path = out / "identification_strategies.png"
     save_figure(fig, path, dpi=100)
     plt.close(fig)
-    paths.append(path)
+    return path
 
+
+def _error_panel(ax: Any, s: Any, cs: Sequence[Curve], color: dict[str, str]) -> None:
+    """One panel: each estimator's mean (the median, open markers, where the mean does not exist
+    or is unreliable) with its 95 % band, ``gamma(N)``, ``gamma_opt(N)`` and ``gamma_c`` in range."""
+    N = cs[0].N
+    Nl = np.unique(np.round(np.geomspace(N[0], N[-1], 200)).astype(int))
+    for c in cs:
+        mean, se = c.mean, c.se
+        ok = np.isfinite(mean)
+        top = c.estimator == "ls"  # the paper's estimator on top of the others
+        # where the mean does not exist or is unreliable: the median (open marker), no band
+        sms = c.summaries
+        bare = np.array([sm is not None and not sm.mean_ok for sm in sms])
+        med = np.array([sm.median if sm is not None else np.nan for sm in sms])
+        y = np.where(bare, med, mean)
+        ax.plot(
+            c.N[ok],
+            y[ok],
+            color=color[c.estimator],
+            lw=2.0 if top else 1.2,
+            marker="o",
+            ms=2,
+            label=c.estimator,
+            zorder=3 if top else 2,
+            ls="--" if top else "-",
+        )
+        if bare.any():
+            ax.plot(c.N[bare], med[bare], ls="none", marker="o", ms=5, mfc="none", color=color[c.estimator], zorder=4)
+        band = ok & ~bare
+        lo = np.maximum(mean - 1.96 * se, 0.05 * mean)
+        ax.fill_between(c.N[band], lo[band], (mean + 1.96 * se)[band], color=color[c.estimator], alpha=0.2, lw=0)
+    ax.plot(Nl, s.params.gamma(Nl), "k--", lw=1.0, label="gamma(N), eq:sic")
+    ax.plot(Nl, s.design.gamma(Nl), "k:", lw=1.4, label="gamma_opt(N)")
+    ax.set(xscale="log", yscale="log")
+    ax.grid(True, which="major", alpha=0.3)
+    shown = [np.array([(sm.mean if sm.mean_ok else sm.median) if sm is not None else np.nan for sm in c.summaries]) for c in cs]
+    lo_y = float(np.nanmin([np.nanmin(v) for v in shown] + [float(np.min(s.design.gamma(Nl)))]))
+    hi_y = float(np.nanmax([np.nanmax(v[np.isfinite(v)]) if np.isfinite(v).any() else lo_y for v in shown]))
+    ax.set_ylim(0.5 * lo_y, 2.0 * max(hi_y, lo_y))
+    if 0.5 * lo_y <= s.base.gamma_c <= 2.0 * max(hi_y, lo_y):  # short runs end above gamma_c
+        ax.axhline(s.base.gamma_c, color="0.5", lw=0.7, ls="-.", label="gamma_c")
+
+
+def _plot_ratios(plt: Any, result: Result, color: dict[str, str], out: Path) -> Path:
+    """``identification_strategies_ratio.png``: each estimator's mean error over least squares'."""
     fig, axes, systems, attackers = _grid_axes(plt, result)
     for i, system in enumerate(systems):
         for j, att in enumerate(attackers):
@@ -236,8 +247,7 @@ def plot(result: Result, out: Path) -> list[Path]:
     path = out / "identification_strategies_ratio.png"
     save_figure(fig, path, dpi=100)
     plt.close(fig)
-    paths.append(path)
-    return paths
+    return path
 
 
 def _cell(c: Curve, N: int) -> str:

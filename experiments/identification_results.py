@@ -18,7 +18,7 @@ from encctl_gym.agents.baselines import ColoredGaussianAttacker, GaussianAttacke
 from encctl_gym.agents.evaluate import budget_config
 from encctl_gym.agents.runs import RunInfo
 from encctl_gym.errors import ParameterError
-from encctl_gym.experiments.compare.attackers import ATTACKERS, learned_players, make_attackers
+from encctl_gym.experiments.compare.attackers import DEFAULT_ATTACKERS, learned_players, make_attackers
 from encctl_gym.experiments.compare.settings import Setting, make_setting, system_entry
 from encctl_gym.experiments.compare.statistics import fit_rate
 from encctl_gym.experiments.compare.tables import bound_rows
@@ -229,7 +229,7 @@ def compute(
         for est in ests:
             est.check_dimensions(p.n, p.m)
         # a learned attacker plays in the environment it was trained in (its run.json)
-        atts = [(a, s) for a in make_attackers(s, tuple(ATTACKERS))] + learned_players(s, list(runs), which)
+        atts = [(a, s) for a in make_attackers(s, DEFAULT_ATTACKERS)] + learned_players(s, list(runs), which)
         curves[system] = []
         worst = 0.0
         for att, play in atts:

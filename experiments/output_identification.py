@@ -39,8 +39,10 @@ import numpy as np
 from encctl_gym.errors import EncctlError
 from encctl_gym.plotting import legend_below, save_figure
 from encctl_gym.presets import get_preset
+from encctl_gym.security.attack_design import optimal_attack_design
 from encctl_gym.security.design import design_security_parameter
 from encctl_gym.security.empirical import empirical_design, fit_empirical_complexity
+from encctl_gym.security.threat import ThreatModel
 from encctl_gym.sim.output import OUTPUT_ATTACKS, OUTPUT_ESTIMATORS, output_attack_errors
 from encctl_gym.sim.plant import LinearPlant
 
@@ -59,15 +61,16 @@ def run(runs: int, points: int, n_max: int | None, seed: int, attacks: tuple[str
     for system in SYSTEMS:
         p = get_preset(system)
         plant = LinearPlant(p.A, p.B, sigma_w2=p.sigma_w2)
-        paper = design_security_parameter(p.plant(), p.threat())
+        paper = design_security_parameter(p.plant(), ThreatModel.of(p))
         top = n_max or 2 * paper.N_star
         grid = np.unique(np.geomspace(200, top, points).astype(int))
         ref = output_attack_errors(
             plant, np.eye(4), sample_sizes=grid, runs=runs, sigma_u2=p.sigma_u2, sigma_v2=0.0, seed=seed, estimator="arx"
         )
+        ol_design = optimal_attack_design(p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, feedback=False)
         ls_fit = fit_empirical_complexity(grid, ref["state_ls_markov"])
         target = float(ls_fit(paper.N_star))
-        base = empirical_design(ls_fit, p.threat(), gamma_c=target)
+        base = empirical_design(ls_fit, ThreatModel.of(p), gamma_c=target)
         rows.append(
             _row(
                 system, "states (least squares)", 0.0, "gaussian", "ls", grid, ref["state_ls_markov"], ls_fit, base,
@@ -80,12 +83,12 @@ def run(runs: int, points: int, n_max: int | None, seed: int, attacks: tuple[str
                     for est in ESTIMATORS_OF[attack]:
                         out = output_attack_errors(
                             plant, C, sample_sizes=grid, runs=runs, sigma_u2=p.sigma_u2, sigma_v2=sv, seed=seed,
-                            estimator=est, attack=attack,
+                            estimator=est, attack=attack, design=ol_design if attack == "optimal-ol" else None,
                         )  # fmt: skip
                         fit = fit_empirical_complexity(grid, out["markov"])
                         d: Any
                         try:
-                            d = empirical_design(fit, p.threat(), gamma_c=target)
+                            d = empirical_design(fit, ThreatModel.of(p), gamma_c=target)
                         except EncctlError as exc:  # a rate that does not decrease: reported, not designed
                             d = exc
                         rows.append(_row(system, label, sv, attack, est, grid, out["markov"], fit, d, paper.N_star, target))

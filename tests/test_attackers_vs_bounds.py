@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from encctl_gym import cli
 from encctl_gym.agents import GaussianAttacker, OptimalDesignAttacker, rollout
 from encctl_gym.agents.evaluate import budget_config
-from encctl_gym.errors import ConfigError
+from encctl_gym.errors import ConfigError, ParameterError
 from encctl_gym.experiments import compare as cmp
 from encctl_gym.experiments.compare.cli import QUICK_EPISODES
 from encctl_gym.security.design import optimal_security_parameter, sample_size_for_rate
@@ -97,9 +97,17 @@ def test_cap_and_exact_length_keep_lambda_and_the_meaning_of_the_budget_fraction
 
 def test_registry_builds_every_attacker_and_rejects_unknown_names():
     s = cmp.make_setting("small", "end", cap=None)
-    atts = cmp.make_attackers(s, tuple(cmp.ATTACKERS))
+    atts = cmp.make_attackers(s, cmp.DEFAULT_ATTACKERS)
     assert [a.name for a in atts] == ["gaussian", "prbs", "colored(rho=0.5)", "optimal-ol"]
     assert [a.oracle for a in atts] == [False, False, False, True]
+    # the stealthy attackers read delivered states: they build at an integer delay and are
+    # refused with a named reason where nothing is delivered
+    stealthy = [n for n in cmp.ATTACKERS if n not in cmp.DEFAULT_ATTACKERS]
+    assert stealthy == ["additive", "sparse"]
+    built = cmp.make_attackers(cmp.make_setting("small", 0, cap=None), stealthy)
+    assert [a.name.split("(")[0] for a in built] == stealthy
+    with pytest.raises(ParameterError, match="decipher_delay='end' delivers none"):
+        cmp.make_attackers(s, ["additive"])
     with pytest.raises(ConfigError, match="unknown attacker 'ppo'"):
         cmp.make_attackers(s, ["gaussian", "ppo"])
 

@@ -1,9 +1,11 @@
-"""Every fenced ```python block of README.md and docs/*.md runs as written.
+"""Every fenced ```python block of README.md and docs/*.md runs as written, alone.
 
-The blocks of one file run in order in one namespace (a later block may use what an earlier one
-defined), each file as its own test. A block preceded by the line ``<!-- docs:slow -->`` runs only
-under ``-m slow`` (the file's test is then split: the fast prefix by default, the whole file with
-``-m slow``). Listings that are not meant to run use another fence language (``text``, ``bash``).
+Readers copy one block, so each block runs in a fresh namespace: a name it uses must be defined
+or imported in the block itself (a block that continues an earlier one fails with NameError).
+The blocks of one file run in order in one process (imported modules stay loaded), each file as
+its own test. A block preceded by the line ``<!-- docs:slow -->`` runs only under ``-m slow`` (the
+file's test is then split: the other blocks by default, every block with ``-m slow``). Listings
+that are not meant to run use another fence language (``text``, ``bash``).
 """
 
 from __future__ import annotations
@@ -72,12 +74,12 @@ EXTRA_MODULES = {
 
 def _run_blocks(path: Path, include_slow: bool, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> int:
     monkeypatch.chdir(tmp_path)  # blocks that write results write them here
-    namespace: dict[str, object] = {"__name__": f"docs_{path.stem}"}
     ran = 0
     for line, code, slow in python_blocks(path.read_text(encoding="utf-8")):
         if slow and not include_slow:
-            break  # later blocks may depend on the slow one
-        rel = path.relative_to(ROOT)
+            continue
+        rel = path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
+        namespace: dict[str, object] = {"__name__": f"docs_{path.stem}_{line}"}  # each block alone
         try:
             exec(compile(code, f"{rel}:{line}", "exec"), namespace)  # noqa: S102 - the documented examples
         except ModuleNotFoundError as exc:
@@ -92,11 +94,11 @@ def _run_blocks(path: Path, include_slow: bool, monkeypatch: pytest.MonkeyPatch,
 
 
 @pytest.mark.parametrize("path", CASES, ids=lambda p: str(p.relative_to(ROOT)))
-def test_python_blocks_run_in_order(path: Path, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+def test_python_blocks_run_alone(path: Path, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     blocks = python_blocks(path.read_text(encoding="utf-8"))
-    if blocks[0][2]:
-        pytest.skip("the first block is marked slow")
-    assert _run_blocks(path, False, monkeypatch, tmp_path) >= 1
+    if all(slow for _, _, slow in blocks):
+        pytest.skip("every block is marked slow")
+    assert _run_blocks(path, False, monkeypatch, tmp_path) == sum(not slow for _, _, slow in blocks)
 
 
 SLOW_CASES = [p for p in CASES if any(slow for _, _, slow in python_blocks(p.read_text(encoding="utf-8")))]
@@ -104,7 +106,7 @@ SLOW_CASES = [p for p in CASES if any(slow for _, _, slow in python_blocks(p.rea
 
 @pytest.mark.slow
 @pytest.mark.parametrize("path", SLOW_CASES, ids=lambda p: str(p.relative_to(ROOT)))
-def test_python_blocks_run_in_order_with_the_slow_ones(path: Path, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+def test_python_blocks_run_alone_with_the_slow_ones(path: Path, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     assert _run_blocks(path, True, monkeypatch, tmp_path) == len(python_blocks(path.read_text(encoding="utf-8")))
 
 
@@ -113,6 +115,15 @@ def test_block_parser_finds_languages_marks_and_unclosed_fences() -> None:
     assert python_blocks(text) == [(3, "x = 1\n", False), (9, "y = x\n", True)]
     with pytest.raises(ValueError, match="line 2"):
         python_blocks("a\n```python\nx = 1\n")
+
+
+def test_a_block_that_continues_an_earlier_one_fails(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    page = tmp_path / "page.md"
+    page.write_text("```python\nx = 1\n```\n\n```python\nprint(x)\n```\n", encoding="utf-8")
+    with pytest.raises(NameError, match="'x'"):
+        _run_blocks(page, False, monkeypatch, tmp_path)
+    page.write_text("```python\nx = 1\n```\n\n```python\nx = 2\nprint(x)\n```\n", encoding="utf-8")
+    assert _run_blocks(page, False, monkeypatch, tmp_path) == 2
 
 
 def test_readme_links_point_to_files_of_the_repository() -> None:

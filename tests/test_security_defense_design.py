@@ -17,6 +17,7 @@ from encctl_gym.security.cost_models import deciphering_model
 from encctl_gym.security.deciphering import keys_to_break
 from encctl_gym.security.defense_design import DefenderCosts, design_defenses, largest_rotation_period, rotated_key_length
 from encctl_gym.security.key_length import defense_budget, design_key_length
+from encctl_gym.security.threat import ThreatModel
 
 PRESET = get_preset("paper-example")
 PHI = np.zeros((PRESET.B.shape[1], PRESET.A.shape[0]))  # A is stable: the zero controller is a controller
@@ -30,7 +31,7 @@ def toy_costs(local: float = 1e-3) -> DefenderCosts:
 
 def design(**kw):
     kw.setdefault("costs", toy_costs())
-    return design_defenses(PRESET.plant(), PRESET.threat(), controller=PHI, **kw)
+    return design_defenses(PRESET.plant(), ThreatModel.of(PRESET), controller=PHI, **kw)
 
 
 def test_each_cost_term_is_the_hand_count():
@@ -63,7 +64,7 @@ def test_the_noise_moves_n_star_and_its_control_cost_is_the_lyapunov_price():
 
 
 def test_without_rotation_the_key_is_the_cost_models_design():
-    t = PRESET.threat()
+    t = ThreatModel.of(PRESET)
     d = design()
     for name in ("paper", "precomputation", "generic"):
         ref = design_key_length(d.N_star, t.replace(cost_model=name)).k_star

@@ -16,6 +16,7 @@ from encctl_gym.security.complexity import sic_from_traces
 from encctl_gym.security.empirical import fit_empirical_complexity
 from encctl_gym.security.gramians import controllability_gramian, noise_gramian
 from encctl_gym.security.output_design import output_design
+from encctl_gym.security.threat import ThreatModel
 
 
 def test_fitted_rate_intervals_cover_the_true_rate_at_their_level():
@@ -48,7 +49,7 @@ def test_state_least_squares_curve_reproduces_the_known_value_and_sits_above_eq_
     below the mean at every N (here about 10 % below: at 150 runs the band reaches down to it)."""
     p = get_preset("small")
     grid = np.array([800, 1600, 3200, 6400])
-    d = output_design(Plant(p.A, p.B, C=np.eye(2)), p.threat(), estimator="arx", runs=150, sample_sizes=grid, seed=3,
+    d = output_design(Plant(p.A, p.B, C=np.eye(2)), ThreatModel.of(p), estimator="arx", runs=150, sample_sizes=grid, seed=3,
                       bootstrap=400)  # fmt: skip
     f = d.state_fit
     S = stationary_regressor_covariance(p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2)
@@ -62,7 +63,7 @@ def test_state_least_squares_curve_reproduces_the_known_value_and_sits_above_eq_
 
 def test_output_design_of_a_plant_with_one_output():
     p = get_preset("small-output")
-    d = output_design(p.plant(), p.threat(), estimator="n4sid", runs=6, points=4, bootstrap=200)
+    d = output_design(p.plant(), ThreatModel.of(p), estimator="n4sid", runs=6, points=4, bootstrap=200)
     assert d.p == 1 and d.output_design is not None
     lo, hi = d.output_design.N_star_interval
     assert lo <= d.output_design.N_star <= hi
@@ -73,9 +74,9 @@ def test_output_design_of_a_plant_with_one_output():
 def test_a_grid_shorter_than_the_estimator_needs_is_refused():
     p = get_preset("small-output")
     with pytest.raises(ParameterError, match="samples"):
-        output_design(p.plant(), p.threat(), estimator="n4sid", runs=3, sample_sizes=[12, 16, 20], bootstrap=200)
+        output_design(p.plant(), ThreatModel.of(p), estimator="n4sid", runs=3, sample_sizes=[12, 16, 20], bootstrap=200)
     with pytest.raises(ParameterError, match="unknown output estimator"):
-        output_design(p.plant(), p.threat(), estimator="cva")
+        output_design(p.plant(), ThreatModel.of(p), estimator="cva")
 
 
 def test_design_command_prints_the_output_design_beside_the_state_design(capsys, tmp_path):
@@ -100,7 +101,12 @@ def test_output_attacks_have_the_gaussian_attacks_power():
     plant = LinearPlant(p.A, p.B, sigma_w2=p.sigma_w2)
     u = attack_inputs(plant, "prbs", N=500, runs=4, sigma_u2=2.0, seed=1)
     np.testing.assert_array_equal(np.abs(u), np.sqrt(2.0))  # +-sigma_u: power sigma_u2 exactly
-    u = attack_inputs(plant, "optimal-ol", N=4000, runs=8, sigma_u2=2.0, seed=1)
+    from encctl_gym.security.attack_design import optimal_attack_design
+
+    with pytest.raises(ParameterError, match="plays a given design"):
+        attack_inputs(plant, "optimal-ol", N=10, runs=1, sigma_u2=2.0, seed=1)
+    design = optimal_attack_design(p.A, p.B, sigma_u2=2.0, sigma_w2=p.sigma_w2, feedback=False)
+    u = attack_inputs(plant, "optimal-ol", N=4000, runs=8, sigma_u2=2.0, seed=1, design=design)
     assert np.mean(u**2) == pytest.approx(2.0, rel=0.05)  # the design's power constraint, stationary from t = 0
     with pytest.raises(ParameterError, match="unknown attack"):
         attack_inputs(plant, "chirp", N=10, runs=1, sigma_u2=1.0, seed=0)

@@ -25,14 +25,22 @@ from scratch.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 from ..errors import ParameterError
 
-if TYPE_CHECKING:
-    from ..loop.scheme import EncryptionScheme
+__all__ = ["BreakableScheme", "Decipherer", "KeyOracle", "KeyBreaking", "make_decipherer", "DEFAULT_BREAKER_TIME_LIMIT"]
 
-__all__ = ["Decipherer", "KeyOracle", "KeyBreaking", "make_decipherer", "DEFAULT_BREAKER_TIME_LIMIT"]
+
+@runtime_checkable
+class BreakableScheme(Protocol):
+    """What the decipherer asks of the loop's scheme (the part of
+    :class:`encctl_gym.loop.scheme.EncryptionScheme` it uses; the loop's layer stands above this one)."""
+
+    def breaker_for(self, breaker: Any, adversary: str, rng: Any) -> Any:
+        """The breaker that reads this scheme's keys for ``adversary``."""
+        ...
+
 
 #: Seconds a breaker may take for its precomputation and for each key, by default: a breaker
 #: whose expected first-key time is longer is refused before any work.
@@ -67,11 +75,11 @@ class KeyOracle:
     Parameters
     ----------
     read_key : callable
-        Returns the plant's secret of the period (the scheme's ``oracle_secret``: for ElGamal
-        the exponent ``s_t``).
+        ``read_key(pk)`` returns the plant's secret of the public key ``pk`` (the scheme's
+        ``oracle_secret``: for ElGamal the exponent ``s_t`` of the period's key, ``s_0`` of ``pk_0``).
     """
 
-    def __init__(self, read_key: Callable[[], Any]) -> None:
+    def __init__(self, read_key: Callable[[Any], Any]) -> None:
         self._read_key = read_key
         self.seconds = 0.0
 
@@ -79,7 +87,7 @@ class KeyOracle:
         self.seconds = 0.0
 
     def secret(self, pk: Any) -> Any:
-        return self._read_key()
+        return self._read_key(pk)
 
     def observe_token(self, token: Any) -> None:
         return None
@@ -125,7 +133,7 @@ class KeyBreaking:
         breaker: str,
         group: Any,
         *,
-        scheme: EncryptionScheme,
+        scheme: BreakableScheme,
         adversary: str,
         time_limit: float = DEFAULT_BREAKER_TIME_LIMIT,
         rng: Any = None,
@@ -200,9 +208,9 @@ class KeyBreaking:
 def make_decipherer(
     breaker: str | None,
     group: Any,
-    read_key: Callable[[], Any],
+    read_key: Callable[[Any], Any],
     *,
-    scheme: EncryptionScheme,
+    scheme: BreakableScheme,
     adversary: str,
     time_limit: float = DEFAULT_BREAKER_TIME_LIMIT,
     rng: Any = None,

@@ -13,6 +13,7 @@ import argparse
 from typing import Any
 
 from .._validation import check_int, parse_number
+from . import verification_design
 from .defense_design import DEFAULT_MIN_KEY_LENGTH, DefenseDesign, DefenseMix
 
 __all__ = ["add_arguments", "defense_options", "format_defenses"]
@@ -45,6 +46,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="BITS",
         help=f"key length of an audit-secure mix (default {DEFAULT_MIN_KEY_LENGTH})",
     )
+    verification_design.add_arguments(g)  # --verify NAME|auto, --verify-param KEY=VALUE
 
 
 def _number_or_auto(name: str, text: str | None) -> float | str | None:
@@ -58,7 +60,8 @@ def _number_or_auto(name: str, text: str | None) -> float | str | None:
 def defense_options(args: argparse.Namespace) -> dict[str, Any] | None:
     """The keyword arguments of :func:`~.defense_design.design_defenses` from the command line,
     or ``None`` when no defender option was given (values are checked by the design)."""
-    if all(getattr(args, dest, None) is None for dest in OPTIONS):
+    verify = verification_design.verify_options(args)
+    if all(getattr(args, dest, None) is None for dest in OPTIONS) and verify is None:
         return None
     rotate = _number_or_auto("rotate_every", args.rotate_every)
     out: dict[str, Any] = {
@@ -71,6 +74,8 @@ def defense_options(args: argparse.Namespace) -> dict[str, Any] | None:
         out["sigma_d2"] = parse_number("defense_noise", args.defense_noise)
     if args.min_key_length is not None:
         out["min_key_length"] = check_int("min_key_length", parse_number("min_key_length", args.min_key_length))
+    if verify is not None:
+        out["verify"] = verify
     return out
 
 
@@ -123,4 +128,4 @@ def format_defenses(design: DefenseDesign) -> list[str]:
         f"  audit-secure mix at the smallest key (--min-key-length {d.min_key_length}). The noise's control cost is per step,",
         "  in the units of the quadratic cost, the same for every mix.",
     ]
-    return lines
+    return lines + verification_design.format_verification(design)

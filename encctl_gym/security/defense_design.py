@@ -54,7 +54,7 @@ from dataclasses import asdict, dataclass, field
 from fractions import Fraction
 from typing import Any
 
-from .._validation import as_finite_array, check_int, check_nonnegative, check_positive, format_value
+from .._validation import as_finite_array, check_int, check_nonnegative, check_positive, check_probability, format_value
 from ..errors import ParameterError
 from ..plant import as_plant
 from .cost_models import GNFS_MIN_KEY_LENGTH, CostModel, paper_security_parameter
@@ -162,13 +162,6 @@ def check_detection_delta(delta: Any) -> float:
     if d >= 1:
         raise ParameterError(f"detection_delta must lie in (0, 1), got {format_value(delta)}")
     return d
-
-
-def _check_audit_rate(p: Any) -> float:
-    p = check_nonnegative("audit_rate", p)
-    if p > 1:
-        raise ParameterError(f"audit_rate must lie in [0, 1], got {format_value(p)}")
-    return p
 
 
 def _work(model: CostModel, key_length: int, keys: int, K: int | None) -> Fraction:
@@ -331,6 +324,56 @@ def _key_candidates(model: CostModel, keys: int, budget: Fraction, rotate: int |
     return out
 
 
+def _check_levers(rotate_every: Any, audit_rate: Any) -> tuple[int | str | None, float | str | None]:
+    """``rotate_every`` (``K >= 1``, ``"auto"`` or None) and ``audit_rate`` (``p`` in [0, 1],
+    ``"auto"`` or None), checked; any other word is refused."""
+    for name, value in (("rotate_every", rotate_every), ("audit_rate", audit_rate)):
+        if isinstance(value, str) and value != "auto":
+            raise ParameterError(f"{name} must be a number or 'auto', got {format_value(value)}")
+    if rotate_every != "auto":
+        rotate_every = check_rotate_every(rotate_every)
+    if audit_rate not in (None, "auto"):
+        audit_rate = check_probability("audit_rate", audit_rate)
+    return rotate_every, audit_rate
+
+
+def _model_design(
+    model: Any,
+    costs: DefenderCosts,
+    *,
+    keys: int,
+    budget: Any,
+    rates: Sequence[float],
+    rotate_every: int | str | None,
+    N_star: int,
+    delta: float,
+    min_k: int,
+) -> ModelDefenseDesign:
+    """The cheapest mix under one cost model: for each audit rate, the audit-secure mix at the
+    smallest key (when the rate alone keeps ``(1 - p)^{N*} <= delta``) or every key-secure
+    ``(k, K)`` of :func:`_key_candidates`; the key-only and audit-only mixes beside it."""
+    k_star = model.minimum_key_length(keys, budget)
+    k_floor = max(min_k, model.key_length_range[0])
+    fixed_K = rotate_every if isinstance(rotate_every, int) else None
+    candidates: list[DefenseMix] = []
+    key_only: DefenseMix | None = None
+    audit_only: DefenseMix | None = None
+    for rate in rates:
+        if undetected_probability(N_star, rate) <= delta:
+            secure_key = _work(model, k_floor, keys, fixed_K) > budget
+            mix = _mix(costs, k_floor, fixed_K, rate, key_secure=secure_key, N_star=N_star, delta=delta)
+            audit_only = mix
+            candidates.append(mix)
+            continue
+        for k, K in _key_candidates(model, keys, budget, rotate_every):
+            mix = _mix(costs, k, K, rate, key_secure=True, N_star=N_star, delta=delta)
+            candidates.append(mix)
+            if rate == 0.0 and (key_only is None or mix.total_seconds < key_only.total_seconds):
+                key_only = mix
+    chosen = min(candidates, key=lambda c: c.total_seconds)
+    return ModelDefenseDesign(model.name, k_star, costs.encrypted_step_seconds(k_star), chosen, key_only, audit_only)
+
+
 def design_defenses(
     plant: Any,
     threat: ThreatModel,
@@ -384,13 +427,7 @@ def design_defenses(
         For ``K < 1``, ``p`` outside [0, 1], negative noise, ``delta`` outside (0, 1), an unknown
         option word.
     """
-    for name, value in (("rotate_every", rotate_every), ("audit_rate", audit_rate)):
-        if isinstance(value, str) and value != "auto":
-            raise ParameterError(f"{name} must be a number or 'auto', got {format_value(value)}")
-    if rotate_every != "auto":
-        rotate_every = check_rotate_every(rotate_every)
-    if audit_rate not in (None, "auto"):
-        audit_rate = _check_audit_rate(audit_rate)
+    rotate_every, audit_rate = _check_levers(rotate_every, audit_rate)
     delta = check_detection_delta(detection_delta)
     sd = check_nonnegative("sigma_d2", sigma_d2)
     min_k = check_int("min_key_length", min_key_length, minimum=1)
@@ -410,27 +447,16 @@ def design_defenses(
     out: dict[str, ModelDefenseDesign] = {}
     for name in cost_models:
         model = build_model(name, gnfs_correction, calibration)
-        k_star = model.minimum_key_length(keys, budget)
-        k_floor = max(min_k, model.key_length_range[0])
-        fixed_K = rotate_every if isinstance(rotate_every, int) else None
-        candidates: list[DefenseMix] = []
-        key_only: DefenseMix | None = None
-        audit_only: DefenseMix | None = None
-        for rate in rates:
-            if undetected_probability(N_star, rate) <= delta:
-                secure_key = _work(model, k_floor, keys, fixed_K) > budget
-                mix = _mix(costs, k_floor, fixed_K, rate, key_secure=secure_key, N_star=N_star, delta=delta)
-                audit_only = mix
-                candidates.append(mix)
-                continue
-            for k, K in _key_candidates(model, keys, budget, rotate_every):
-                mix = _mix(costs, k, K, rate, key_secure=True, N_star=N_star, delta=delta)
-                candidates.append(mix)
-                if rate == 0.0 and (key_only is None or mix.total_seconds < key_only.total_seconds):
-                    key_only = mix
-        chosen = min(candidates, key=lambda c: c.total_seconds)
-        out[model.name] = ModelDefenseDesign(
-            model.name, k_star, costs.encrypted_step_seconds(k_star), chosen, key_only, audit_only
+        out[model.name] = _model_design(
+            model,
+            costs,
+            keys=keys,
+            budget=budget,
+            rates=rates,
+            rotate_every=rotate_every,
+            N_star=N_star,
+            delta=delta,
+            min_k=min_k,
         )
     return DefenseDesign(
         N_star=N_star,

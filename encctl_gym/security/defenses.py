@@ -40,7 +40,15 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import as_finite_array, check_int, check_nonnegative, check_positive, check_schur_stable, check_system
+from .._validation import (
+    as_finite_array,
+    check_int,
+    check_nonnegative,
+    check_positive,
+    check_probability,
+    check_schur_stable,
+    check_system,
+)
 from ..errors import ParameterError, ShapeError
 from ..plant import as_plant
 from .complexity import _out, check_sample_size
@@ -213,17 +221,10 @@ def noise_defense_price(
     return out
 
 
-def _check_rate(p: Any) -> float:
-    p = check_nonnegative("audit_rate", p)
-    if p > 1:
-        raise ParameterError(f"audit_rate must lie in [0, 1], got {p}")
-    return p
-
-
 def undetected_probability(N: Any, audit_rate: float) -> float:
     """``(1 - p)^N``: the probability that an attacker injecting at each of ``N`` steps meets no audit."""
     N = check_int("N", N, minimum=0)
-    p = _check_rate(audit_rate)
+    p = check_probability("audit_rate", audit_rate)
     if p == 1.0:
         return 0.0 if N else 1.0
     return math.exp(N * math.log1p(-p))

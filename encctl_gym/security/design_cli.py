@@ -49,7 +49,7 @@ import numpy as np
 
 from .._validation import check_int, format_value, parse_number
 from ..errors import ConfigError, ParameterError
-from ..plant_file import load_plant_file, load_system
+from ..plant_file import fields_help, load_plant_file, load_system
 from ..presets import DESIGN_FIELDS, design_defaults, get_preset, preset_names
 from ..units import SECONDS_PER_UNIT, parse_duration
 from . import defense_cli
@@ -58,6 +58,7 @@ from .cost_models import DECIPHERING_MODELS, GUILLEVIC_CORRECTION, check_gnfs_co
 from .defense_design import DefenseDesign
 from .records import load_records
 from .report import COMPLEXITIES, LABELS, design_report
+from .scheme_design import format_scheme_key_lengths, scheme_key_lengths
 from .threat import ThreatModel
 
 __all__ = ["add_arguments", "run", "parse_duration", "load_system", "DEFAULTS", "parse_cost_models", "parse_gnfs_correction"]
@@ -67,13 +68,21 @@ DEFAULTS: dict[str, Any] = design_defaults()
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Register the options of ``encctl-gym design``."""
+    """Register the options of ``encctl-gym design``; the help ends with the plant-file fields."""
+    parser.formatter_class = argparse.RawDescriptionHelpFormatter  # keeps the field table's lines
+    parser.epilog = (
+        "plant file fields (JSON, YAML or NPZ with these names, nothing else;\n"
+        "the optional ones default to the paper's design example):\n"
+        + fields_help()
+        + "\nexamples in the repository: examples/plant_state.yaml (the state measured),\n"
+        "examples/plant_output.yaml (with C and sigma_v2, for --estimator)"
+    )
     parser.add_argument(
         "system_file",
         nargs="?",
         metavar="SYSTEM_FILE",
-        help="plant file: JSON/YAML ({'A': [[...]], 'B': [[...]]}, optional sigma_u2, sigma_w2, "
-        "sigma_x2, gamma_c, tau_c, upsilon) or NPZ with the same names",
+        help="plant file: JSON/YAML ({'A': [[...]], 'B': [[...]]}, optional C, sigma_v2, sigma_u2, sigma_w2, "
+        "sigma_x2, gamma_c, tau_c, upsilon; see the fields below) or NPZ with the same names",
     )
     parser.add_argument(
         "--preset",
@@ -283,15 +292,13 @@ def _format_table(res: dict[str, Any], title: str, sources: str | None = None) -
 
 
 # --------------------------------------------------------------------------- the command
-def run(args: argparse.Namespace, defenses: Callable[..., DefenseDesign] | None = None) -> int:
-    """Run ``encctl-gym design``: print the tables (or JSON); return 0. ``defenses`` designs the
-    defender's levers when one of their options is given (:mod:`encctl_gym.design_command`
-    passes :func:`encctl_gym.loop.defense_costs.design_loop_defenses`)."""
+def _plant_of(args: argparse.Namespace) -> tuple[Any, Any, Any, float, str, dict[str, Any], dict[str, str]]:
+    """``(A, B, C, sigma_v2, title, values, sources)`` of ``--preset`` or SYSTEM_FILE: the
+    design values (defaults overridden by the preset or file) and where each came from."""
     if args.preset and args.system_file:
         raise ConfigError("give either SYSTEM_FILE or --preset, not both")
     base: dict[str, Any] = dict(DEFAULTS)
     sources: dict[str, str] = {}
-    sources_line = None
     C, sigma_v2 = None, 0.0  # the sensors of --estimator (a plant file's or preset's)
     if args.preset:
         preset = get_preset(args.preset)
@@ -309,6 +316,17 @@ def run(args: argparse.Namespace, defenses: Callable[..., DefenseDesign] | None 
         sources = {key: ("file" if key in spec.from_file else "default") for key in DESIGN_FIELDS}
     else:
         raise ConfigError("give a SYSTEM_FILE (JSON, YAML or NPZ with A and B) or --preset NAME")
+    return A, B, C, sigma_v2, title, base, sources
+
+
+def run(args: argparse.Namespace, defenses: Callable[..., DefenseDesign] | None = None, scheme: Any = None) -> int:
+    """Run ``encctl-gym design``: print the tables (or JSON); return 0. ``defenses`` designs the
+    defender's levers when one of their options is given (:mod:`encctl_gym.design_command`
+    passes :func:`encctl_gym.loop.defense_costs.design_loop_defenses`); ``scheme`` (an
+    :class:`~encctl_gym.loop.scheme.EncryptionScheme`, from ``--scheme``) adds its key size per
+    cost model (:func:`~encctl_gym.security.scheme_design.scheme_key_lengths`)."""
+    A, B, C, sigma_v2, title, base, sources = _plant_of(args)
+    sources_line = None
     values: dict[str, Any] = {}
     for key in DESIGN_FIELDS:
         raw = getattr(args, key)
@@ -363,6 +381,9 @@ def run(args: argparse.Namespace, defenses: Callable[..., DefenseDesign] | None 
             calibration=records,
             **defense,
         )
+    if scheme is not None:
+        N_star = res["designs"][COMPLEXITIES[args.complexity]]["N_star"]
+        res["scheme"] = scheme_key_lengths(scheme, N_star, threat, gnfs_correction=correction)
     output = _output_design(args, A, B, C, sigma_v2, threat)
     if output is not None:
         res["output_design"] = output.to_dict()
@@ -374,6 +395,8 @@ def run(args: argparse.Namespace, defenses: Callable[..., DefenseDesign] | None 
         print(json.dumps(_sanitize(res), indent=2, allow_nan=False))
     else:
         text = _format_table(res, title, sources_line)
+        if "scheme" in res:
+            text += "\n" + "\n".join(format_scheme_key_lengths(res["scheme"]))
         if "defenses" in res:
             text += "\n" + "\n".join(defense_cli.format_defenses(res["defenses"]))
         print(text)

@@ -146,13 +146,18 @@ class KeyValue:
         return d
 
 
-def build_model(model: Any, gnfs_correction: Any = 0.0, calibration: Any = None) -> CostModel:
+def build_model(model: Any, gnfs_correction: Any = 0.0, calibration: Any = None, *, registry: Any = None) -> CostModel:
     """A cost model by name with the options that apply to it: the GNFS correction and the
     calibration go to the models whose constructors take them (the paper and precomputation
     models; the calibration only when given), so no model is named here. A built model is
-    returned as it is."""
+    returned as it is. ``registry``: the scheme's own models (its ``cost_models``; default the
+    discrete-log ones, :data:`DECIPHERING_MODELS`)."""
     if isinstance(model, CostModel):
         return model
+    if registry is not None and registry is not DECIPHERING_MODELS:
+        takes = registry.options(model)
+        options_of = {k: v for k, v in (("gnfs_correction", gnfs_correction), ("calibration", calibration)) if k in takes}
+        return registry.build(model, **{k: v for k, v in options_of.items() if v is not None})
     takes = DECIPHERING_MODELS.options(model)
     options: dict[str, Any] = {}
     if "gnfs_correction" in takes:

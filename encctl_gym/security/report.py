@@ -164,37 +164,9 @@ def design_report(
     c = check_gnfs_correction(gnfs_correction)
     tr_u = float(np.trace(controllability_gramian(A, B)))
     tr_w = float(np.trace(noise_gramian(A)))
-    designs: dict[str, SecurityDesign] = {
-        "paper_sic2": design_from_traces(tr_u, tr_w, m, n, t, method="asymptotic"),
-        "exact_sic": design_from_traces(tr_u, tr_w, m, n, t, method="exact"),
-    }
-    attacks: dict[str, Any] = {}
-    skipped: dict[str, str] = {}
-    for kind, feedback in (("closed_loop", True), ("open_loop", False)):
-        try:
-            attacks[kind] = optimal_attack_design(
-                A, B, sigma_u2=su, sigma_w2=sw, feedback=feedback, solver=solver, max_dimension=sdp_max_dimension
-            )
-        except ResourceLimitError as exc:
-            skipped[kind] = str(exc)
-    attacks["gaussian"] = gaussian_attack_design(A, B, sigma_u2=su, sigma_w2=sw)
-    for kind, att in attacks.items():
-        designs[kind] = robust_security_design(p, t, kind=kind, design=att)
-    designs = {k: designs[k] for k in LABELS if k in designs}
+    designs, attacks, skipped = _designs(p, t, tr_u, tr_w, solver=solver, sdp_max_dimension=sdp_max_dimension)
     N_ref = designs["paper_sic2"].N_star
-    g_ref = float(sic_asymptotic_from_traces(N_ref, tr_u, tr_w, m, n, su / sw))
-    ratios = {
-        "paper_sic2": 1.0,
-        "exact_sic": float(sic_from_traces(N_ref, tr_u, tr_w, m, n, su, sw, sx)) / g_ref,
-        **{kind: float(att.gamma(N_ref)) / g_ref for kind, att in attacks.items()},
-    }
-    out_designs = {}
-    for name, d in designs.items():
-        entry = d.to_dict()
-        entry["ratio_to_paper"] = ratios[name]
-        if name in attacks:
-            entry["trace_inv_sigma"] = attacks[name].trace_inv
-        out_designs[name] = entry
+    out_designs = _design_entries(designs, attacks, N_ref, tr_u, tr_w, m, n, su, sw, sx)
     res: dict[str, Any] = {
         "system": {"n": n, "m": m, "spectral_radius": rho, "tr_psi_u": tr_u, "tr_psi_w": tr_w, "r_sigma": su / sw},
         "parameters": {"gamma_c": gamma_c, "tau_c": tau_c, "upsilon": upsilon, "sigma_u2": su, "sigma_w2": sw, "sigma_x2": sx},
@@ -214,6 +186,62 @@ def design_report(
         res["models"] = {name: _describe(name, c, records) for name in cost_models}
         res["records"] = _records_section(records)
     return res
+
+
+def _designs(
+    p: Plant, t: ThreatModel, tr_u: float, tr_w: float, *, solver: str | None, sdp_max_dimension: int | None
+) -> tuple[dict[str, SecurityDesign], dict[str, Any], dict[str, str]]:
+    """The security designs of :data:`LABELS` (in that order), the attack designs they rest on
+    and the SDP rows skipped for their size (with the reason)."""
+    A, B, n, m = p.A, p.B, p.n, p.m
+    su, sw = float(t.sigma_u2), float(t.sigma_w2)
+    designs: dict[str, SecurityDesign] = {
+        "paper_sic2": design_from_traces(tr_u, tr_w, m, n, t, method="asymptotic"),
+        "exact_sic": design_from_traces(tr_u, tr_w, m, n, t, method="exact"),
+    }
+    attacks: dict[str, Any] = {}
+    skipped: dict[str, str] = {}
+    for kind, feedback in (("closed_loop", True), ("open_loop", False)):
+        try:
+            attacks[kind] = optimal_attack_design(
+                A, B, sigma_u2=su, sigma_w2=sw, feedback=feedback, solver=solver, max_dimension=sdp_max_dimension
+            )
+        except ResourceLimitError as exc:
+            skipped[kind] = str(exc)
+    attacks["gaussian"] = gaussian_attack_design(A, B, sigma_u2=su, sigma_w2=sw)
+    for kind, att in attacks.items():
+        designs[kind] = robust_security_design(p, t, kind=kind, design=att)
+    return {k: designs[k] for k in LABELS if k in designs}, attacks, skipped
+
+
+def _design_entries(
+    designs: dict[str, SecurityDesign],
+    attacks: dict[str, Any],
+    N_ref: int,
+    tr_u: float,
+    tr_w: float,
+    m: int,
+    n: int,
+    su: float,
+    sw: float,
+    sx: float,
+) -> dict[str, dict[str, Any]]:
+    """Each design's :meth:`SecurityDesign.to_dict` with ``ratio_to_paper``, its complexity at the
+    paper's ``N*`` over eq:sic2's (and ``trace_inv_sigma`` for an attack design)."""
+    g_ref = float(sic_asymptotic_from_traces(N_ref, tr_u, tr_w, m, n, su / sw))
+    ratios = {
+        "paper_sic2": 1.0,
+        "exact_sic": float(sic_from_traces(N_ref, tr_u, tr_w, m, n, su, sw, sx)) / g_ref,
+        **{kind: float(att.gamma(N_ref)) / g_ref for kind, att in attacks.items()},
+    }
+    out_designs = {}
+    for name, d in designs.items():
+        entry = d.to_dict()
+        entry["ratio_to_paper"] = ratios[name]
+        if name in attacks:
+            entry["trace_inv_sigma"] = attacks[name].trace_inv
+        out_designs[name] = entry
+    return out_designs
 
 
 def _describe(name: str, c: float, records: RecordSet) -> dict[str, Any]:

@@ -18,7 +18,7 @@ module                 holds
 =====================  =====================================================================
 """
 
-from .attackers import ATTACKERS, learned_players, left_out, make_attackers, run_applies, run_setting
+from .attackers import ATTACKERS, DEFAULT_ATTACKERS, learned_players, left_out, make_attackers, run_applies, run_setting
 from .protocol import compute, elgamal_check, evaluate, planned_steps
 from .records import Curve, Result
 from .report import comparison_table, findings, summary_markdown
@@ -28,6 +28,7 @@ from .tables import CURVE_COLUMNS, EPISODE_COLUMNS, SECURITY_COLUMNS, bound_rows
 
 __all__ = [
     "ATTACKERS",
+    "DEFAULT_ATTACKERS",
     "learned_players",
     "left_out",
     "make_attackers",

@@ -22,13 +22,23 @@ from encctl_gym._validation import format_value
 from encctl_gym.agents import Attacker, ColoredGaussianAttacker, GaussianAttacker, OptimalDesignAttacker, PRBSAttacker
 from encctl_gym.agents.evaluate import budget_config
 from encctl_gym.agents.runs import RUN_FILE, RunInfo
+from encctl_gym.agents.stealth import AdditiveAttacker, SparseAttacker
 from encctl_gym.envs.config import AttackParams, resolve_params
 from encctl_gym.errors import ConfigError, EncctlError
 from encctl_gym.registry import Registry
 
 from .settings import Setting
 
-__all__ = ["ATTACKERS", "make_attackers", "system_config", "run_setting", "run_applies", "left_out", "learned_players"]
+__all__ = [
+    "ATTACKERS",
+    "DEFAULT_ATTACKERS",
+    "make_attackers",
+    "system_config",
+    "run_setting",
+    "run_applies",
+    "left_out",
+    "learned_players",
+]
 
 #: Baseline and oracle attackers by name -> factory for a setting.
 ATTACKERS: Registry[Callable[[Setting], Attacker]] = Registry(
@@ -38,9 +48,15 @@ ATTACKERS: Registry[Callable[[Setting], Attacker]] = Registry(
         "prbs": lambda s: PRBSAttacker(s.params),
         "colored": lambda s: ColoredGaussianAttacker(s.params, rho=0.5),
         "optimal": lambda s: OptimalDesignAttacker(s.params, design=s.design, feedback=s.params.decipher_delay is not None),
+        # the stealthy attackers of agents.stealth (replaying Phi x under the settings' replace
+        # injection; they read delivered states, so they play at integer delays only)
+        "additive": lambda s: AdditiveAttacker(s.params),
+        "sparse": lambda s: SparseAttacker(s.params),
     },
     error=ConfigError,
 )
+#: The attackers ``compare`` plays when none are named (every setting, ``"end"`` included).
+DEFAULT_ATTACKERS: tuple[str, ...] = ("gaussian", "prbs", "colored", "optimal")
 
 
 def make_attackers(setting: Setting, names: Sequence[str]) -> list[Attacker]:

@@ -27,7 +27,7 @@ from encctl_gym._validation import format_value
 from encctl_gym.agents.runs import MODEL_FILES, check_output_dir, find_runs
 from encctl_gym.errors import ConfigError
 
-from .attackers import ATTACKERS, left_out
+from .attackers import ATTACKERS, DEFAULT_ATTACKERS, left_out
 from .plots import plot
 from .protocol import compute
 from .records import Result
@@ -98,7 +98,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--attackers",
         default=None,
-        help=f"comma-separated registered attackers (default all: {','.join(ATTACKERS)}); learned ones come from --runs",
+        help=f"comma-separated registered attackers ({','.join(ATTACKERS)}; default {','.join(DEFAULT_ATTACKERS)}); learned ones come from --runs",
     )
     parser.add_argument("--max-samples", type=int, default=None, help=f"evaluation cap on N (default {DEFAULT_CAP})")
     parser.add_argument(
@@ -112,7 +112,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--runs",
         action="append",
         default=[],
-        help="training run directory or a parent of runs (repeatable; default results/train if it exists)",
+        help="training run directory or a parent of runs (repeatable; default results/train if it exists, left out with --quick)",
     )
     parser.add_argument(
         "--which",
@@ -140,19 +140,37 @@ def write_outputs(result: Result, out: Path, *, command: str, title: str | None 
     return md, [*files, *plots, out / "summary.md"]
 
 
+def run_roots(runs: Sequence[str] | None, quick: bool, default: str = "results/train") -> tuple[list[str], str]:
+    """The run folders whose learned attackers play, and a note when the default folder exists
+    but is left out: ``--runs`` as given; else ``default`` if it exists, except with ``--quick``
+    (a smoke test of the scripted attackers), which says that it leaves it out."""
+    if runs:
+        return list(runs), ""
+    if not Path(default).exists():
+        return [], ""
+    if quick:
+        return (
+            [],
+            f"--quick leaves out the trained runs in {default} (it plays the scripted attackers only); give --runs {default} to add them",
+        )
+    return [default], ""
+
+
 def run(args: argparse.Namespace) -> int:
     """Run, write CSV, PNG and summary.md; print the summary."""
     quick = args.quick
     # an empty list given on the command line is an error, not the default
     systems = names(args.systems, "systems") if args.systems is not None else (QUICK_SYSTEMS if quick else DEFAULT_SYSTEMS)
     delays = parse_delays(args.delays) if args.delays is not None else DELAYS
-    attackers = names(args.attackers, "attackers") if args.attackers is not None else tuple(ATTACKERS)
+    attackers = names(args.attackers, "attackers") if args.attackers is not None else DEFAULT_ATTACKERS
     episodes = positive("episodes", args.episodes) or (QUICK_EPISODES if quick else FULL_EPISODES)
     cap = positive("max-samples", args.max_samples, 2) or (QUICK_CAP if quick else DEFAULT_CAP)
     points = positive("points", args.points, 1, cap) or (QUICK_POINTS if quick else FULL_POINTS)
     positive("elgamal-episodes", args.elgamal_episodes, 0)
     check_output_dir(args.out)  # before the work, not after it
-    roots = args.runs or (["results/train"] if Path("results/train").exists() and not quick else [])
+    roots, note = run_roots(args.runs, quick)
+    if note:
+        print(f"encctl-gym compare: {note}", file=sys.stderr)
     skipped: list[tuple[Path, str]] = []
     runs = find_runs(roots, left_out=skipped)
     for r in runs:  # every model that may play is a readable archive, checked before the work

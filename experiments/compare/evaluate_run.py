@@ -32,6 +32,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from encctl_gym._validation import format_count
 from encctl_gym.agents import Attacker
 from encctl_gym.agents.runs import MODEL_FILES, RunInfo, check_output_dir, read_run
 from encctl_gym.agents.sb3 import load_attacker  # the [rl] extra: without it the CLI says which extra to install
@@ -218,6 +219,7 @@ def run(args: argparse.Namespace) -> int:
         elgamal_N=min(40, min(s.params.horizon for s in settings)),
         progress=not args.no_progress,
         players=learned,
+        label="evaluate",
     )
     cmd = [
         f"encctl-gym evaluate {info.path}",
@@ -250,7 +252,7 @@ def run(args: argparse.Namespace) -> int:
                 + "\n"
             )
     print(
-        f"\n{episodes} episodes per attacker and attack length on environment seeds {args.seed}, {args.seed + 1}, ...; "
+        f"\n{format_count(episodes, 'episode')} per attacker and attack length on environment seeds {args.seed}, {args.seed + 1}, ...; "
         f"{'deterministic' if args.deterministic else 'stochastic'} policy ({args.which} model)."
     )
     print("wrote " + ", ".join(str(p) for p in paths))

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from encctl_gym._validation import format_count
 from encctl_gym.plotting import legend_below, save_figure
 
 from .records import Curve, Result
@@ -107,7 +108,7 @@ def plot(result: Result, out: Path) -> list[Path]:
         fig.suptitle(
             "\n".join(
                 textwrap.wrap(
-                    f"Attackers against the sample identifying complexity: {system} ({episodes} episodes per attacker and N, "
+                    f"Attackers against the sample identifying complexity: {system} ({format_count(episodes, 'episode')} per attacker and N, "
                     "same seeds, energy budget m sigma_u2 N at every N)",
                     int(11 * fig.get_figwidth()),
                 )

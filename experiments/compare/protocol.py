@@ -37,7 +37,7 @@ from encctl_gym.envs.config import resolve_params
 from encctl_gym.resources import check_memory
 from encctl_gym.sim.montecarlo import log_grid
 
-from .attackers import ATTACKERS, learned_players, make_attackers
+from .attackers import DEFAULT_ATTACKERS, learned_players, make_attackers
 from .records import Curve, Result
 from .settings import DEFAULT_CAP, DEFAULT_SYSTEMS, DELAYS, Setting, length_grid, make_setting
 from .statistics import mean_se
@@ -182,11 +182,12 @@ def compute(
     elgamal_episodes: int = 1,
     elgamal_N: int = 40,
     progress: bool = False,
-    attackers: Sequence[str] = tuple(ATTACKERS),
+    attackers: Sequence[str] = DEFAULT_ATTACKERS,
     configs: Mapping[str, dict[str, Any]] | None = None,
     deterministic: bool = False,
     settings: Sequence[Setting] | None = None,
     players: Callable[[Setting], Sequence[Attacker]] | None = None,
+    label: str = "compare",
 ) -> Result:
     """Run the comparison; every number of the tables and plots comes from here.
 
@@ -211,9 +212,10 @@ def compute(
     elgamal_episodes, elgamal_N : int
         Short episodes of each attacker through real ElGamal ciphertexts (0: none).
     progress : bool
-        A progress bar on stderr.
+        A progress bar on stderr, labelled ``label`` (the command that runs it: ``compare``,
+        ``evaluate``).
     attackers : sequence of str
-        Names of :data:`~experiments.compare.attackers.ATTACKERS` (default all), played in this
+        Names of :data:`~experiments.compare.attackers.ATTACKERS` (default :data:`DEFAULT_ATTACKERS`), played in this
         order before the learned ones.
     configs : mapping, optional
         System label -> environment configuration, for systems that are not presets.
@@ -258,31 +260,52 @@ def compute(
         advice="use fewer episodes",
     )
     warm_up(plan, points=points, elgamal=elgamal_episodes > 0)  # the bar's rate (its ETA) counts no compile time
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        tty = sys.stderr.isatty()
-        bar = tqdm(total=total, desc="compare", unit="step", unit_scale=True, mininterval=0.5 if tty else 30.0, ascii=not tty)
-    curves: dict[tuple[str, Any], list[Curve]] = {}
-    security: list[dict[str, Any]] = []
-    bounds: list[dict[str, Any]] = []
-    elgamal: list[dict[str, Any]] = []
+    bar = _progress_bar(total, label) if progress else None
     try:
-        for setting, atts in plan:
-            curves[setting.key] = []
-            for att, play in atts:
-                if bar is not None:
-                    bar.set_postfix_str(f"{setting.system} d={setting.delay} {att.name}")
-                curves[setting.key].append(evaluate(play, att, episodes=episodes, seed=seed, points=points, progress=bar))
-                if elgamal_episodes > 0:
-                    elgamal.extend(elgamal_check(play, att, episodes=elgamal_episodes, N=elgamal_N, seed=seed))
-            cs = curves[setting.key]
-            gauss = next((c for c in cs if c.attacker == GAUSSIAN_NAME), None)
-            oracle = next((c for c in cs if c.oracle), None)
-            security.extend(security_row(setting, c, gaussian=gauss, oracle=oracle) for c in cs)
-            bounds.extend(bound_rows(setting))
+        curves, security, bounds, elgamal = _play_plan(
+            plan, episodes=episodes, seed=seed, points=points, elgamal_episodes=elgamal_episodes, elgamal_N=elgamal_N, bar=bar
+        )
     finally:
         if bar is not None:
             bar.close()
     return Result(settings, curves, security, bounds, time.perf_counter() - t0, elgamal, seed)
+
+
+def _progress_bar(total: int, label: str = "compare") -> Any:
+    """The bar of the command ``label`` on stderr (updated every 30 s when stderr is not a terminal)."""
+    from tqdm import tqdm
+
+    tty = sys.stderr.isatty()
+    return tqdm(total=total, desc=label, unit="step", unit_scale=True, mininterval=0.5 if tty else 30.0, ascii=not tty)
+
+
+def _play_plan(
+    plan: Sequence[tuple[Setting, Sequence[tuple[Attacker, Setting]]]],
+    *,
+    episodes: int,
+    seed: int,
+    points: int,
+    elgamal_episodes: int,
+    elgamal_N: int,
+    bar: Any,
+) -> tuple[dict[tuple[str, Any], list[Curve]], list[dict[str, Any]], list[dict[str, Any]], list[dict[str, Any]]]:
+    """Play every attacker of every setting: the curves by setting, the security and bound rows,
+    and the ElGamal checks."""
+    curves: dict[tuple[str, Any], list[Curve]] = {}
+    security: list[dict[str, Any]] = []
+    bounds: list[dict[str, Any]] = []
+    elgamal: list[dict[str, Any]] = []
+    for setting, atts in plan:
+        curves[setting.key] = []
+        for att, play in atts:
+            if bar is not None:
+                bar.set_postfix_str(f"{setting.system} d={setting.delay} {att.name}")
+            curves[setting.key].append(evaluate(play, att, episodes=episodes, seed=seed, points=points, progress=bar))
+            if elgamal_episodes > 0:
+                elgamal.extend(elgamal_check(play, att, episodes=elgamal_episodes, N=elgamal_N, seed=seed))
+        cs = curves[setting.key]
+        gauss = next((c for c in cs if c.attacker == GAUSSIAN_NAME), None)
+        oracle = next((c for c in cs if c.oracle), None)
+        security.extend(security_row(setting, c, gaussian=gauss, oracle=oracle) for c in cs)
+        bounds.extend(bound_rows(setting))
+    return curves, security, bounds, elgamal

@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from encctl_gym._validation import format_count
+
 from .protocol import GAUSSIAN_NAME
 from .records import Result
 from .statistics import paired_ratio
@@ -153,7 +155,7 @@ def summary_markdown(
         attackers = len({(r["system"], r["delay"], r["attacker"]) for r in result.elgamal})
         lines.append(
             f"Through real ElGamal ciphertexts ({result.elgamal[0]['key_length']}-bit key, N = {result.elgamal[0]['N']}): "
-            f"{len(result.elgamal)} episodes over {attackers} attacker settings; {same} of them give the same final "
+            f"{format_count(len(result.elgamal), 'episode')} over {format_count(attackers, 'attacker setting')}; {same} of them give the same final "
             "error as the ideal backend on the same seeds (elgamal.csv)."
         )
     return "\n".join(lines) + "\n"

@@ -59,6 +59,9 @@ One module per job, every public name re-exported here:
   model subclasses it: ``break_cost`` and ``describe``; the key-length search is shared).
 * :mod:`.models` - the shipped models ``paper``, ``precomputation``, ``generic``, and eq:opt_key's
   :func:`minimum_key_length`.
+* :mod:`.factoring` - the factoring family (Paillier moduli): ``gnfs``, ``factory``
+  (Coppersmith), ``batch-nfs`` (Bernstein-Lange) beside the ``paper`` baseline, in their own
+  registry :data:`FACTORING_MODELS`.
 * :mod:`.registry` - :data:`DECIPHERING_MODELS` (name -> class) and :func:`deciphering_model`,
   which builds one by name (the ``--cost-model`` option of ``encctl-gym design``); a model's
   options are the parameters of its constructor.
@@ -66,11 +69,12 @@ One module per job, every public name re-exported here:
 
 from __future__ import annotations
 
-from . import base, formulas, models, registry
+from . import base, factoring, formulas, models, registry
 from .base import *  # noqa: F403
+from .factoring import *  # noqa: F403
 from .formulas import *  # noqa: F403
 from .models import *  # noqa: F403
 from .registry import *  # noqa: F403
 
 #: The public names of the modules above (each module's ``__all__``).
-__all__ = [*formulas.__all__, *base.__all__, *models.__all__, *registry.__all__]
+__all__ = [*formulas.__all__, *base.__all__, *models.__all__, *registry.__all__, *factoring.__all__]
