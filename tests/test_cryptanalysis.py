@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import pickle
 import random
+import subprocess
 import sys
 from functools import cache
 
@@ -323,6 +324,30 @@ def test_pari_time_limit_uses_an_alarm() -> None:
     with pytest.raises(BreakerTimeoutError):
         pre.break_key(hs[0], time_limit=0.5)
     assert pre.break_key(4).s == 1  # PARI is usable after the alarm
+
+
+@needs_pari
+def test_pari_time_limit_holds_when_cysignals_owns_the_alarm() -> None:
+    """With the lattice extra, fpylll imports cysignals, whose SIGALRM handler raises its own
+    AlarmInterrupt: the time limit is still the package's BreakerTimeoutError (fresh process)."""
+    pytest.importorskip("fpylll", reason="needs fpylll (pip install 'encctl-gym[lattice]')")
+    code = (
+        "import fpylll\n"
+        "from encctl_gym.cryptanalysis import get_breaker\n"
+        "from encctl_gym.crypto.group import generate_safe_prime_group\n"
+        "from encctl_gym.errors import BreakerTimeoutError\n"
+        "grp = generate_safe_prime_group(104, rng=11)\n"
+        "pre = get_breaker('pari').precompute(grp)\n"
+        "h = pow(grp.g, 0x1234567890ABCDEF1234567, grp.p)\n"
+        "try:\n"
+        "    pre.break_key(h, time_limit=0.5)\n"
+        "except BreakerTimeoutError:\n"
+        "    print('timeout')\n"
+        "print(pre.break_key(grp.g).s)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split() == ["timeout", "1"]
 
 
 def test_missing_cypari_is_one_line_naming_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -111,8 +111,12 @@ class PariContext(Precomputation):
             else:
                 seconds = max(1, math.ceil(deadline.remaining))
                 result = _ZNLOG_ALARM(target, g, order, seconds)
-        except cp.AlarmInterrupt:
-            raise deadline.error() from None
+        except KeyboardInterrupt as exc:
+            # PARI's alarm arrives as cypari's AlarmInterrupt, or as cysignals' one once fpylll (the
+            # lattice extra) has imported cysignals and taken over SIGALRM: both are the time limit
+            if isinstance(exc, cp.AlarmInterrupt) or type(exc).__name__ == "AlarmInterrupt":
+                raise deadline.error() from None
+            raise
         except cp.PariError as exc:  # PARI gives up (an algorithm it lacks, its stack): one line, ours
             said = " ".join(str(exc).split())
             raise BreakerError(f"pari: znlog failed for h = {format_int(h)}: {format_value(said, 200)}") from None

@@ -38,6 +38,7 @@ from .defenses import AuditDefender, CusumDefender, DetectorDefender, NoiseDefen
 from .elgamal import ElGamalLoop
 from .elgamal_scheme import ElGamalScheme  # registers "modified", "token", "static"
 from .ideal import IdealLoop
+from .paillier_scheme import PaillierScheme  # registers "paillier"
 from .quantize import Quantization
 from .rotation import RotatingDefender  # registers "rotate"
 from .scheme import SCHEMES, EncryptionScheme, make_scheme
@@ -53,6 +54,7 @@ __all__ = [
     "Quantization",
     "EncryptionScheme",
     "ElGamalScheme",
+    "PaillierScheme",
     "SCHEMES",
     "make_scheme",
     "LoopSpec",

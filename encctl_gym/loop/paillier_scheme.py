@@ -40,6 +40,7 @@ from ..crypto.paillier import MAX_MODULUS_BITS, MIN_MODULUS_BITS, PaillierCipher
 from ..crypto.paillier_controller import PaillierControllerServer, PaillierEncoder, PaillierPlant, check_row_sums, to_signed
 from ..errors import KeyMismatchError, ParameterError
 from ..security.cost_models.factoring import FACTORING_MODELS
+from .injection import addition
 from .scheme import SCHEMES, SchemeBase
 
 __all__ = ["PaillierParameters", "PaillierQuantization", "PaillierScheme"]
@@ -159,21 +160,24 @@ class PaillierScheme(SchemeBase):
 
     # ------------------------------------------------------------------ the adversary
     def forge(self, plant: PaillierPlant, a: np.ndarray, encoder: Any, n_cols: int, rng: Any) -> list[PaillierCiphertext]:
-        """Rows ``Enc(pk_t, round(Delta^2 a_i) mod n)``: the plant decodes ``a`` (rounded), from the
+        """Rows ``Enc(pk_t, Ecd(a_i) Ecd(1) mod n)``, the forgery of def:adversary (:func:`~.injection.addition`):
+        the plant decodes ``a`` on the grid of ``1/Delta``, as the ideal backend computes it; from the
         public key alone (``n_cols`` is not used: one ciphertext per row)."""
-        pk, d2 = plant.pk, plant.encoder.delta**2
-        return [encrypt(pk, _scaled(v, d2) % pk.n, rng) for v in np.asarray(a, dtype=float).ravel().tolist()]
+        pk, delta = plant.pk, plant.encoder.delta
+        one = plant.encoder.quantize(1.0)
+        return [encrypt(pk, addition(v, delta, one) % pk.n, rng) for v in np.asarray(a, dtype=float).ravel().tolist()]
 
     def add(
         self, plant: PaillierPlant, out: Any, a: np.ndarray, encoder: Any, secret_of: Callable[[Any], Any], rng: Any
     ) -> list[PaillierCiphertext]:
-        """The honest rows times ``g^(round(Delta^2 a_i))``: the plant decodes ``u + a``; no secret is used."""
-        d2 = plant.encoder.delta**2
+        """The honest rows times ``g^d`` with ``d = Ecd(a_i) Ecd(1)`` (:func:`~.injection.addition`):
+        the plant decodes ``u + a``; no secret is used."""
+        delta, one = plant.encoder.delta, plant.encoder.quantize(1.0)
         rows = list(out)
         vals = np.asarray(a, dtype=float).ravel().tolist()
         if len(vals) != len(rows):
             raise ParameterError(f"a must have {len(rows)} entries, got {len(vals)}")
-        return [ct + _scaled(v, d2) for ct, v in zip(rows, vals)]
+        return [ct + addition(v, delta, one) for ct, v in zip(rows, vals)]
 
     def public_key(self, plant: PaillierPlant) -> Any:
         return plant.pk
@@ -200,10 +204,6 @@ class PaillierScheme(SchemeBase):
         raise ParameterError(
             f"the paillier scheme's keys are broken by factoring ({', '.join(FACTORERS)}), not {format_value(breaker)}"
         )
-
-
-def _scaled(v: float, d2: float) -> int:
-    return int(round(float(v) * d2))
 
 
 SCHEMES.register(PaillierScheme)

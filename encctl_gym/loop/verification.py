@@ -177,7 +177,9 @@ class LinearCheckDefender(_PlantSidePolicy):
         scheme = self._params.encryption()
         encoder = scheme.encoder(group, self.delta)
         self.quantization = scheme.quantization(self.Phi, encoder, float(self._params.x_bound))
-        E = self.quantization.phi_int
+        E = getattr(self.quantization, "phi_int", None)
+        if E is None:  # Paillier quantises Phi in the plant's parties; its check is security.verification.PaillierMac
+            raise ParameterError(f"the linear check verifies the ElGamal schemes' quantised Phi; scheme {scheme.name!r} has none")
         x_max = int(round(self.delta * float(self._params.x_bound))) + int(self.max_shift) + 1
         if max(sum(abs(int(v)) for v in row) for row in E) * x_max >= EXACT_SUM_LIMIT:
             raise ParameterError(
