@@ -329,15 +329,17 @@ def test_pari_time_limit_uses_an_alarm() -> None:
 @needs_pari
 def test_pari_time_limit_holds_when_cysignals_owns_the_alarm() -> None:
     """With the lattice extra, fpylll imports cysignals, whose SIGALRM handler raises its own
-    AlarmInterrupt: the time limit is still the package's BreakerTimeoutError (fresh process)."""
+    AlarmInterrupt once imported after PARI: the time limit is still the package's
+    BreakerTimeoutError, not an interrupt that ends the caller (fresh process)."""
     pytest.importorskip("fpylll", reason="needs fpylll (pip install 'encctl-gym[lattice]')")
     code = (
-        "import fpylll\n"
         "from encctl_gym.cryptanalysis import get_breaker\n"
         "from encctl_gym.crypto.group import generate_safe_prime_group\n"
         "from encctl_gym.errors import BreakerTimeoutError\n"
         "grp = generate_safe_prime_group(104, rng=11)\n"
         "pre = get_breaker('pari').precompute(grp)\n"
+        "pre.break_key(grp.g)\n"  # PARI loaded first, then cysignals takes over SIGALRM
+        "import fpylll\n"
         "h = pow(grp.g, 0x1234567890ABCDEF1234567, grp.p)\n"
         "try:\n"
         "    pre.break_key(h, time_limit=0.5)\n"
