@@ -164,3 +164,39 @@ def test_the_game_runs_on_paillier_with_the_linear_check_off_and_named() -> None
     acts["defender"][3] = 1.0
     with pytest.raises(ParameterError, match="verify lever is off.*'paillier' has none"):
         game.step(acts)
+
+
+@pytest.mark.parametrize("factorer", ["rho-factor", "ecm"])
+def test_the_environment_factors_every_fresh_modulus_and_sees_what_the_oracle_sees(factorer: str) -> None:
+    """Real-break mode: the adversary factors each modulus it meets (a fresh one every 2 steps),
+    and its observations equal those of the key oracle bit for bit."""
+    from encctl_gym.envs.encrypted_lti_attack import EncryptedLTIAttackEnv
+
+    cfg = {"preset": "small", "gamma_opt": False, "key_length": 64, "max_samples": 8, "warmup_steps": 1}
+    cfg |= {"scheme": {"name": "paillier", "rotation_period": 2}, "crypto": "elgamal", "crypto_seed": 3, "decipher_delay": 0}
+    runs, envs = [], []
+    for breaker in (factorer, None):
+        env = EncryptedLTIAttackEnv(config={**cfg, "breaker": breaker})
+        obs, _ = env.reset(seed=0)
+        rows, rng = [obs], np.random.default_rng(5)
+        for _ in range(8):
+            obs, _, te, tr, _ = env.step(rng.uniform(-1, 1, env.action_space.shape).astype(np.float32))
+            rows.append(obs)
+            if te or tr:
+                break
+        runs.append(rows)
+        envs.append(env)
+    assert len(runs[0]) == len(runs[1]) and all(np.array_equal(a, b) for a, b in zip(*runs))
+    decipherer = envs[0].unwrapped.loop.decipherer
+    assert len(decipherer.costs) >= 3  # one factorisation per modulus met
+    assert all(method == factorer for method, _ in decipherer.costs) and decipherer.seconds > 0
+
+
+def test_a_factorer_on_a_discrete_log_scheme_is_refused_by_name() -> None:
+    from encctl_gym.envs.encrypted_lti_attack import EncryptedLTIAttackEnv
+
+    cfg = {"preset": "small", "gamma_opt": False, "key_length": 64, "max_samples": 8, "crypto": "elgamal", "breaker": "ecm"}
+    with pytest.raises(ParameterError, match="breaker 'ecm' factors Paillier moduli; the keys of scheme 'modified'"):
+        EncryptedLTIAttackEnv(config=cfg).reset(seed=0)
+    with pytest.raises(ParameterError, match="unknown breaker 'gnfs'; choose one of .*rho-factor"):
+        EncryptedLTIAttackEnv(config={**cfg, "breaker": "gnfs"})

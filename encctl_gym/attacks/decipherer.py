@@ -29,7 +29,15 @@ from typing import Any, Protocol, runtime_checkable
 
 from ..errors import ParameterError
 
-__all__ = ["BreakableScheme", "Decipherer", "KeyOracle", "KeyBreaking", "make_decipherer", "DEFAULT_BREAKER_TIME_LIMIT"]
+__all__ = [
+    "BreakableScheme",
+    "Decipherer",
+    "KeyOracle",
+    "KeyBreaking",
+    "KeyFactoring",
+    "make_decipherer",
+    "DEFAULT_BREAKER_TIME_LIMIT",
+]
 
 
 @runtime_checkable
@@ -205,6 +213,47 @@ class KeyBreaking:
             self._state.add_tokens([token])
 
 
+class KeyFactoring:
+    """The adversary that factors each Paillier modulus it meets (:mod:`encctl_gym.cryptanalysis.factoring`):
+    a new key is a new modulus, so nothing is precomputed or shared between keys; each recovered
+    key is checked by decrypting (:func:`~encctl_gym.cryptanalysis.paillier_keys.break_paillier_key`).
+
+    Raises
+    ------
+    BreakerLimitError
+        At construction, if one modulus of the parameters' size would take longer than ``time_limit``.
+    """
+
+    def __init__(self, factorer: Any, params: Any, *, time_limit: float = DEFAULT_BREAKER_TIME_LIMIT, rng: Any = None) -> None:
+        factorer.check_time(
+            int(params.key_length),
+            time_limit,
+            limit_name="breaker_time_limit",
+            advice="use a shorter key_length, another breaker or a longer breaker_time_limit",
+        )
+        self.breaker, self.group, self.time_limit, self._rng = factorer, params, float(time_limit), rng
+        self._known: dict[int, Any] = {}
+        self.costs: list[tuple[str, Any]] = []
+        self.seconds = 0.0
+
+    def start_episode(self) -> None:
+        self._known, self.costs, self.seconds = {}, [], 0.0
+
+    def secret(self, pk: Any) -> Any:
+        from ..cryptanalysis.paillier_keys import break_paillier_key
+
+        n = int(pk.n)
+        if n not in self._known:
+            key = break_paillier_key(self.breaker, pk, time_limit=self.time_limit, rng=self._rng)
+            self.costs.append((key.factorization.method, key.factorization.cost))
+            self.seconds += key.seconds
+            self._known[n] = key.secret
+        return self._known[n]
+
+    def observe_token(self, token: Any) -> None:
+        return None  # Paillier has no update token
+
+
 def make_decipherer(
     breaker: str | None,
     group: Any,
@@ -229,6 +278,19 @@ def make_decipherer(
         return KeyOracle(read_key)
     if not isinstance(breaker, str):
         raise ParameterError(f"breaker must be a breaker name, got {breaker!r}")
+    from ..cryptanalysis.factoring_registry import FACTORERS
+
+    if breaker in FACTORERS:
+        from ..cryptanalysis.factoring import Factorer
+
+        factorer = scheme.breaker_for(breaker, adversary, rng)
+        if not isinstance(factorer, Factorer):
+            raise ParameterError(
+                f"breaker {breaker!r} factors Paillier moduli; the keys of scheme "
+                f"{getattr(scheme, 'name', type(scheme).__name__)!r} are discrete logarithms (a breaker of "
+                "encctl_gym.cryptanalysis.BREAKERS)"
+            )
+        return KeyFactoring(factorer, group, time_limit=time_limit, rng=rng)
     return KeyBreaking(
         breaker, group, scheme=scheme, adversary=adversary, time_limit=time_limit, rng=rng, precomputation=precomputation
     )

@@ -269,11 +269,12 @@ def _choice(name: str, value: Any, options: tuple[str, ...]) -> str:
 def _breaking(cfg: Mapping[str, Any], crypto: str) -> tuple[str | None, str, float]:
     """The checked ``breaker``, ``deciphering_clock`` and ``breaker_time_limit`` (the breaker's
     feasibility on the loop's group is checked when the backend is built)."""
+    from ..cryptanalysis.factoring_registry import FACTORERS
     from ..cryptanalysis.registry import BREAKERS as breakers
 
     breaker = cfg["breaker"]
-    if breaker is not None:
-        breaker = _choice("breaker", breaker, tuple(breakers))
+    if breaker is not None:  # a discrete-log breaker or a factorer (the scheme refuses the other family)
+        breaker = _choice("breaker", breaker, (*breakers, *FACTORERS))
         if crypto != "elgamal":
             raise ParameterError(f"breaker={breaker!r} needs crypto='elgamal': the {crypto} backend has no ciphertexts to break")
     clock = _choice("deciphering_clock", cfg["deciphering_clock"], DECIPHERING_CLOCKS)

@@ -32,7 +32,10 @@ key                           meaning
                               with the recovered exponents only; needs ``crypto="elgamal"``
                               and a group the breaker can break (the loop's group has
                               64 bits for ``key_length <= 64``: index calculus and PARI
-                              break it in about 0.5 s, then about 1 ms resp. 0.1 s per key)
+                              break it in about 0.5 s, then about 1 ms resp. 0.1 s per key);
+                              with ``scheme="paillier"`` a factorer (``"ecm"``,
+                              ``"rho-factor"``, ``"p-1"``, ``"pari-factor"``) factors each
+                              modulus met and decrypts with the recovered key
 ``breaker_precomputation``    ``None`` or a file saved by ``encctl-gym crack
                               --save-precomputation`` (the index calculus's factor base
                               of the loop's group, checked against it): the breaker loads
