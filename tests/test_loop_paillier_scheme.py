@@ -200,3 +200,20 @@ def test_a_factorer_on_a_discrete_log_scheme_is_refused_by_name() -> None:
         EncryptedLTIAttackEnv(config=cfg).reset(seed=0)
     with pytest.raises(ParameterError, match="unknown breaker 'gnfs'; choose one of .*rho-factor"):
         EncryptedLTIAttackEnv(config={**cfg, "breaker": "gnfs"})
+
+
+def test_the_vector_environment_runs_paillier_on_its_ideal_backend() -> None:
+    """The vector environment batches the ideal backend (which the test above shows equal to the
+    ciphertext backend bit for bit); the Paillier rounding runs there too."""
+    from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
+
+    cfg = {"preset": "small", "gamma_opt": False, "key_length": 96, "max_samples": 10, "warmup_steps": 1}
+    vec = EncryptedLTIAttackVectorEnv(2, config={**cfg, "scheme": "paillier", "crypto": "ideal", "crypto_seed": 3})
+    obs, _ = vec.reset(seed=1)
+    first = obs.copy()
+    for _ in range(4):
+        obs, rewards, _, _, _ = vec.step(np.full(vec.action_space.shape, 0.5, dtype=np.float32))
+        assert np.isfinite(rewards).all()
+    assert obs.shape == first.shape and not np.array_equal(obs, first)
+    with pytest.raises(ParameterError, match="ideal backend only"):
+        EncryptedLTIAttackVectorEnv(2, config={**cfg, "scheme": "paillier", "crypto": "elgamal"})
