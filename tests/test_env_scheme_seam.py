@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from episodes import rollout
 
 from encctl_gym.attacks.forgery import injection_integers
 from encctl_gym.crypto.encoding import Encoder, lift
@@ -123,15 +124,7 @@ if MultiplicativePad.name not in SCHEMES:
 
 def _trajectory(config: dict[str, Any], steps: int, seed: int = 4) -> tuple[list[np.ndarray], EncryptedLTIAttackEnv]:
     env = EncryptedLTIAttackEnv(config=config)
-    obs, _ = env.reset(seed=seed)
-    out = [obs]
-    rng = np.random.default_rng(9)
-    for _ in range(steps):
-        obs, _, te, tr, _ = env.step(rng.uniform(-1, 1, env.action_space.shape).astype(np.float32))
-        out.append(obs)
-        if te or tr:
-            break
-    return out, env
+    return rollout(env, seed=seed, action_seed=9, steps=steps), env
 
 
 def test_the_toy_scheme_implements_the_protocol_and_the_elgamal_variants_too():

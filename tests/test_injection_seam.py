@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from episodes import rollout
 
 from encctl_gym.envs.encrypted_lti_attack import EncryptedLTIAttackEnv
 from encctl_gym.envs.vector import EncryptedLTIAttackVectorEnv
@@ -18,15 +19,7 @@ BASE = {"preset": "small", "gamma_opt": False, "key_length": 64, "max_samples": 
 
 
 def _play(config: dict[str, Any], actions: str = "random", seed: int = 3) -> np.ndarray:
-    env = EncryptedLTIAttackEnv(config=config)
-    obs, _ = env.reset(seed=seed)
-    out, rng = [obs], np.random.default_rng(1)
-    while True:
-        a = rng.uniform(-1, 1, env.action_space.shape) if actions == "random" else np.zeros(env.action_space.shape)
-        obs, _, term, trunc, _ = env.step(a.astype(np.float32))
-        out.append(obs)
-        if term or trunc:
-            return np.array(out)
+    return np.array(rollout(EncryptedLTIAttackEnv(config=config), seed=seed, action_seed=1, actions=actions))
 
 
 @pytest.mark.parametrize("crypto", ["ideal", "elgamal"])

@@ -7,6 +7,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from episodes import rollout
 
 from encctl_gym.cryptanalysis.factoring import Factorer
 from encctl_gym.cryptanalysis.paillier_keys import break_paillier_key
@@ -128,15 +129,7 @@ def test_both_backends_give_the_same_paillier_episode_bit_for_bit(injection: str
     cfg |= {"scheme": "paillier", "crypto_seed": 3, "injection": injection, "decipher_delay": 0}
     runs = []
     for crypto in ("elgamal", "ideal"):
-        env = EncryptedLTIAttackEnv(config={**cfg, "crypto": crypto})
-        obs, _ = env.reset(seed=4)
-        rows, rng = [obs], np.random.default_rng(9)
-        for _ in range(20):
-            obs, _, te, tr, _ = env.step(rng.uniform(-1, 1, env.action_space.shape).astype(np.float32))
-            rows.append(obs)
-            if te or tr:
-                break
-        runs.append(rows)
+        runs.append(rollout(EncryptedLTIAttackEnv(config={**cfg, "crypto": crypto}), seed=4, action_seed=9, steps=20))
     assert len(runs[0]) == len(runs[1]) > 5
     assert all(np.array_equal(a, b) for a, b in zip(*runs))
     assert not all(np.array_equal(runs[0][0], r) for r in runs[0][1:])  # the episode moved
@@ -177,14 +170,7 @@ def test_the_environment_factors_every_fresh_modulus_and_sees_what_the_oracle_se
     runs, envs = [], []
     for breaker in (factorer, None):
         env = EncryptedLTIAttackEnv(config={**cfg, "breaker": breaker})
-        obs, _ = env.reset(seed=0)
-        rows, rng = [obs], np.random.default_rng(5)
-        for _ in range(8):
-            obs, _, te, tr, _ = env.step(rng.uniform(-1, 1, env.action_space.shape).astype(np.float32))
-            rows.append(obs)
-            if te or tr:
-                break
-        runs.append(rows)
+        runs.append(rollout(env, seed=0, action_seed=5, steps=8))
         envs.append(env)
     assert len(runs[0]) == len(runs[1]) and all(np.array_equal(a, b) for a, b in zip(*runs))
     decipherer = envs[0].unwrapped.loop.decipherer

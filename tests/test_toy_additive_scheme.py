@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from episodes import rollout
 
 from encctl_gym.cli import main
 from encctl_gym.envs.encrypted_lti_attack import EncryptedLTIAttackEnv
@@ -187,14 +188,7 @@ BASE = {
 
 
 def _play(config: dict[str, Any], seed: int = 5) -> np.ndarray:
-    env = EncryptedLTIAttackEnv(config=config)
-    obs, _ = env.reset(seed=seed)
-    out, rng = [obs], np.random.default_rng(2)
-    while True:
-        obs, _, term, trunc, _ = env.step(rng.uniform(-1, 1, env.action_space.shape).astype(np.float32))
-        out.append(obs)
-        if term or trunc:
-            return np.array(out)
+    return np.array(rollout(EncryptedLTIAttackEnv(config=config), seed=seed, action_seed=2))
 
 
 @pytest.mark.parametrize("injection", ["replace", "add", "pass"])

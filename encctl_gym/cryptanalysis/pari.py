@@ -114,7 +114,7 @@ class PariContext(Precomputation):
         except KeyboardInterrupt as exc:
             # PARI's alarm arrives as cypari's AlarmInterrupt, or as cysignals' one once fpylll (the
             # lattice extra) has imported cysignals and taken over SIGALRM: both are the time limit
-            if isinstance(exc, cp.AlarmInterrupt) or type(exc).__name__ == "AlarmInterrupt":
+            if type(exc).__name__ == "AlarmInterrupt":  # cypari.AlarmInterrupt or cysignals.signals.AlarmInterrupt
                 raise deadline.error() from None
             raise
         except cp.PariError as exc:  # PARI gives up (an algorithm it lacks, its stack): one line, ours
