@@ -25,12 +25,15 @@ the :class:`~encctl_gym.loop.provisioning.ProvisioningCost`, and sums them per e
 (``EpisodeCore.rotation``; the info fields of :func:`rotation_info`). Both backends rotate (the
 ideal one rebuilds its quantisation table for the new group, the ElGamal one its keys and
 ciphertexts), so their trajectories stay bit-identical for one seed. Every episode starts on the
-loop's first group again and meets the same sequence of groups (the pool keeps them by index).
+loop's first group again. With ``crypto_seed`` set every episode meets the same sequence of groups
+(the pool keeps them by index); with ``crypto_seed=None`` the groups follow the episode's seed
+(:class:`RotationGroups`), so one seed gives one episode in any instance.
 """
 
 from __future__ import annotations
 
 import time
+from collections import OrderedDict
 from collections.abc import Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -46,7 +49,16 @@ from ..security.rotation import check_rotation_period
 from .defender import DEFENDERS, DefenderAction, DefenderBase, DefenderPolicy, PlantView, make_defender
 from .provisioning import GroupDecipherers, RotationRecord
 
-__all__ = ["GroupPool", "GenerationTally", "RotatingDefender", "move_loop", "rotation_info", "MAX_AHEAD", "check_ahead"]
+__all__ = [
+    "GroupPool",
+    "RotationGroups",
+    "GenerationTally",
+    "RotatingDefender",
+    "move_loop",
+    "rotation_info",
+    "MAX_AHEAD",
+    "check_ahead",
+]
 
 #: Most groups a :class:`GroupPool` generates ahead. The worker makes one group at a time and the
 #: episode takes one every ``K`` steps, so a deeper pool only starts sooner: 16 covers a rotation
@@ -181,6 +193,65 @@ class GroupPool:
         return f"GroupPool(bits={self.bits}, ahead={self.ahead}, made={len(self._groups)})"
 
 
+class RotationGroups:
+    """Where a rotating defender's groups come from, episode by episode (one home for the
+    :class:`RotatingDefender` and the game's rotate lever).
+
+    * ``crypto_seed`` an integer: one :class:`GroupPool` seeded from the plant's group stream, a
+      child of ``party_random_sources(crypto_seed)["plant"]``; every episode meets the same groups.
+    * ``crypto_seed`` ``None``: the keys come from the secure source, but the groups (public
+      parameters, sent to the server at every move) follow the episode's seed, so that two
+      instances reset with the same seed meet the same groups and run the same episode (the
+      quantisation depends on the group). The pool of an episode is keyed by 256 bits drawn from a
+      child spawned off the defender's stream of copy 0 (``rngs[0]``; spawning leaves that stream's
+      draws unchanged): ``reset(seed=s)`` meets the groups of ``s``, a reset without a seed meets
+      new ones. The last :attr:`MAX_POOLS` pools are kept, so re-seeding does not regenerate.
+      In a batch all copies share the loop's group, so copy 0's seed decides.
+
+    Raises
+    ------
+    ResourceLimitError
+        If the time model expects a group of ``bits`` to take more than the pool's limit.
+    """
+
+    #: Pools kept for re-seeded episodes (``crypto_seed=None``); an evicted pool's worker stops.
+    MAX_POOLS = 4
+
+    def __init__(self, bits: int, crypto_seed: int | None, ahead: int) -> None:
+        from .elgamal import party_random_sources
+
+        self.crypto_seed = crypto_seed
+        self.ahead = check_ahead("ahead", ahead)
+        self.fixed = GroupPool(bits, party_random_sources(crypto_seed)["plant"].spawn("group-rotation"), ahead)
+        self.bits = self.fixed.bits
+        self._pools: OrderedDict[int, GroupPool] = OrderedDict()
+
+    def for_episode(self, rng: np.random.Generator) -> GroupPool:
+        """The pool of the episode whose defender stream (copy 0) is ``rng``."""
+        if self.crypto_seed is not None:
+            return self.fixed
+        from ..crypto.arith import seeded_random
+
+        words = rng.spawn(1)[0].integers(0, 2**64, size=4, dtype=np.uint64)
+        key = int.from_bytes(words.astype(">u8").tobytes(), "big")
+        pool = self._pools.pop(key, None)
+        if pool is None:
+            pool = GroupPool(self.bits, seeded_random(key, "group-rotation"), self.ahead, self.fixed.max_seconds)
+        self._pools[key] = pool  # most recent last
+        while len(self._pools) > self.MAX_POOLS:
+            self._pools.popitem(last=False)[1].close()
+        return pool
+
+    def close(self) -> None:
+        """Stop every pool's worker (groups already made are kept)."""
+        self.fixed.close()
+        for pool in self._pools.values():
+            pool.close()
+
+    def __repr__(self) -> str:
+        return f"RotationGroups(bits={self.bits}, crypto_seed={self.crypto_seed!r}, pools={len(self._pools)})"
+
+
 @dataclass
 class GenerationTally:
     """The groups a :class:`RotatingDefender` took in one episode."""
@@ -217,28 +288,28 @@ class RotatingDefender(DefenderBase):
             raise ParameterError("a rotating defender cannot wrap another rotating defender")
         self.inner: DefenderPolicy = make_defender(inner)
         self.ahead = check_ahead("ahead", ahead)
-        self.pool: GroupPool | None = None
+        self.groups: RotationGroups | None = None
+        self.pool: GroupPool | None = None  # the episode's (RotationGroups.for_episode)
         self.initial_group: GroupParams | None = None
         self.tally = GenerationTally()
         self._next = 1
 
     def group(self, params: Any) -> Any:
-        """The inner policy's group; the pool of fresh groups of its size, seeded from the plant's stream."""
-        from .elgamal import party_random_sources
-
+        """The inner policy's group; the fresh groups of its size (:class:`RotationGroups`)."""
         group = self.inner.group(params)
         if not (isinstance(group, GroupParams) and group.is_safe_prime):
             raise ParameterError(f"group rotation needs a safe-prime group to start from, got {format_value(group)}")
         self.initial_group = group
         self.horizon = int(params.horizon)
-        source = party_random_sources(params.crypto_seed)["plant"].spawn("group-rotation")
-        self.pool = GroupPool(group.bits, source, self.ahead)
+        self.groups = RotationGroups(group.bits, params.crypto_seed, self.ahead)
+        self.pool = self.groups.fixed
         return group
 
     def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
         self.inner.reset(K, n, m, rngs)
-        if self.pool is None:
+        if self.groups is None:
             raise ParameterError("the rotating defender's group() must pick the loop's group before an episode")
+        self.pool = self.groups.for_episode(rngs[0])
         self._next = 1
         self.tally = GenerationTally()
         self.pool.prefetch(1)
@@ -263,9 +334,9 @@ class RotatingDefender(DefenderBase):
         return DefenderAction(input_noise=action.input_noise, end=action.end, new_group=group)
 
     def close(self) -> None:
-        """Stop the pool's worker (the environment's ``close``); the inner policy's too."""
-        if self.pool is not None:
-            self.pool.close()
+        """Stop the pools' workers (the environment's ``close``); the inner policy's too."""
+        if self.groups is not None:
+            self.groups.close()
         self.inner.close()
 
     def __repr__(self) -> str:

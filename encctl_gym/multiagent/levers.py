@@ -21,9 +21,9 @@ The defender's action is a vector in ``[-1, 1]``, one entry per lever of :data:`
   ``cost_increase / cost_base`` (linear in ``sigma_d2``).
 
 * ``"rotate"`` (> 0: rotate now): the loop moves to a fresh safe-prime group of its size before
-  this step's period (:mod:`encctl_gym.loop.rotation`: the groups come from a
-  :class:`~encctl_gym.loop.rotation.GroupPool` seeded from the plant's stream, the same sequence
-  as the ``"rotate"`` defender's), so the samples from the next one on lie in the new group and
+  this step's period (:mod:`encctl_gym.loop.rotation`: the groups come from
+  :class:`~encctl_gym.loop.rotation.RotationGroups`, the same sequence as the ``"rotate"``
+  defender's: from the plant's stream with ``crypto_seed`` set, from the episode's seed without), so the samples from the next one on lie in the new group and
   the attacker's deciphering pays for it (its cost model charges per group: the game's
   :class:`~encctl_gym.multiagent.clock.GroupClock`). Each rotation costs
   :attr:`GameRules.rotation_cost`.
@@ -60,7 +60,7 @@ from ..errors import ParameterError
 from ..loop.defender import DefenderAction, DefenderStreams, PlantView
 from ..loop.defenses import _PlantSidePolicy, audit_tolerance
 from ..loop.detection import Audit, ChiSquaredDetector
-from ..loop.rotation import GenerationTally, GroupPool, check_ahead
+from ..loop.rotation import GenerationTally, GroupPool, RotationGroups, check_ahead
 from ..loop.verification import LinearCheckDefender
 from ..security.defenses import noise_defense_price
 from ..security.verification import check_secret_range
@@ -205,14 +205,11 @@ class DefenderLevers(_PlantSidePolicy):
         self.horizon = int(params.horizon)
         price = noise_defense_price(self.A, self.B, self.Phi, sigma_w2=self.sigma_w2, sigma_d2=1.0)
         self.unit_noise_price = price["cost_increase"] / price["cost_base"]  # per unit sigma_d2 (linear)
-        self.pool: GroupPool | None = None
-        if (
-            self.rules.rotation and isinstance(group, GroupParams) and group.is_safe_prime
-        ):  # the groups the "rotate" defender meets
-            from ..loop.elgamal import party_random_sources
-
-            source = party_random_sources(params.crypto_seed)["plant"].spawn("group-rotation")
-            self.pool = GroupPool(group.bits, source, self.rules.rotation_ahead)
+        self.groups: RotationGroups | None = None
+        self.pool: GroupPool | None = None  # the episode's (RotationGroups.for_episode)
+        if self.rules.rotation and isinstance(group, GroupParams) and group.is_safe_prime:  # as the "rotate" defender
+            self.groups = RotationGroups(group.bits, params.crypto_seed, self.rules.rotation_ahead)
+            self.pool = self.groups.fixed
         self._verifier: LinearCheckDefender | None = LinearCheckDefender(self.rules.verify_secret_range)
         self._no_verifier = ""
         try:
@@ -239,6 +236,8 @@ class DefenderLevers(_PlantSidePolicy):
         self.rotated = False  # the loop moved at the last step
         self.tally = GenerationTally()  # read by the episode's rotation info
         self._next_group = 1
+        if self.groups is not None:
+            self.pool = self.groups.for_episode(rngs[0])
         if self.pool is not None and self.rules.rotation_ahead:
             self.pool.prefetch(1)
         self.audited = False  # an audit ran at the last step
@@ -316,8 +315,8 @@ class DefenderLevers(_PlantSidePolicy):
 
     def close(self) -> None:
         """Stop the group pool's worker."""
-        if self.pool is not None:
-            self.pool.close()
+        if self.groups is not None:
+            self.groups.close()
 
     # ------------------------------------------------------------- the game's side
     def cost(self) -> float:
