@@ -65,8 +65,8 @@ class MultiplicativePad(SchemeBase):
     def rounding(self, params: Any, limit: int) -> Any:
         return make_scheme("modified").rounding(params, limit)
 
-    def quantization(self, Phi: Any, encoder: Any, x_bound: float) -> Any:
-        return make_scheme("modified").quantization(Phi, encoder, x_bound)
+    def quantization(self, Phi: Any, encoder: Any, x_bound: float, u_max: float) -> Any:
+        return make_scheme("modified").quantization(Phi, encoder, x_bound, u_max)
 
     def add(self, plant: Any, out: Any, a: np.ndarray, encoder: Any, secret_of: Any, rng: Any) -> Any:
         raise ParameterError("the toy pad has no addition")

@@ -124,7 +124,7 @@ class OneTimePad(SchemeBase):
     def encoder(self, params: Modulus, delta: float) -> ScaleEncoder:
         return ScaleEncoder(params, delta)
 
-    def quantization(self, Phi: np.ndarray, encoder: ScaleEncoder, x_bound: float) -> Quantized:
+    def quantization(self, Phi: np.ndarray, encoder: ScaleEncoder, x_bound: float, u_max: float) -> Quantized:
         return Quantized(Phi, encoder, x_bound)
 
     def parties(self, quantization: Quantized, plant_rng: Any, server_rng: Any) -> tuple[PadPlant, PadServer]:

@@ -68,6 +68,8 @@ __all__ = [
     "LWECiphertext",
     "keygen",
     "keygen_shared",
+    "split",
+    "add_plaintext",
     "encrypt",
     "decrypt",
     "decryption_noise",
@@ -504,6 +506,37 @@ def concatenate(*cts: LWECiphertext) -> LWECiphertext:
     )
 
 
+def split(ct: LWECiphertext) -> list[LWECiphertext]:
+    """The ``k`` ciphertexts of ``ct`` one by one (the inverse of :func:`concatenate`)."""
+    ct = _check_ct(ct)
+    return [
+        LWECiphertext(ct.public, ct.c1[i : i + 1], ct.c2[i : i + 1], (ct.noise_bound[i],), (ct.message_bound[i],))
+        for i in range(len(ct))
+    ]
+
+
+def add_plaintext(ct: LWECiphertext, d: Any) -> LWECiphertext:
+    """Eval of adding known integers ``d`` (shape (k,)): ``c2 + Delta_q d mod q`` decrypts to
+    ``mu + d``; the noise is unchanged, the message bound grows by ``|d|`` (checked first, so
+    ``|Delta_q d| <= q / 2`` and the int64 arithmetic is exact). No key is needed.
+
+    Raises
+    ------
+    ShapeError
+        If ``d`` has not one integer per ciphertext.
+    EncodingOverflowError
+        If a message bound would leave the plaintext space.
+    """
+    ct = _check_ct(ct)
+    vals = [check_int("d", v) for v in np.asarray(d, dtype=object).reshape(-1).tolist()]
+    if len(vals) != len(ct):
+        raise ShapeError(f"d must have {len(ct)} entries, got {len(vals)}")
+    p = ct.params
+    noise, msg = _checked_bounds(p, list(ct.noise_bound), [b + abs(v) for b, v in zip(ct.message_bound, vals)])
+    shift = np.array([p.delta_q * v for v in vals], dtype=np.int64)
+    return LWECiphertext(ct.public, ct.c1, (ct.c2 + shift) % p.q, noise, msg)
+
+
 def encode(x: Any, scale: float) -> np.ndarray:
     """Ecd of Definition def:ec for LWE: ``round(scale x)`` as int64 (round half to even).
 
@@ -532,11 +565,15 @@ def quantization_error_bound(Phi: Any, x: Any, delta_x: float, delta_phi: float)
     return np.abs(Phi).sum(axis=1) / (2 * dx) + np.abs(x).sum() / (2 * dp) + Phi.shape[1] / (4 * dp * dx)
 
 
-def controller_parameters(n: int, Phi: Any, delta_x: float, delta_phi: float, x_bound: float, eta: int = 2) -> LWEParams:
+def controller_parameters(
+    n: int, Phi: Any, delta_x: float, delta_phi: float, x_bound: float, eta: int = 2, *, message_margin: int = 0
+) -> LWEParams:
     """The smallest parameters of dimension ``n`` (m = n) on which :class:`LWEController` runs
     ``u = Phi x`` for every ``|x_j| <= x_bound``: ``t = 2 M + 1`` with the message bound
-    ``M = max_i ||Phi_int,i||_1 round(Delta_x x_bound)``, and ``q = t (2 N + 1)`` with the noise
-    bound ``N = max_i ||Phi_int,i||_1 B_fresh`` (then ``floor(q / t) = 2 N + 1``, ``2 N < Delta_q``).
+    ``M = max_i ||Phi_int,i||_1 round(Delta_x x_bound) + message_margin``, and ``q = t (2 N + 1)``
+    with the noise bound ``N = max_i ||Phi_int,i||_1 B_fresh`` (then ``floor(q / t) = 2 N + 1``,
+    ``2 N < Delta_q``). ``message_margin`` reserves room for an integer added to an output
+    (:func:`add_plaintext`, the loop's additive injection) or sent in its place.
 
     Raises
     ------
@@ -546,7 +583,8 @@ def controller_parameters(n: int, Phi: Any, delta_x: float, delta_phi: float, x_
     n, eta = check_int("n", n, minimum=1), check_int("eta", eta, minimum=1)
     row = int(np.abs(encode(as_finite_array("Phi", Phi, ndim=2), delta_phi)).sum(axis=1).max())
     x_int = int(round(check_positive("delta_x", delta_x) * check_positive("x_bound", x_bound)))
-    t = 2 * max(row * x_int, 1) + 1
+    margin = check_int("message_margin", message_margin, minimum=0)
+    t = 2 * max(row * x_int + margin, 1) + 1
     noise = max(row, 1) * (eta * eta * 2 * n + eta)
     return LWEParams(n=n, q=t * (2 * noise + 1), t=t, eta=eta)
 

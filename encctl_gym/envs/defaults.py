@@ -18,13 +18,15 @@ key                           meaning
 ``adversary``                 ``"eavesdropper"`` or ``"server"``
 ``security_parameter``        lambda in bits; ``None``: from ``key_length``, else lambda* of
                               Theorem thm:opt_sec for the preset's design parameters
-``key_length``                key length k in bits (lambda = log2 Omega(k), eq:opt_key)
+``key_length``                key length k in bits (lambda = log2 Omega(k), eq:opt_key);
+                              for ``scheme="lwe"`` the dimension n of the secret
 ``deciphering_model``         what breaking the keys costs: a model of the scheme's ``cost_models``
                               (``None``: its ``baseline_model``); ElGamal's
                               (:mod:`encctl_gym.security.cost_models`):
                               ``"paper"`` (def:sdt: ``2^lambda`` per key), ``"precomputation"``
                               (one GNFS precomputation per group, then a cheap step per key),
-                              ``"generic"`` (Pollard rho per key)
+                              ``"generic"`` (Pollard rho per key); LWE's: ``"core-svp"``,
+                              ``"core-svp-quantum"``, ``"core-svp-plausible"`` (primal uSVP)
 ``breaker``                   ``None`` (the break is simulated: the plant's key of the period
                               is read) or a key breaker of :mod:`encctl_gym.cryptanalysis`
                               (``"index-calculus"``, ``"pari"``, ``"rho-multi"``, ...): every
@@ -35,7 +37,8 @@ key                           meaning
                               break it in about 0.5 s, then about 1 ms resp. 0.1 s per key);
                               with ``scheme="paillier"`` a factorer (``"ecm"``,
                               ``"rho-factor"``, ``"p-1"``, ``"pari-factor"``) factors each
-                              modulus met and decrypts with the recovered key
+                              modulus met and decrypts with the recovered key (``lwe``: no
+                              breaker in the environment yet, refused by name)
 ``breaker_precomputation``    ``None`` or a file saved by ``encctl-gym crack
                               --save-precomputation`` (the index calculus's factor base
                               of the loop's group, checked against it): the breaker loads

@@ -38,6 +38,7 @@ from .defenses import AuditDefender, CusumDefender, DetectorDefender, NoiseDefen
 from .elgamal import ElGamalLoop
 from .elgamal_scheme import ElGamalScheme  # registers "modified", "token", "static"
 from .ideal import IdealLoop
+from .lwe_scheme import LWEScheme  # registers "lwe"
 from .paillier_scheme import PaillierScheme  # registers "paillier"
 from .quantize import Quantization
 from .rotation import RotatingDefender  # registers "rotate"
@@ -55,6 +56,7 @@ __all__ = [
     "EncryptionScheme",
     "ElGamalScheme",
     "PaillierScheme",
+    "LWEScheme",
     "SCHEMES",
     "make_scheme",
     "LoopSpec",

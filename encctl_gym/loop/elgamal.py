@@ -94,6 +94,8 @@ class ElGamalLoop:
         self.encoder = self.encryption.encoder(group, float(params.delta))
         self.Phi = controller_matrix(params)  # -K_lqr on x, or the output controller on [x_c; y]
         self.n, self.m = self.Phi.shape[1], params.m  # n: the controller's input xi (x, y or [x_c; y])
+        # the scheme refuses a loop its plaintext space cannot hold now, not at the first reset (as the ideal backend)
+        self.encryption.quantization(self.Phi, self.encoder, params.x_bound, params.u_max)
         #: each party's random source (privileged: who holds which randomness), see :func:`party_random_sources`
         self.random_sources = party_random_sources(params.crypto_seed)
         #: how the adversary obtains the secret of each period's key (:mod:`encctl_gym.attacks.decipherer`)
@@ -127,7 +129,7 @@ class ElGamalLoop:
 
     def provision(self) -> None:
         """KeyGen in the loop's group and the server of the scheme set up with ``Enc(pk_0, Ecd(Phi))``."""
-        quant = self.encryption.quantization(self.Phi, self.encoder, self.params.x_bound)
+        quant = self.encryption.quantization(self.Phi, self.encoder, self.params.x_bound, self.params.u_max)
         self.plant, self.server = self.encryption.parties(quant, self.random_sources["plant"], self.random_sources["server"])
 
     def rotate_group(self, group: Any) -> Any:

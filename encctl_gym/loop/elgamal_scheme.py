@@ -139,8 +139,9 @@ class ElGamalScheme:
 
         return residue_table(params, limit)
 
-    def quantization(self, Phi: np.ndarray, encoder: Any, x_bound: float) -> Any:
-        """:class:`~encctl_gym.crypto.quantized.QuantizedLinearController` of ``Phi`` on the group's encoder."""
+    def quantization(self, Phi: np.ndarray, encoder: Any, x_bound: float, u_max: float = 0.0) -> Any:
+        """:class:`~encctl_gym.crypto.quantized.QuantizedLinearController` of ``Phi`` on the group's encoder
+        (the group's plaintext space is fixed: ``u_max`` needs no room)."""
         from ..crypto.quantized import QuantizedLinearController
 
         return QuantizedLinearController(Phi, encoder, x_bound)

@@ -81,6 +81,8 @@ class IdealLoop:
             ) from None
         self.Phi_int = self.encode_int(self.Phi)
         self._encoder = None
+        # the scheme's own check that its plaintext space holds this loop (the ciphertext backend's)
+        self._scheme.quantization(self.Phi, self._scheme.encoder(group, self.delta), self.x_bound, params.u_max)
         self.quantization = Quantization(
             delta=self.delta,
             offsets=self.table.offsets,

@@ -98,9 +98,10 @@ class PaillierScheme(SchemeBase):
         k = params.key_length if isinstance(params, PaillierParameters) else PaillierParameters(params).key_length
         return PaillierEncoder((1 << (k - 1)) + 1, float(delta))
 
-    def quantization(self, Phi: np.ndarray, encoder: Any, x_bound: float) -> PaillierQuantization:
+    def quantization(self, Phi: np.ndarray, encoder: Any, x_bound: float, u_max: float = 0.0) -> PaillierQuantization:
         """Phi, the encoder and the state bound, as :meth:`parties` takes them (Phi is quantised there,
-        with the plant's encoder, and its row sums checked against the modulus)."""
+        with the plant's encoder, and its row sums checked against the modulus; the modulus dwarfs
+        ``u_max``)."""
         return PaillierQuantization(np.asarray(Phi, dtype=float), encoder, float(x_bound))
 
     def parties(self, quantization: Any, plant_rng: Any, server_rng: Any) -> tuple[PaillierPlant, PaillierControllerServer]:

@@ -22,7 +22,7 @@ its breakers                      :attr:`~EncryptionScheme.breakers` (names -> b
 its encoder (def:ec) and the      :meth:`~EncryptionScheme.encoder` ``(params, delta)``,
 ideal backend's rounding          :meth:`~EncryptionScheme.rounding` ``(params, limit)``,
                                   :meth:`~EncryptionScheme.nearest_plaintext`
-KeyGen, ``Enc(pk_0, Phi)``, the   :meth:`~EncryptionScheme.quantization` ``(Phi, encoder, x_bound)``,
+KeyGen, ``Enc(pk_0, Phi)``, the   :meth:`~EncryptionScheme.quantization` ``(Phi, encoder, x_bound, u_max)``,
 server set-up                     :meth:`~EncryptionScheme.parties` ``(quantization, plant_rng, server_rng)``
 one period of eq:ec               :meth:`~EncryptionScheme.encrypt_state`, :meth:`~EncryptionScheme.evaluate`,
                                   :meth:`~EncryptionScheme.decrypt_output`, :meth:`~EncryptionScheme.update_keys`
@@ -122,9 +122,11 @@ class EncryptionScheme(Protocol):
         ideal backend tabulates it: an object with ``offsets``, ``limit``, ``nearest`` and
         ``max_shift`` (:class:`~encctl_gym.crypto.residue_table.ResidueTable`, :class:`ExactRounding`)."""
 
-    def quantization(self, Phi: np.ndarray, encoder: Any, x_bound: float) -> Any:
+    def quantization(self, Phi: np.ndarray, encoder: Any, x_bound: float, u_max: float) -> Any:
         """The plant's quantised controller (``Phi`` on the encoder's scale, checked against the
-        plaintext space for states up to ``x_bound``) that :meth:`parties` is built from."""
+        plaintext space for states up to ``x_bound``) that :meth:`parties` is built from;
+        ``u_max`` bounds what an injection puts on an input (a scheme that sizes its plaintext
+        space per loop, like LWE, reserves room for it)."""
 
     def parties(self, quantization: Any, plant_rng: Any, server_rng: Any) -> tuple[Any, Any]:
         """KeyGen and the parameter ciphertexts: a new plant party (fresh keys) and its server,

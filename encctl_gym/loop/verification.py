@@ -176,7 +176,7 @@ class LinearCheckDefender(_PlantSidePolicy):
     def _quantize(self, group: Any) -> None:
         scheme = self._params.encryption()
         encoder = scheme.encoder(group, self.delta)
-        self.quantization = scheme.quantization(self.Phi, encoder, float(self._params.x_bound))
+        self.quantization = scheme.quantization(self.Phi, encoder, float(self._params.x_bound), float(self._params.u_max))
         E = getattr(self.quantization, "phi_int", None)
         if E is None:  # Paillier quantises Phi in the plant's parties; its check is security.verification.PaillierMac
             raise ParameterError(f"the linear check verifies the ElGamal schemes' quantised Phi; scheme {scheme.name!r} has none")

@@ -70,14 +70,14 @@ def format_scheme_key_lengths(res: dict[str, Any]) -> list[str]:
         "",
         f"  Scheme {res['scheme']} ({res['family']}): key size k* per cost model for N* = {res['N_star']} "
         f"({res['adversary']}; baseline {res['baseline']})",
-        f"  {'model':<16}{'keys':>8}{'k*':>8}{'work(N*)':>10}{'first key':>11}{'next key':>10}",
+        f"  {'model':<20}{'keys':>8}{'k*':>8}{'work(N*)':>10}{'first key':>11}{'next key':>10}",
     ]
     for name, d in res["designs"].items():
         if "error" in d:
-            lines.append(f"  {name:<16}  {d['error']}")
+            lines.append(f"  {name:<20}  {d['error']}")
             continue
         lines.append(
-            f"  {name:<16}{d['keys']:>8d}{d['k_star']:>8d}{d['work_bits']:>10.3f}{d['first_key_bits']:>11.3f}{d['next_key_bits']:>10.3f}"
+            f"  {name:<20}{d['keys']:>8d}{d['k_star']:>8d}{d['work_bits']:>10.3f}{d['first_key_bits']:>11.3f}{d['next_key_bits']:>10.3f}"
         )
     lines.append("  keys: keys the adversary must break for N* samples; work, first/next key: log2 operations.")
     return lines

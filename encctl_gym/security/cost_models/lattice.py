@@ -47,6 +47,8 @@ import numpy as np
 
 from ..._validation import check_int, check_positive, format_value
 from ...errors import ModelRangeError, ParameterError
+from ..exact import pow2
+from .base import CostModel, KeyBreakCost
 
 __all__ = [
     "CORE_SVP_EXPONENTS",
@@ -60,6 +62,7 @@ __all__ = [
     "smallest_secure_dimension",
     "key_costs",
     "STANDARD_PARAMETER_SETS",
+    "PrimalUSVPModel",
 ]
 
 #: Exponent ``c`` of the core-SVP cost ``2^(c beta)`` per model (module docstring).
@@ -233,12 +236,13 @@ def key_costs(est: PrimalEstimate, *, shared_matrix: bool, model: str = "classic
     on the reduced basis, ``d^2`` operations in dimension ``d = m + n`` (measured with
     :mod:`encctl_gym.cryptanalysis.lattice_lwe`'s ``bdd`` breaker, ``docs/lwe.md``). The first
     key's figure is then a lower bound: decoding by Babai needed larger block sizes than the
-    primal attack in every measurement (n <= 100).
+    primal attack in every measurement (n <= 100). A later key never costs more than a fresh
+    primal attack (the attacker can always run one): ``later = min(first, 2 log2 d)``.
     """
     first = est.bits(model)
     if not shared_matrix:
         return first, first
-    return first, 2 * math.log2(est.parameters.n + est.m)
+    return first, min(first, 2 * math.log2(est.parameters.n + est.m))
 
 
 def smallest_secure_dimension(
@@ -306,3 +310,78 @@ STANDARD_PARAMETER_SETS: Mapping[str, LWEParameterSet] = {
         LWEParameterSet("NewHope-512", 512, 12289, 2.0, 2.0, 512, _NEWHOPE_NIST, {"classical": 112, "quantum": 101}),
     )
 }
+
+
+class PrimalUSVPModel(CostModel):
+    """A deciphering-cost model of an LWE scheme for the key-length design (eq:opt_key): the key
+    length is the dimension ``n``, and breaking one key costs the primal uSVP attack's core-SVP
+    operations ``2^(c beta)`` (:func:`primal_usvp_estimate`, ``m <= n`` samples of a public key,
+    secret and error of width ``sigma``, modulus ``modulus_of(n)``).
+
+    A scheme binds ``modulus_of`` (its modulus for a dimension) and the core-SVP model; the
+    security parameter of a dimension is its first key's bits. With ``shared_matrix`` the keys
+    share one public matrix and every key after the first costs one nearest-plane decoding
+    (:func:`key_costs`).
+
+    Parameters
+    ----------
+    modulus_of : callable
+        ``n -> q``.
+    sigma : float
+        Width of the secret and of the error.
+    core_svp : str
+        A model of :data:`CORE_SVP_EXPONENTS`.
+    shared_matrix : bool
+        Whether the keys share their public matrix.
+    """
+
+    key_length_range = (2, 4096)
+    FORMULA = "2^(c beta), beta the smallest block size meeting the GSA condition of the primal uSVP attack (ADPS16)"
+
+    def __init__(
+        self, modulus_of: Callable[[int], int], sigma: float, core_svp: str = "classical", *, shared_matrix: bool = False
+    ) -> None:
+        if core_svp not in CORE_SVP_EXPONENTS:
+            raise ParameterError(f"core_svp must be one of {sorted(CORE_SVP_EXPONENTS)}, got {format_value(core_svp)}")
+        self.modulus_of, self.sigma, self.core_svp = modulus_of, check_positive("sigma", sigma), core_svp
+        self.shared_matrix = bool(shared_matrix)
+        self._estimates: dict[int, PrimalEstimate] = {}
+
+    def estimate(self, n: int) -> PrimalEstimate:
+        """The primal estimate at dimension ``n`` (cached)."""
+        n = check_int("n", n, minimum=self.key_length_range[0], maximum=self.key_length_range[1])
+        if n not in self._estimates:
+            q = int(self.modulus_of(n))
+            self._estimates[n] = primal_usvp_estimate(LWEParameterSet(f"n={n}", n, q, self.sigma, self.sigma, n))
+        return self._estimates[n]
+
+    def security_parameter_of_key_length(self, key_length: int) -> float:
+        """The first key's core-SVP bits at dimension ``key_length``."""
+        return self.estimate(key_length).bits(self.core_svp)
+
+    def break_cost(self, key_length: int) -> KeyBreakCost:
+        first, later = key_costs(self.estimate(key_length), shared_matrix=self.shared_matrix, model=self.core_svp)
+        return KeyBreakCost(self.name, pow2(first), pow2(later), key_length=int(key_length), security_parameter=first)
+
+    def key_length_for_security_parameter(self, lam: Any) -> int:
+        """The smallest dimension whose first key costs at least ``2^lam`` (:func:`smallest_secure_dimension`)."""
+        n, _ = smallest_secure_dimension(
+            self.modulus_of, self.sigma, float(lam), model=self.core_svp, n_max=self.key_length_range[1]
+        )
+        return n
+
+    def cost_of_security_parameter(self, lam: Any) -> KeyBreakCost:
+        return self.break_cost(self.key_length_for_security_parameter(lam))
+
+    def describe(self) -> dict[str, Any]:
+        return {
+            "name": self.name,
+            "family": "lattice",
+            "formula": self.FORMULA,
+            "core_svp": self.core_svp,
+            "exponent": CORE_SVP_EXPONENTS[self.core_svp],
+            "sigma": self.sigma,
+            "shared_matrix": self.shared_matrix,
+            "source": "Alkim, Ducas, Poppelmann, Schwabe, USENIX Security 2016, Section 6",
+            "key_length_range": list(self.key_length_range),
+        }
