@@ -19,14 +19,18 @@ file                     content
 ``tb/``                  TensorBoard logs
 =======================  ==================================================================
 
-stable-baselines3 unpickles parts of ``model.zip`` when it loads it: load only runs you trust.
-Older runs hold ``vecnormalize.pkl`` instead of ``vecnormalize.npz``; it is unpickled only on
-request (``load_attacker(..., allow_pickle=True)``, ``encctl-gym evaluate --allow-pickle``).
+stable-baselines3's own loader unpickles the ``data`` entry of ``model.zip``;
+:func:`~agents.sb3.load_attacker` does not use it: it rebuilds the model from ``run.json``'s
+config and loads the archive's weights only (``torch.load(..., weights_only=True)``). Older runs
+hold ``vecnormalize.pkl`` instead of ``vecnormalize.npz``; it, and stable-baselines3's loader for
+a model the config cannot rebuild, are used only on request (``load_attacker(...,
+allow_pickle=True)``, ``encctl-gym evaluate --allow-pickle``).
 """
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import zipfile
 from collections.abc import Sequence
@@ -34,7 +38,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from encctl_gym._validation import format_value, read_bounded
+from encctl_gym._validation import check_path_name, format_value, read_bounded
 from encctl_gym.errors import ConfigError
 
 __all__ = [
@@ -267,9 +271,16 @@ def new_run_dir(parent: str | Path, name: str, *, overwrite: bool = False) -> Pa
     """
     if not name or Path(name).name != name or name in (".", ".."):
         raise ConfigError(f"run name must be a plain directory name, got {name!r}")
+    check_path_name("run name (--name)", name)
     parent = Path(parent)
     check_output_dir(parent, "the runs directory (--out)")
     target = parent / name
+    check_path_name("run directory", target)
+    if overwrite and target.is_symlink():  # rmtree refuses a link; deleting what it points to is not asked
+        raise ConfigError(
+            f"--overwrite refuses to delete {str(target)!r}: it is a symbolic link (to {os.readlink(target)!r}); "
+            "remove the link or choose another --name"
+        )
     if target.exists() and overwrite:
         if not target.is_dir():
             raise ConfigError(f"{str(target)!r} exists and is not a directory")

@@ -19,7 +19,9 @@
 
 from __future__ import annotations
 
+import inspect
 import pickle
+import warnings
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -242,6 +244,79 @@ def load_vecnormalize(path: str | Path, venv: VecEnv) -> Any:
     return vecnorm
 
 
+#: Replay buffer of a model rebuilt only to predict (SAC would otherwise allocate its training buffer).
+_PREDICT_BUFFER = 1
+
+
+def _load_weights_only(run: Any, cls: type[BaseAlgorithm], model_path: Path) -> BaseAlgorithm:
+    """The run's model without unpickling anything: rebuilt from its ``run.json`` config as
+    :mod:`agents.train` builds it, then given the archive's weights by ``set_parameters``
+    (stable-baselines3 reads only the ``.pth`` entries there, with ``torch.load(...,
+    weights_only=True)``; the ``data`` entry, whose objects are cloudpickled, is not read).
+
+    Raises
+    ------
+    ConfigError
+        If the config does not rebuild the model or the weights do not fit it exactly.
+    """
+    from .hyperparams import make_schedules, policy_kwargs
+
+    cfg = run.meta.get("config")
+    if not isinstance(cfg, dict) or not isinstance(cfg.get("hyperparams"), dict) or "policy" not in cfg:
+        raise ConfigError(
+            f"cannot load {model_path} without unpickling: {run.path / 'run.json'} has no training config to rebuild the model from"
+        )
+    try:
+        hp = make_schedules(cfg["hyperparams"])
+        hp["policy_kwargs"] = policy_kwargs(cls, cfg["policy"], hp.get("policy_kwargs"))
+        if "buffer_size" in inspect.signature(cls.__init__).parameters:
+            hp["buffer_size"] = _PREDICT_BUFFER
+        try:  # a bad env is the run.json's fault, not the model's
+            env = SB3VecEnv(dict(run.env), 1, run.observation, features=run.features)
+        except EncctlError as exc:
+            raise ConfigError(f"{run.path / 'run.json'}: its env does not make an environment: {exc}") from exc
+        with warnings.catch_warnings():  # the training-time advice (PPO's mini-batch size for one copy) does not apply
+            warnings.simplefilter("ignore", UserWarning)
+            model = cls(cfg["policy"], env, verbose=0, device="cpu", **hp)
+        model.set_parameters(str(model_path), exact_match=True, device="cpu")
+    except ConfigError:
+        raise
+    except EncctlError as exc:
+        raise ConfigError(f"cannot rebuild the {run.algo} model of {run.path}: {exc}") from exc
+    except (
+        zipfile.BadZipFile,
+        EOFError,
+        OSError,
+        ValueError,
+        KeyError,
+        TypeError,
+        AssertionError,
+        RuntimeError,
+        pickle.UnpicklingError,
+    ) as exc:
+        raise ConfigError(
+            f"cannot load the weights of {model_path} into a {run.algo} model: {type(exc).__name__}: {_first_line(exc)}"
+        ) from exc
+    return model
+
+
+def _load_model(run: Any, cls: type[BaseAlgorithm], model_path: Path, allow_pickle: bool) -> BaseAlgorithm:
+    """The model by :func:`_load_weights_only`; stable-baselines3's own loader (which unpickles)
+    only if that fails and the caller allows pickles."""
+    try:
+        return _load_weights_only(run, cls, model_path)
+    except ConfigError as exc:
+        if not allow_pickle:
+            raise ConfigError(
+                f"{exc}; loading {model_path} as stable-baselines3 saved it unpickles its 'data' entry, which can run any code: "
+                "do it only for a run you trust, with allow_pickle=True (encctl-gym evaluate --allow-pickle)"
+            ) from exc
+    try:
+        return cls.load(str(model_path), device="cpu")
+    except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError, RuntimeError, pickle.UnpicklingError) as exc:
+        raise ConfigError(f"cannot load {model_path} as a {run.algo} model: {type(exc).__name__}: {_first_line(exc)}") from exc
+
+
 def load_attacker(
     run_dir: str | Path,
     *,
@@ -259,7 +334,8 @@ def load_attacker(
     run_dir : path
         The run's directory (:mod:`agents.runs`: ``run.json``, ``model.zip``,
         ``best_model.zip`` and, when the observations were normalised, ``vecnormalize.npz``).
-        stable-baselines3 unpickles parts of the model archives: load only runs you trust.
+        The model is rebuilt from the run's config and given the archive's weights only
+        (nothing is unpickled, :func:`_load_weights_only`).
     which : {"final", "best"}
         The model at the end of training or the best one of the evaluation callback.
     params : AttackParams, optional
@@ -273,8 +349,10 @@ def load_attacker(
         and on a shared 2-core machine a second thread made one RecurrentPPO step 4 to 40 times
         slower (1.1 ms on one thread). ``None`` leaves it as it is.
     allow_pickle : bool, default False
-        Unpickle a ``vecnormalize.pkl`` (written by older versions; a pickle can run any code
-        when loaded). Without it such a run is refused, saying how to opt in.
+        Allow every pickle a run may need (a pickle can run any code when loaded): a
+        ``vecnormalize.pkl`` (written by older versions), and stable-baselines3's own loader
+        (which unpickles the archive's ``data`` entry) for a model the run's config cannot
+        rebuild. Without it such a run is refused, saying how to opt in.
 
     Raises
     ------
@@ -290,11 +368,7 @@ def load_attacker(
         import torch
 
         torch.set_num_threads(int(torch_threads))
-    model_path = run.model_path(which)
-    try:
-        model = cls.load(str(model_path), device="cpu")
-    except (zipfile.BadZipFile, EOFError, OSError, ValueError, KeyError, RuntimeError, pickle.UnpicklingError) as exc:
-        raise ConfigError(f"cannot load {model_path} as a {run.algo} model: {type(exc).__name__}: {_first_line(exc)}") from exc
+    model = _load_model(run, cls, run.model_path(which), allow_pickle)
     env_cfg = dict(run.env)
     env_cfg["gamma_opt"] = False
     if params is None:

@@ -343,12 +343,49 @@ _FILE_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pip
                (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))  # fmt: skip
 
 
+#: Longest file name component and path where the file system does not say (POSIX's usual values).
+DEFAULT_NAME_MAX, DEFAULT_PATH_MAX = 255, 4096
+
+
+def check_path_name(what: str, path: Any) -> str:
+    """Return ``path`` as a string, raising :class:`ParameterError` for a name no file can have
+    here, before any work is done: an embedded NUL, a component longer than the file system's
+    ``NAME_MAX`` (asked of the nearest existing directory, 255 where it does not say) or a path
+    longer than ``PATH_MAX`` (4096). The message names the limit."""
+    try:
+        name = os.fsdecode(os.fspath(path))
+    except TypeError:
+        raise ParameterError(f"{what} must be a path (a str or os.PathLike), got {format_value(path)}") from None
+    if "\x00" in name:
+        raise ParameterError(f"{what} {format_value(name)} holds a NUL character, which no file name can")
+    if len(os.fsencode(name)) > DEFAULT_PATH_MAX:
+        raise ParameterError(f"{what} is {len(os.fsencode(name))} bytes long, beyond PATH_MAX = {DEFAULT_PATH_MAX}")
+    base = os.path.dirname(os.path.abspath(name))
+    while not os.path.isdir(base) and os.path.dirname(base) != base:
+        base = os.path.dirname(base)
+    try:
+        name_max = int(os.pathconf(base, "PC_NAME_MAX"))
+    except (OSError, ValueError, AttributeError):  # no pathconf (Windows) or the name is unknown
+        name_max = DEFAULT_NAME_MAX
+    for part in name.replace(os.sep, "/").split("/"):
+        if len(os.fsencode(part)) > name_max:
+            raise ParameterError(
+                f"{what}: the name {format_value(part, limit=40)} is {len(os.fsencode(part))} bytes long, "
+                f"beyond the file system's NAME_MAX = {name_max}"
+            )
+    return name
+
+
 def check_regular_file(what: str, path: Any) -> str:
     """Return ``path`` as a string, raising :class:`ConfigError` unless it names an existing
     regular file; the message says what it is instead ("does not exist", "is a directory",
     "is not a regular file: a FIFO (named pipe)", ...). Only ``os.stat`` is called: a FIFO is
     never opened, so the check cannot block."""
-    name = os.fspath(path)
+    try:
+        name = os.fspath(path)
+    except TypeError:
+        raise ParameterError(f"{what} must be a path (a str or os.PathLike), got {format_value(path)}") from None
+    name = os.fsdecode(name)  # a bytes path as the file system decodes it
     try:
         mode = os.stat(name).st_mode
     except FileNotFoundError:

@@ -65,14 +65,20 @@ def observable_order(A: np.ndarray, C: np.ndarray, rtol: float = OBSERVABILITY_R
     orthonormal basis ``V`` of the row space is grown one Krylov step at a time: start from the
     right singular vectors of ``C``, then add the directions of ``A^T V`` orthogonal to ``V``
     (projected out twice) whose singular values exceed ``rtol * max(||A||_2, ||C||_2)``, until no
-    direction is new. Each step works on orthonormal vectors, so the test sees directions, not
+    direction is new. ``C`` is first divided by its largest entry (the order does not depend on
+    the scale of the sensors: ``1e300 C`` and ``1e-300 C`` have the order of ``C``). Each step works on orthonormal vectors, so the test sees directions, not
     the decay of ``A^k``.
     """
     A = np.asarray(A, dtype=float)
     C = np.asarray(C, dtype=float)
     n = A.shape[0]
-    scale = max(float(np.linalg.norm(A, 2)), float(np.linalg.norm(C, 2)), np.finfo(float).tiny)
-    tol = rtol * scale
+    # the rank does not depend on the scale of C: C is divided by its largest entry first, so
+    # that C = 1e300 [1 0 1] and 1e-300 [1 0 1] see the directions [1 0 1] does
+    peak = float(np.max(np.abs(C))) if C.size else 0.0
+    if peak == 0.0:
+        return 0
+    C = C / peak
+    tol = rtol * max(float(np.linalg.norm(A, 2)), float(np.linalg.norm(C, 2)))
     _, s, Vt = np.linalg.svd(C, full_matrices=False)
     V = Vt[s > tol].T  # (n, r)
     while 0 < V.shape[1] < n:

@@ -13,7 +13,9 @@ composer that enforces, while it reads:
   without being expanded (a few hundred bytes of nested aliases, the "billion laughs", would
   otherwise build gigabytes); an alias inside the node it names (a recursive alias) is refused;
 * at most ``max_nodes`` nodes in all, aliases counted expanded;
-* no key given twice in a mapping (the same key text: PyYAML would keep the last one silently).
+* no key given twice in a mapping (the same key text: PyYAML would keep the last one silently),
+  and no key given by two merges (``<<:`` twice, or ``<<: [*a, *b]`` with a key in both: PyYAML
+  keeps one silently); a key written out beside a merge overrides the merged one, as YAML says.
 
 Only then are Python objects built, by PyYAML's safe constructor (no ``!!python/...`` tags).
 A number with an exponent but no dot (``1e-6``, ``442e15``) is a number, as in JSON and YAML
@@ -165,6 +167,46 @@ def _compose(loader: Any, what: str, max_nodes: int, max_depth: int, aliases: bo
     return root
 
 
+def _merged_keys(source: Any) -> list[str]:
+    """The scalar keys a merge source gives: a mapping's own keys and those of its merges."""
+    import yaml
+
+    sources = source.value if isinstance(source, yaml.SequenceNode) else [source]
+    keys: list[str] = []
+    for node in sources:
+        if not isinstance(node, yaml.MappingNode):
+            continue  # PyYAML's constructor refuses a merge of anything else, with its own message
+        for key, value in node.value:
+            if isinstance(key, yaml.ScalarNode):
+                keys.extend(_merged_keys(value) if key.tag == _MERGE_TAG else [key.value])
+    return keys
+
+
+def _check_merges(root: Any, what: str) -> None:
+    """Refuse a mapping whose merges (``<<:``) give one key twice (module docstring); each node
+    is visited once, so a document of shared aliases is not walked once per alias."""
+    import yaml
+
+    seen: set[int] = set()
+    todo = [] if root is None else [root]
+    while todo:
+        node = todo.pop()
+        if id(node) in seen or not isinstance(node, (yaml.MappingNode, yaml.SequenceNode)):
+            continue
+        seen.add(id(node))
+        if isinstance(node, yaml.SequenceNode):
+            todo.extend(node.value)
+            continue
+        merged: set[str] = set()
+        for key, value in node.value:
+            todo.append(value)
+            if isinstance(key, yaml.ScalarNode) and key.tag == _MERGE_TAG:
+                for name in _merged_keys(value):
+                    if name in merged:
+                        raise ConfigError(f"{what}: field {format_value(name)} is given by two merges (<<)")
+                    merged.add(name)
+
+
 def _at(mark: Any) -> str:
     return "" if mark is None else f" (line {mark.line + 1}, column {mark.column + 1})"
 
@@ -219,6 +261,7 @@ def load_yaml(
     try:
         try:
             root = _compose(loader, what, max_nodes, max_depth, aliases, limit_error)
+            _check_merges(root, what)
             return None if root is None else loader.construct_document(root)
         except EncctlError:  # the bounds' own errors (a ParameterError is a ValueError)
             raise

@@ -411,6 +411,51 @@ def test_an_old_run_with_a_pickle_is_refused_unless_the_caller_opts_in(ppo_run, 
     assert not marker.exists()  # nothing was unpickled
 
 
+def _plant_a_pickle_in_the_model(run_dir: Path, marker: Path) -> None:
+    """Rewrite ``model.zip`` with its ``data`` entry's ``policy_class`` replaced by a payload
+    that writes ``marker`` when stable-baselines3's loader unpickles it."""
+    import base64
+    import pickle
+    import zipfile
+
+    path = run_dir / "model.zip"
+    with zipfile.ZipFile(path) as z:
+        entries = {name: z.read(name) for name in z.namelist()}
+    data = json.loads(entries["data"])
+    data["policy_class"] = {
+        ":type:": "<class 'abc.ABCMeta'>",
+        ":serialized:": base64.b64encode(pickle.dumps(_RunsCode(marker))).decode(),
+    }
+    entries["data"] = json.dumps(data).encode()
+    with zipfile.ZipFile(path, "w") as z:
+        for name, raw in entries.items():
+            z.writestr(name, raw)
+
+
+def test_a_model_archive_is_loaded_without_unpickling_its_data(ppo_run, tmp_path, capsys):
+    """``model.zip``'s ``data`` entry holds cloudpickled objects that stable-baselines3's loader
+    unpickles: the run is rebuilt from its config and given the weights only (issue 34, item 24)."""
+    run = _copy_run(ppo_run, tmp_path / "planted")
+    marker = tmp_path / "marker"
+    _plant_a_pickle_in_the_model(run, marker)
+    att, ref = load_attacker(run, deterministic=True), load_attacker(ppo_run, deterministic=True)
+    assert not marker.exists()  # nothing was unpickled
+    obs = np.random.default_rng(0).normal(size=(4, *att.model.observation_space.shape)).astype(np.float32)
+    att.reset(seed=0)
+    ref.reset(seed=0)
+    assert np.array_equal(att.act(obs), ref.act(obs))  # the same weights act the same
+    assert cli.main(["evaluate", str(run), "--episodes", "2", "--points", "1", "--no-progress",
+                     "--out", str(tmp_path / "ev")]) == 0  # fmt: skip
+    assert not marker.exists()
+    # a run whose config cannot rebuild its model is refused, naming the opt-in, and nothing runs
+    meta = json.loads((run / "run.json").read_text())
+    meta["config"]["hyperparams"]["policy_kwargs"]["net_arch"] = [3]
+    (run / "run.json").write_text(json.dumps(meta))
+    with pytest.raises(ConfigError, match="allow_pickle=True"):
+        load_attacker(run)
+    assert not marker.exists()
+
+
 def test_a_bad_env_in_run_json_is_blamed_on_run_json(ppo_run, tmp_path):
     bad = _copy_run(ppo_run, tmp_path / "bad")
     meta = json.loads((bad / "run.json").read_text())

@@ -140,14 +140,13 @@ def _fake_run(root: Path, algo: str, observation: str) -> Path:
     env_cfg = {"preset": "paper-example", "decipher_delay": 0, "gamma_opt": False, "max_samples": 64}
     venv = SB3VecEnv(env_cfg, 2, observation)
     policy = "MlpLstmPolicy" if algo == "recurrent_ppo" else "MlpPolicy"
-    kw = {"policy_kwargs": {"lstm_hidden_size": 4}} if algo == "recurrent_ppo" else {}
-    model = algorithm_class(algo)(policy, venv, n_steps=8, batch_size=16, seed=0, device="cpu", **kw)
+    hp = {"n_steps": 8, "batch_size": 16, **({"policy_kwargs": {"lstm_hidden_size": 4}} if algo == "recurrent_ppo" else {})}
+    model = algorithm_class(algo)(policy, venv, seed=0, device="cpu", **hp)
     d = root / f"{algo}_{observation}"
     d.mkdir(parents=True)
     model.save(str(d / "model.zip"))
-    (d / "run.json").write_text(
-        json.dumps({"algo": algo, "observation": observation, "env": env_cfg, "config": {"quick": False}})
-    )
+    config = {"quick": False, "policy": policy, "hyperparams": hp}  # what agents.train records: the model is rebuilt from it
+    (d / "run.json").write_text(json.dumps({"algo": algo, "observation": observation, "env": env_cfg, "config": config}))
     return d
 
 

@@ -91,7 +91,12 @@ def test_a_learned_attacker_from_a_run_directory_joins(tmp_path: Path) -> None:
     run = tmp_path / "ppo_full"
     run.mkdir()
     model.save(str(run / "model.zip"))  # an untrained policy in the format of agents.train
-    (run / "run.json").write_text(json.dumps({"algo": "ppo", "observation": "full", "env": env_cfg, "config": {"quick": False}}))
+    config = {
+        "quick": False,
+        "policy": "MlpPolicy",
+        "hyperparams": {"n_steps": 8, "batch_size": 16},
+    }  # as agents.train records it
+    (run / "run.json").write_text(json.dumps({"algo": "ppo", "observation": "full", "env": env_cfg, "config": config}))
     res = strat.compute(("small",), estimators=("ls", "bayes"), episodes=2, cap=16, points=2, runs=strat.find_runs([tmp_path]))
     learned = [c for c in res.curves["small"] if c.attacker == "ppo"]
     assert [c.estimator for c in learned] == ["ls", "bayes(evidence)"] and np.all(np.isfinite(learned[0].errors))

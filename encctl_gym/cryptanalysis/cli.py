@@ -49,7 +49,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .._validation import check_int, check_positive
+from .._validation import check_int, check_path_name, check_positive
 from ..crypto import arith
 from ..crypto.group import SHIPPED_BITS, GroupParams, generate_safe_prime_group, shipped_group
 from ..errors import BreakerError, ParameterError
@@ -181,6 +181,7 @@ def _check_save_path(args: argparse.Namespace) -> str | None:
             )
     save = args.save_precomputation
     if save is not None:
+        save = check_path_name("--save-precomputation", save)
         parent = Path(save).resolve().parent
         if not parent.is_dir():
             raise ParameterError(f"--save-precomputation {save!r}: the directory {str(parent)!r} does not exist")

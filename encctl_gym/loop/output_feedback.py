@@ -142,6 +142,16 @@ def static_output_feedback(A: Any, B: Any, C: Any, *, max_iter: int = 500, tol: 
     """
     A, B, C = (np.asarray(M, dtype=float) for M in (A, B, C))
     max_iter = check_int("max_iter", max_iter, minimum=0)
+    # J depends on Phi C alone: the gain for C / s is s times the gain for C, so the iteration runs
+    # on C scaled to its largest entry (C = 1e155 I would overflow C L C^T) and the gain is scaled back
+    peak = float(np.max(np.abs(C))) if C.size else 0.0
+    if peak == 0.0 or not np.isfinite(peak):
+        raise ParameterError(f"C must have a finite nonzero entry, got {format_value(C)}")
+    return _static_output_feedback(A, B, C / peak, max_iter, tol) / peak
+
+
+def _static_output_feedback(A: np.ndarray, B: np.ndarray, C: np.ndarray, max_iter: int, tol: float) -> np.ndarray:
+    """:func:`static_output_feedback` for a ``C`` whose largest entry is 1."""
     n, m = A.shape[0], B.shape[1]
     start = [-lqr_gain(A, B) @ np.linalg.pinv(C), np.zeros((m, C.shape[0]))]
     scored = [(cost, F) for F in start if (cost := _lq_cost(A, B, C, F)) is not None]
@@ -187,13 +197,19 @@ def lqg_controller(A: Any, B: Any, C: Any, *, sigma_w2: float, sigma_v2: float) 
     sw = check_nonnegative("sigma_w2", sigma_w2)
     sv = check_nonnegative("sigma_v2", sigma_v2)
     n, p = A.shape[0], C.shape[0]
-    V = max(sv, LQG_MEASUREMENT_FLOOR * sw, np.finfo(float).tiny) * np.eye(p)
+    # the filter for y = C x + v is the filter for y / s = (C / s) x + v / s with its gain scaled
+    # by 1 / s: it runs on C scaled to its largest entry (C = 1e155 I would overflow C S C^T)
+    peak = float(np.max(np.abs(C))) if C.size else 0.0
+    if peak == 0.0 or not np.isfinite(peak):
+        raise ParameterError(f"C must have a finite nonzero entry, got {format_value(C)}")
+    Cs = C / peak
+    V = max(max(sv, LQG_MEASUREMENT_FLOOR * sw) / peak / peak, np.finfo(float).tiny) * np.eye(p)
     W = max(sw, np.finfo(float).tiny) * np.eye(n)
     try:
-        S = scipy.linalg.solve_discrete_are(A.T, C.T, W, V)
+        S = scipy.linalg.solve_discrete_are(A.T, Cs.T, W, V)
     except (np.linalg.LinAlgError, ValueError) as exc:
         raise SolverError(f"the Kalman predictor's Riccati equation has no stabilising solution ({exc})") from None
-    L = A @ S @ C.T @ np.linalg.inv(C @ S @ C.T + V)
+    L = A @ S @ Cs.T @ np.linalg.inv(Cs @ S @ Cs.T + V) / peak
     K = lqr_gain(A, B)
     return OutputController(A - B @ K - L @ C, L, -K, np.zeros((B.shape[1], p)), "lqg")
 

@@ -284,9 +284,9 @@ class RotatingDefender(DefenderBase):
 
     def __init__(self, every: int = 10, inner: Any = None, ahead: int = 2) -> None:
         self.every = check_rotation_period(every, "every")
-        if isinstance(inner, RotatingDefender):
-            raise ParameterError("a rotating defender cannot wrap another rotating defender")
         self.inner: DefenderPolicy = make_defender(inner)
+        if getattr(self.inner, "rotates", False):  # given as an object, a name or a dict spec alike
+            raise ParameterError(f"a rotating defender cannot wrap another rotating defender (inner={format_value(inner)})")
         self.ahead = check_ahead("ahead", ahead)
         self.groups: RotationGroups | None = None
         self.pool: GroupPool | None = None  # the episode's (RotationGroups.for_episode)

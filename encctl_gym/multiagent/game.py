@@ -171,6 +171,8 @@ class EncryptedControlGame(ParallelEnv):
         a = as_finite_array("the attacker's action", actions["attacker"]).reshape(-1)
         if a.shape != (m + 1,):
             raise ParameterError(f"the attacker's action must have shape ({m + 1},), got {np.shape(actions['attacker'])}")
+        if not -1.0 <= a[m] <= 1.0:  # the input entries are checked by the episode (core.step)
+            raise ParameterError(f"the attacker's inject flag must lie in [-1, 1] (its action space), got {float(a[m])!r}")
         self.levers.decide(actions["defender"])
         core, clock = self.episode, self.clock
         if clock.active and not clock.affords(self.levers.rotates_at(core.plant_view.step)):

@@ -138,7 +138,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--allow-pickle",
         action="store_true",
-        help="unpickle an older run's vecnormalize.pkl (a pickle can run any code: only for runs you trust)",
+        help="allow the pickles a run may need: an older run's vecnormalize.pkl, and stable-baselines3's own loader for a "
+        "model its run.json cannot rebuild (a pickle can run any code: only for runs you trust)",
     )
     parser.add_argument(
         "--which",
