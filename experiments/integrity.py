@@ -16,7 +16,10 @@ Three parts, each a function the tests call too:
   ``sk_0, sk_t``; on Paillier keyless), ``sparse`` (one input moved by the encoding's smallest step),
   ``malleability`` (no key: one product ciphertext of ElGamal times ``Enc``-free ``4``, every
   Paillier row and tag raised to the power 2), ``replay`` (the previous step's output, its labels
-  stripped) and ``kerckhoffs`` (knows the check and its parameters, not its secret: against the
+  stripped), ``mix`` (across steps, no key: on Paillier ``u' = Phi x_t + K (x_t - x_s)`` with the
+  tags moved alike, :func:`~encctl_gym.loop.verification.forge_across_steps`, from an earlier step
+  under the same MAC; on ElGamal one product of the previous step put into this step's output) and
+  ``kerckhoffs`` (knows the check and its parameters, not its secret: against the
   linear check ``(+d, -d)`` on two rows, passing iff ``r_1 = r_2``; against the MAC a guessed
   ``alpha``; against audits the largest falsification below the tolerance). Detection per
   falsified step with its Wilson 95 % interval, against the bound ``1 - epsilon``.
@@ -67,7 +70,7 @@ __all__ = [
 ]
 
 #: The attacker classes, in the table's order.
-ATTACKERS: tuple[str, ...] = ("replace", "add", "sparse", "malleability", "replay", "kerckhoffs")
+ATTACKERS: tuple[str, ...] = ("replace", "add", "sparse", "malleability", "replay", "mix", "kerckhoffs")
 #: The small secret ranges of the Kerckhoffs sweep.
 SWEEP_RANGES: tuple[int, ...] = (2, 4, 8, 16, 32)
 
@@ -222,6 +225,12 @@ def _elgamal_attack(
         return rows
     if name == "replay":
         return None if prev is None else [[dataclasses.replace(c, t1=None, t2=None) for c in r] for r in prev]
+    if name == "mix":  # across steps, no key: one product of the last step in this step's output
+        if prev is None:
+            return None
+        i, j = int(rng.integers(bench.m)), int(rng.integers(bench.n))
+        rows[i][j] = dataclasses.replace(prev[i][j], t1=None, t2=None)
+        return rows
     i = int(rng.integers(bench.m))
     if name == "sparse" or (name == "kerckhoffs" and defence == "audit"):
         d = int(bench.delta) if name == "sparse" else max(1, int(bench.tolerance(x)[i] * bench.delta**2 * 0.5))
@@ -264,6 +273,14 @@ def _paillier_attack(
         return [c * 2 for c in rows], [t * 2 for t in tags]
     if name == "replay":
         return (None, None) if prev is None else prev
+    if name == "mix":  # across steps, no key: u' = Phi x_t + K (x_t - x_s), tags moved alike
+        if prev is None:
+            return None, None
+        from encctl_gym.loop.verification import forge_across_steps
+
+        K = rng.integers(-2, 3, size=(bench.m, bench.n))
+        K[0, int(rng.integers(bench.n))] = 1  # K != 0
+        return forge_across_steps(rows, tags, prev[0], prev[1], K)
     i = int(rng.integers(bench.m))
     if name == "sparse" or (name == "kerckhoffs" and defence == "audit"):
         d = 1 if name == "sparse" else max(1, int(bench.tolerance(x)[i] * d2 * 0.5))
@@ -380,15 +397,22 @@ def _paillier_cells(
         x = rng.uniform(-1.0, 1.0, size=bench.n)
         X = bench.X(x)
         mac = PaillierMac(bench.plant.sk, bench.E, bench.rng, alpha_range=params.get("alpha_range"))
+        earlier = None
+        if attacker == "mix":  # one key serves a whole episode: an earlier step under this MAC
+            x_s = rng.uniform(-1.0, 1.0, size=bench.n)
+            cts_s = bench.plant.encrypt_state(x_s)
+            earlier = (cts_s, mac.tag_state(bench.X(x_s))[0])
         t0 = time.perf_counter()
-        rows = bench.server.evaluate(bench.plant.encrypt_state(x))
+        cts = bench.plant.encrypt_state(x)
+        rows = bench.server.evaluate(cts)
         bench.plant.decrypt_output(rows)
         step.append(time.perf_counter() - t0)
         tagged, masks = _timed(tagging, mac.tag_state, X)
         tags = _timed(server, evaluate_tags, bench.E, tagged, masks)
         honest = bench.sums(rows)
         for d in defences:
-            f_rows, f_tags = _paillier_attack(bench, attacker, rows, tags, prev, x, rng, d, mac)
+            before = prev if attacker != "mix" else ((cts, tagged), earlier)
+            f_rows, f_tags = _paillier_attack(bench, attacker, rows, tags, before, x, rng, d, mac)
             if f_rows is None:
                 continue
             S = bench.sums(f_rows)
@@ -588,6 +612,8 @@ ENV_DEFENDERS: dict[str, Any] = {
     "cusum": {"name": "cusum", "false_alarm_rate": 1e-3},
     "linear-check": "linear-check",
 }
+#: On the Paillier loop: the MAC in place of the linear check (which needs the ElGamal schemes' Phi).
+PAILLIER_ENV_DEFENDERS: dict[str, Any] = {**{k: v for k, v in ENV_DEFENDERS.items() if k != "linear-check"}, "mac": "mac"}
 
 
 def environment_rows(
@@ -598,16 +624,20 @@ def environment_rows(
     crypto: str = "ideal",
     injections: tuple[str, ...] = ("pass", "replace", "add"),
     seed: int = 0,
+    scheme: str | None = None,
+    key_length: int | None = None,
 ) -> list[EnvironmentRow]:
-    """Every defender of :data:`ENV_DEFENDERS` in the environment against each injection mode
-    (random actions uniform in the action space; ``pass``: the honest loop, whose detections
-    are false alarms)."""
+    """Every defender of :data:`ENV_DEFENDERS` (:data:`PAILLIER_ENV_DEFENDERS` with ``scheme=
+    "paillier"``) in the environment against each injection mode (random actions uniform in the
+    action space; ``pass``: the honest loop, whose detections are false alarms)."""
     import gymnasium as gym
 
     import encctl_gym  # noqa: F401  registers the environment
 
     rows: list[EnvironmentRow] = []
-    for label, spec in ENV_DEFENDERS.items():
+    loop: dict[str, Any] = {k: v for k, v in (("scheme", scheme), ("key_length", key_length)) if v is not None}
+    defenders = PAILLIER_ENV_DEFENDERS if scheme == "paillier" else ENV_DEFENDERS
+    for label, spec in defenders.items():
         for injection in injections:
             env = gym.make(
                 "encctl_gym/EncryptedLTIAttack-v0",
@@ -617,6 +647,7 @@ def environment_rows(
                 injection=injection,
                 defender=spec,
                 crypto_seed=seed,
+                **loop,
             )
             rng = np.random.default_rng([seed, len(rows)])
             detected, samples, steps, t0 = 0, [], 0, time.perf_counter()
@@ -632,7 +663,7 @@ def environment_rows(
                 EnvironmentRow(
                     label,
                     injection,
-                    crypto,
+                    crypto if scheme is None else f"{crypto} ({scheme})",
                     episodes,
                     horizon,
                     detected,
@@ -661,12 +692,22 @@ class _Recording:
         return a
 
 
-def trained_defender_rows(*, steps: int = 20_000, episodes: int = 50, horizon: int = 40, seed: int = 0) -> list[dict[str, Any]]:
+def trained_defender_rows(
+    *,
+    steps: int = 20_000,
+    episodes: int = 50,
+    horizon: int = 40,
+    seed: int = 0,
+    scheme: str | None = None,
+    key_length: int | None = None,
+) -> list[dict[str, Any]]:
     """A PPO defender trained (``steps`` game steps, :func:`encctl_gym.agents.game_training.train_side`)
     against the sparse Gaussian attacker (injects at a quarter of the steps) on the ``small``
     plant with the game's default costs (rotation off), and static defenders beside it: per
     defender the share of steps each lever of :data:`~encctl_gym.multiagent.levers.LEVERS` is
-    pulled, the detection rate, the samples the attacker collected and the defender's cost."""
+    pulled, the detection rate, the samples the attacker collected and the defender's cost.
+    ``scheme="paillier"`` (with ``key_length``) plays the Paillier loop, whose verify lever is
+    the MAC."""
     from encctl_gym.agents.baselines import GaussianAttacker
     from encctl_gym.agents.evaluate import budget_config, env_config
     from encctl_gym.agents.game import NoDefence, RandomAudit, ScheduledAttacker, defender_action, play
@@ -674,7 +715,8 @@ def trained_defender_rows(*, steps: int = 20_000, episodes: int = 50, horizon: i
     from encctl_gym.envs.config import resolve_params
     from encctl_gym.multiagent.levers import LEVERS
 
-    cfg = budget_config(env_config({"preset": "small"}), horizon)
+    loop = {k: v for k, v in (("scheme", scheme), ("key_length", key_length)) if v is not None}
+    cfg = budget_config(env_config({"preset": "small", **loop, **({"max_samples": horizon} if loop else {})}), horizon)
     attacker = ScheduledAttacker(GaussianAttacker(resolve_params(cfg)), q=0.25)
     rules = {"rotation": False}
     learned, _ = train_side("defender", attacker, cfg, rules, algo="ppo", steps=steps, seed=seed)
@@ -851,6 +893,13 @@ def _parser() -> argparse.ArgumentParser:
         metavar="STEPS",
         help="only train a PPO defender for STEPS game steps and report its levers",
     )
+    parser.add_argument(
+        "--scheme",
+        choices=("modified", "paillier"),
+        default="modified",
+        help="the loop of --trained-defender: ElGamal's modified scheme (verify lever: the linear check) or Paillier "
+        "at --paillier-bits (verify lever: the MAC); default modified",
+    )
     return parser
 
 
@@ -868,6 +917,10 @@ def main(argv: list[str] | None = None) -> int:
         env = environment_rows(episodes=episodes, seed=args.seed) + environment_rows(
             episodes=max(4, episodes // 10), crypto="elgamal", seed=args.seed
         )
+        for crypto, n_episodes in (("ideal", episodes), ("elgamal", max(4, episodes // 10))):  # the MAC's real tags on both
+            env += environment_rows(
+                episodes=n_episodes, crypto=crypto, seed=args.seed, scheme="paillier", key_length=args.paillier_bits
+            )
     except EncctlError as exc:
         print(f"integrity: {exc}", file=sys.stderr)
         return 2
@@ -888,15 +941,17 @@ def main(argv: list[str] | None = None) -> int:
 
 def _trained_main(args: argparse.Namespace, argv: list[str] | None) -> int:
     try:
-        rows = trained_defender_rows(steps=args.trained_defender, episodes=50 if not args.quick else 5, seed=args.seed)
+        loop = {"scheme": "paillier", "key_length": args.paillier_bits} if args.scheme == "paillier" else {}
+        rows = trained_defender_rows(steps=args.trained_defender, episodes=50 if not args.quick else 5, seed=args.seed, **loop)
     except EncctlError as exc:
         print(f"integrity: {exc}", file=sys.stderr)
         return 2
     out = ensure_out_dir(Path("docs/results/integrity") if args.record else args.out)
     cmd = "python -m encctl_gym.experiments.integrity" + "".join(f" {a}" for a in (argv if argv is not None else sys.argv[1:]))
-    notes = "\n\nPreset `small`, 40 samples per attack, game rules: defaults with rotation off; 50 evaluation episodes."
+    where = f"the Paillier loop at {args.paillier_bits} bits (verify lever: the MAC)" if args.scheme == "paillier" else "ElGamal"
+    notes = f"\n\nPreset `small`, {where}, 40 samples per attack, game rules: defaults with rotation off; 50 evaluation episodes."
     write_recorded_table(
-        out / "trained_defender.md",
+        out / ("trained_defender_paillier.md" if args.scheme == "paillier" else "trained_defender.md"),
         "A trained defender with the verify lever (issue 33)",
         cmd,
         format_trained(rows, args.trained_defender),

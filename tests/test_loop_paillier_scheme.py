@@ -135,9 +135,10 @@ def test_both_backends_give_the_same_paillier_episode_bit_for_bit(injection: str
     assert not all(np.array_equal(runs[0][0], r) for r in runs[0][1:])  # the episode moved
 
 
-def test_the_game_runs_on_paillier_with_the_linear_check_off_and_named() -> None:
-    """The attacker-defender game on real Paillier ciphertexts: noise and audits work; the
-    linear-check lever (ElGamal's quantised Phi) is off, and asking for it says why."""
+def test_the_game_runs_on_paillier_with_the_mac_as_its_verify_lever() -> None:
+    """The attacker-defender game on real Paillier ciphertexts: noise and audits work, and the
+    verify lever runs the MAC (the linear check needs ElGamal's quantised Phi): it catches the
+    attacker's forged input at the first checked step."""
     from encctl_gym.multiagent.encctl_game_v0 import parallel_env
 
     cfg = {"preset": "small", "gamma_opt": False, "key_length": 96, "max_samples": 10, "warmup_steps": 1}
@@ -154,9 +155,11 @@ def test_the_game_runs_on_paillier_with_the_linear_check_off_and_named() -> None
     assert steps >= 2
     game.reset(seed=1)
     acts = {a: np.zeros(game.action_space(a).shape, dtype=np.float32) for a in game.agents}
+    acts["attacker"][:-1] = 0.5  # inject (flag 0 >= 0) an input that is not Phi x
+    game.step(acts)
     acts["defender"][3] = 1.0
-    with pytest.raises(ParameterError, match="verify lever is off.*'paillier' has none"):
-        game.step(acts)
+    _, _, term, _, infos = game.step(acts)
+    assert infos["defender"]["verified"] and infos["defender"]["detected"] and term["defender"]
 
 
 @pytest.mark.parametrize("factorer", ["rho-factor", "ecm"])

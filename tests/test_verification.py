@@ -13,7 +13,14 @@ from hypothesis import strategies as st
 
 from encctl_gym.errors import ParameterError
 from encctl_gym.experiments.compare.statistics import wilson_interval
-from encctl_gym.loop.verification import KeyedLinearCheck, PaillierMac, evaluate_tags, row_sums_of, uniform_below
+from encctl_gym.loop.verification import (
+    KeyedLinearCheck,
+    PaillierMac,
+    evaluate_tags,
+    forge_across_steps,
+    row_sums_of,
+    uniform_below,
+)
 from encctl_gym.security.verification import (
     expected_passes_before_detection,
     linear_check_pass_bound,
@@ -185,6 +192,62 @@ def _mac_step_same(mac, sk, E, X, rng):
     return rows, evaluate_tags(E, tagged, masks)
 
 
+class _OneGammaMac(PaillierMac):
+    """The MAC as this package first built it: one ``gamma`` for every step (``rho_t = 1``)."""
+
+    def tag_state(self, X):
+        from encctl_gym.crypto.paillier import encrypt_with_secret
+
+        n = self.pk.n
+        self._rho = 1
+        self._beta = [uniform_below(self._rng, n) for _ in range(self.m)]
+        tagged = [encrypt_with_secret(self.sk, (self._alpha * int(x) + g) % n, self._rng) for x, g in zip(X, self._gamma)]
+        return tagged, [encrypt_with_secret(self.sk, b, self._rng) for b in self._beta]
+
+
+def _cross_step_passes(sk, mac_class, trials, rng, A=None):
+    """Pass count of the cross-step forgery u' = Phi x_t + K (x_t - x_s) over ``trials`` MACs,
+    each used for two steps; every forgery checked to change the decrypted output."""
+    from encctl_gym.crypto.paillier import decrypt, encrypt_with_secret
+
+    n = sk.public.n
+    E, K = [[3, -2, 5], [-1, 4, 2]], [[1, 0, -1], [0, 2, 1]]
+    passed = 0
+    for _ in range(trials):
+        mac = mac_class(sk, E, rng, alpha_range=A)
+        steps = []
+        for X in ([7, -3, 11], [2, 5, -4]):  # x_s, then x_t: different, so K (X_t - X_s) != 0
+            cts = [encrypt_with_secret(sk, x % n, rng) for x in X]
+            tagged, masks = mac.tag_state(X)
+            steps.append((cts, tagged, masks))
+        (cts_s, tag_s, _), (cts_t, tag_t, masks_t) = steps
+        rows = [sum((c * e for c, e in zip(cts_t, row) if e), start=encrypt_with_secret(sk, 0, rng)) for row in E]
+        tags = evaluate_tags(E, tag_t, masks_t)
+        f_rows, f_tags = forge_across_steps(rows, tags, (cts_t, tag_t), (cts_s, tag_s), K)
+        assert [decrypt(sk, c) for c in f_rows] != [decrypt(sk, c) for c in rows]
+        assert mac.passes(rows, tags)  # the honest output of the same step passes
+        passed += mac.passes(f_rows, f_tags)
+    return passed
+
+
+def test_the_cross_step_forgery_breaks_a_mac_with_one_gamma_and_not_the_mac(paillier_key):
+    """With one gamma for every step the difference of two tagged states is Enc(alpha dX): the
+    forgery passes always, far above the bound 1/A + 2/p_min; the per-step rho_t stops it."""
+    from encctl_gym.crypto.arith import seeded_random
+
+    _, sk = paillier_key
+    assert _cross_step_passes(sk, _OneGammaMac, 20, seeded_random(4)) == 20
+    assert _cross_step_passes(sk, PaillierMac, 100, seeded_random(5)) == 0
+    A, trials = 2, 200  # a small alpha range: still within the bound's interval
+    passed = _cross_step_passes(sk, PaillierMac, trials, seeded_random(6), A)
+    assert wilson_interval(passed, trials, z=Z_WIDE)[0] <= mac_pass_bound(A, 256)
+
+
+def test_the_cross_step_forgery_refuses_a_k_of_the_wrong_shape():
+    with pytest.raises(ParameterError, match="K must have shape"):
+        forge_across_steps([1, 2], [3, 4], ([1], [1]), ([1], [1]), [[1, 2]])
+
+
 def test_a_guessed_alpha_passes_with_probability_one_over_A(paillier_key):
     from encctl_gym.crypto.arith import seeded_random
 
@@ -209,39 +272,92 @@ def test_mac_refuses_bad_alpha_ranges(paillier_key):
 
 
 # ---------------------------------------------------------------------- the environment's defender
-def _episode(crypto: str, injection: str, steps: int = 25, **defender):
+def _episode(crypto: str, injection: str, steps: int = 25, check: str = "linear-check", **defender):
+    scheme = {"scheme": "paillier", "key_length": 256} if check == "mac" else {"key_length": 128}
     env = gym.make(
         ENV_ID,
         preset="small",
         crypto=crypto,
-        key_length=128,
         max_samples=steps,
         crypto_seed=3,
         injection=injection,
-        defender={"name": "linear-check", **defender},
+        defender={"name": check, **defender},
+        **scheme,
     )
     env.reset(seed=1)
     rng = np.random.default_rng(0)
-    taken, done = 0, False
+    taken, done, observations = 0, False, []
     while not done:
-        _, _, te, tr, info = env.step(rng.uniform(-1, 1, size=2))
+        obs, _, te, tr, info = env.step(rng.uniform(-1, 1, size=2))
+        observations.append(obs)
         taken, done = taken + 1, te or tr
     policy = env.unwrapped.episode.defender
     env.close()
-    return taken, info, policy
+    return taken, info, policy, np.array(observations)
 
 
 @pytest.mark.parametrize("crypto", ["ideal", "elgamal"])
-def test_an_honest_server_never_fails_the_check_through_either_backend(crypto):
-    steps, info, policy = _episode(crypto, "pass")
+@pytest.mark.parametrize("check", ["linear-check", "mac"])
+def test_an_honest_server_never_fails_the_check_through_either_backend(crypto, check):
+    steps, info, policy, _ = _episode(crypto, "pass", check=check)
     assert not info["detected"] and policy.failures == 0 and policy.checks == steps - 1
 
 
 @pytest.mark.parametrize("crypto", ["ideal", "elgamal"])
 @pytest.mark.parametrize("injection", ["replace", "add"])
-def test_a_falsifying_server_is_caught_at_its_first_checked_step(crypto, injection):
-    steps, info, policy = _episode(crypto, injection)
+@pytest.mark.parametrize("check", ["linear-check", "mac"])
+def test_a_falsifying_server_is_caught_at_its_first_checked_step(crypto, injection, check):
+    steps, info, policy, _ = _episode(crypto, injection, check=check)
     assert info["detected"] and steps == 2 and policy.failures == 1
+
+
+@pytest.mark.parametrize("injection", ["pass", "add"])
+def test_the_mac_gives_both_backends_one_episode(injection):
+    """The MAC's tags are real Paillier ciphertexts on both backends, its secrets from the
+    defender's streams: one seed, one episode, bit for bit, and one verdict."""
+    ideal, cipher = _episode("ideal", injection, check="mac"), _episode("elgamal", injection, check="mac")
+    assert ideal[0] == cipher[0] and np.array_equal(ideal[3], cipher[3])
+    assert ideal[1]["detected"] == cipher[1]["detected"] == (injection != "pass")
+    assert (ideal[2].checks, ideal[2].failures) == (cipher[2].checks, cipher[2].failures)
+
+
+def test_the_mac_defender_refuses_other_loops_and_bad_ranges():
+    with pytest.raises(ParameterError, match="paillier scheme's loop, not 'modified'"):
+        gym.make(ENV_ID, preset="small", defender="mac")
+    with pytest.raises(ParameterError, match="observe"):
+        gym.make(
+            ENV_ID, preset="small-output", observe="output", scheme="paillier", key_length=256, max_samples=12, defender="mac"
+        )
+    with pytest.raises(ParameterError, match="alpha_range"):
+        gym.make(
+            ENV_ID, preset="small", scheme="paillier", key_length=256, max_samples=12, defender={"name": "mac", "alpha_range": 1}
+        )
+    with pytest.raises(ParameterError, match="linear check verifies the ElGamal"):
+        gym.make(ENV_ID, preset="small", scheme="paillier", key_length=256, max_samples=12, defender="linear-check")
+
+
+def test_a_small_alpha_range_lets_a_guessing_attacker_through_at_its_bound():
+    """The defender's own MAC against the Kerckhoffs move on its tags (A = 2): a pass rate within
+    the bound's interval, and the honest rows pass."""
+    from encctl_gym.loop.verification import MacDefender
+
+    env = gym.make(
+        ENV_ID, preset="small", scheme="paillier", key_length=256, max_samples=12, defender={"name": "mac", "alpha_range": 2}
+    )
+    env.reset(seed=0)
+    policy = env.unwrapped.episode.defender
+    assert isinstance(policy, MacDefender) and policy.epsilon == mac_pass_bound(2, 256)
+    mac, E, X = policy._macs[0], policy.E, [3, -2]
+    guess, passed, trials = np.random.default_rng(1), 0, 300
+    S = [sum(e * x for e, x in zip(row, X)) for row in E]
+    for _ in range(trials):
+        tagged, masks = mac.tag_state(X)
+        tags = evaluate_tags(E, tagged, masks)
+        assert mac.passes_sums(S, tags)
+        passed += mac.passes_sums([S[0] + 1, *S[1:]], [tags[0] + (1 + int(guess.integers(2))), *tags[1:]])
+    lo, hi = wilson_interval(passed, trials, z=Z_WIDE)
+    assert lo <= mac_pass_bound(2, 256) and 0.5 <= hi
+    env.close()
 
 
 def test_the_defender_refuses_bad_options():
@@ -291,3 +407,29 @@ def test_the_verify_lever_catches_an_injection_and_never_a_passed_through_input(
     game.step({"attacker": inject, "defender": defender_action()})
     _, _, term, _, info = game.step({"attacker": inject, "defender": verify})
     assert term["defender"] and info["defender"]["detected"] and info["defender"]["verified"]
+
+
+def test_the_verify_lever_runs_the_mac_on_a_paillier_loop():
+    pytest.importorskip("pettingzoo")
+    from encctl_gym.agents.evaluate import budget_config, env_config
+    from encctl_gym.agents.game import defender_action
+    from encctl_gym.loop.verification import MacDefender
+    from encctl_gym.multiagent import EncryptedControlGame
+
+    cfg = budget_config(env_config({"preset": "small", "scheme": "paillier", "key_length": 256, "max_samples": 12}), 12)
+    game = EncryptedControlGame(cfg)
+    assert isinstance(game.levers._verifier, MacDefender)
+    m, verify = game.params.m, defender_action(verify=1.0)
+    game.reset(seed=0)
+    passing = np.r_[np.full(m, 0.3), -1.0].astype(np.float32)
+    steps = 0
+    while game.agents:
+        _, _, _, _, info = game.step({"attacker": passing, "defender": verify})
+        steps += 1
+        assert not info["defender"]["detected"]
+    assert info["defender"]["checks"] == steps - 1
+    game.reset(seed=0)
+    inject = np.r_[np.full(m, 0.3), 1.0].astype(np.float32)
+    game.step({"attacker": inject, "defender": defender_action()})
+    _, _, term, _, info = game.step({"attacker": inject, "defender": verify})
+    assert term["defender"] and info["defender"]["detected"]

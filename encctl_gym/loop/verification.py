@@ -19,9 +19,12 @@ which it can form from ``c`` and ``X`` in ``n`` products without the server: on 
 server-side tag costs ``n`` decryptions more and checks nothing more.
 
 **The MAC** (:class:`PaillierMac`) is for a verifier that does not hold ``E``: the plant side keeps
-``alpha``, ``gamma``, ``delta = E gamma mod n`` (provisioned once) and a fresh ``beta_t`` per step;
-it sends ``Enc(alpha X_j + gamma_j)`` beside ``Enc(X_j)`` and ``Enc(beta_t)``; the server
-evaluates the tag rows with the same plaintext coefficients (:func:`evaluate_tags`).
+``alpha``, ``gamma``, ``delta = E gamma mod n`` (provisioned once) and a fresh ``rho_t`` and
+``beta_t`` per step; it sends ``Enc(alpha X_j + rho_t gamma_j)`` beside ``Enc(X_j)`` and
+``Enc(beta_t)``; the server evaluates the tag rows with the same plaintext coefficients
+(:func:`evaluate_tags`). Without ``rho_t`` (one ``gamma`` for every step) the MAC is broken by
+the homomorphism itself: the difference of two steps' tagged states is ``Enc(alpha (X(t) -
+X(s)))``, and :func:`forge_across_steps` passes with probability 1.
 
 :class:`LinearCheckDefender` runs the keyed linear check in the environment: every attack step it
 checks the input the plant decoded last step against the state it encrypted then (the integers
@@ -47,8 +50,12 @@ from .spec import LoopSpec
 __all__ = [
     "KeyedLinearCheck",
     "LinearCheckDefender",
+    "MacDefender",
+    "verifier_for",
+    "check_exact_sums",
     "PaillierMac",
     "evaluate_tags",
+    "forge_across_steps",
     "uniform_below",
     "row_sums_of",
     "measure_check_seconds",
@@ -56,6 +63,17 @@ __all__ = [
 
 #: Integers below this are recovered exactly from their decoded double (``|S| < 2^52``).
 EXACT_SUM_LIMIT = 1 << 52
+
+
+def check_exact_sums(what: str, E: Any, delta: float, x_bound: float, max_shift: int = 0) -> None:
+    """Refuse an encoding whose row sums ``S = E X`` could reach ``2^52``: a check that reads
+    them back from the decoded input (:func:`row_sums_of`) would no longer see them exactly."""
+    x_max = int(round(delta * x_bound)) + max_shift + 1
+    if max(sum(abs(int(v)) for v in row) for row in E) * x_max >= EXACT_SUM_LIMIT:
+        raise ParameterError(
+            f"{what} recovers the row sums from the decoded input exactly only below 2^52; "
+            f"Delta = {delta:g} with x_bound = {x_bound:g} exceeds it"
+        )
 
 
 def uniform_below(rng: Any, bound: int) -> int:
@@ -180,12 +198,7 @@ class LinearCheckDefender(_PlantSidePolicy):
         E = getattr(self.quantization, "phi_int", None)
         if E is None:  # Paillier quantises Phi in the plant's parties; its check is security.verification.PaillierMac
             raise ParameterError(f"the linear check verifies the ElGamal schemes' quantised Phi; scheme {scheme.name!r} has none")
-        x_max = int(round(self.delta * float(self._params.x_bound))) + int(self.max_shift) + 1
-        if max(sum(abs(int(v)) for v in row) for row in E) * x_max >= EXACT_SUM_LIMIT:
-            raise ParameterError(
-                f"the linear check recovers the row sums from the decoded input exactly only below 2^52; "
-                f"Delta = {self.delta:g} with x_bound = {self._params.x_bound:g} exceeds it"
-            )
+        check_exact_sums("the linear check", E, self.delta, float(self._params.x_bound), int(self.max_shift))
 
     def on_new_group(self, group: Any) -> None:
         super().on_new_group(group)
@@ -258,31 +271,46 @@ class PaillierMac:
         self._gamma = [uniform_below(rng, n) for _ in range(self.n)]
         self._delta = [sum(e * g for e, g in zip(row, self._gamma)) % n for row in rows]
         self._beta: list[int] | None = None
+        self._rho = 0
         self.epsilon = mac_pass_bound(self.A, self.pk.bits)
 
     def tag_state(self, X: Sequence[int]) -> tuple[list[Any], list[Any]]:
-        """What the plant sends this step beside ``Enc(X_j)``: ``Enc(alpha X_j + gamma_j)`` and the
-        fresh ``Enc(beta_t,i)`` (``n + m`` encryptions); the step's ``beta_t`` replaces the last."""
+        """What the plant sends this step beside ``Enc(X_j)``: ``Enc(alpha X_j + rho_t gamma_j)``
+        and ``Enc(beta_t,i)`` (``n + m`` encryptions), with this step's fresh ``rho_t`` and
+        ``beta_t``, which replace the last step's."""
         from ..crypto.paillier import encrypt_with_secret
 
         n = self.pk.n
         if len(X) != self.n:
             raise ParameterError(f"the MAC takes {self.n} state integers, got {len(X)}")
+        self._rho = uniform_below(self._rng, n)
         self._beta = [uniform_below(self._rng, n) for _ in range(self.m)]
-        tagged = [encrypt_with_secret(self.sk, (self._alpha * int(x) + g) % n, self._rng) for x, g in zip(X, self._gamma)]
+        tagged = [
+            encrypt_with_secret(self.sk, (self._alpha * int(x) + self._rho * g) % n, self._rng) for x, g in zip(X, self._gamma)
+        ]
         masks = [encrypt_with_secret(self.sk, b, self._rng) for b in self._beta]
         return tagged, masks
 
     def passes(self, rows: Sequence[Any], tags: Sequence[Any]) -> bool:
-        """``Dec(tau_i) = alpha Dec(c_i) + delta_i + beta_t,i (mod n)`` for every row, with this
-        step's ``beta_t`` (``2 m`` decryptions); before any :meth:`tag_state` nothing passes."""
+        """``Dec(tau_i) = alpha Dec(c_i) + rho_t delta_i + beta_t,i (mod n)`` for every row, with
+        this step's ``rho_t`` and ``beta_t`` (``2 m`` decryptions); before any :meth:`tag_state`
+        nothing passes."""
         from ..crypto.paillier import decrypt
 
-        if self._beta is None or len(rows) != self.m or len(tags) != self.m:
+        if len(rows) != self.m:
+            return False
+        return self.passes_sums([decrypt(self.sk, c) for c in rows], tags)
+
+    def passes_sums(self, sums: Sequence[int], tags: Sequence[Any]) -> bool:
+        """:meth:`passes` for rows the plant has decrypted already: ``sums`` are the integers
+        ``S_i`` (signed or reduced modulo ``n``: the check is modulo ``n``); ``m`` decryptions."""
+        from ..crypto.paillier import decrypt
+
+        if self._beta is None or len(sums) != self.m or len(tags) != self.m:
             return False
         n = self.pk.n
-        for c, t, d, b in zip(rows, tags, self._delta, self._beta):
-            if decrypt(self.sk, t) != (self._alpha * decrypt(self.sk, c) + d + b) % n:
+        for S, t, d, b in zip(sums, tags, self._delta, self._beta):
+            if decrypt(self.sk, t) != (self._alpha * int(S) + self._rho * d + b) % n:
                 return False
         return True
 
@@ -300,6 +328,139 @@ def evaluate_tags(E: Any, tagged: Sequence[Any], masks: Sequence[Any]) -> list[A
             acc = acc + ct * int(e)
         out.append(acc)
     return out
+
+
+def forge_across_steps(
+    rows: Sequence[Any],
+    tags: Sequence[Any],
+    now: tuple[Sequence[Any], Sequence[Any]],
+    before: tuple[Sequence[Any], Sequence[Any]],
+    K: Any,
+) -> tuple[list[Any], list[Any]]:
+    """The cross-step forgery of the MAC (no key): ``u' = Phi x_t + K (x_t - x_s)``.
+
+    ``now`` and ``before`` are the ciphertexts the plant sent at steps ``t`` and ``s``: the states
+    ``Enc(X_j)`` and the tagged states. The server adds ``K (Enc(X(t)) - Enc(X(s)))`` to the rows
+    and ``K`` times the difference of the tagged states to the tags. With one ``gamma`` for every
+    step (a MAC without a per-step factor), the difference of two tagged states is
+    ``Enc(alpha (X(t) - X(s)))``: ``gamma`` cancels and the forgery passes with probability 1
+    whatever ``alpha`` is. Any ``u' = sum_s K_s x_s`` with ``sum_s K_s = Phi`` is such a forgery,
+    which includes another controller of the state's history. With the per-step ``rho_t`` of
+    :class:`PaillierMac` the difference leaves ``(rho_t - rho_s) gamma``, which the server cannot
+    remove, and the forgery passes with at most the MAC's ``epsilon``.
+    """
+    (x_now, tag_now), (x_before, tag_before) = now, before
+    K = [[int(v) for v in row] for row in K]
+    if len(K) != len(rows) or any(len(row) != len(x_now) for row in K):
+        raise ParameterError(f"K must have shape ({len(rows)}, {len(x_now)}), got {format_value(K)}")
+
+    def moved(base: Sequence[Any], a: Sequence[Any], b: Sequence[Any]) -> list[Any]:
+        out = []
+        for c, row in zip(base, K):
+            for k, ca, cb in zip(row, a, b):
+                if k:
+                    c = c + ca * k + cb * (-k)
+            out.append(c)
+        return out
+
+    return moved(rows, x_now, x_before), moved(tags, tag_now, tag_before)
+
+
+class MacDefender(_PlantSidePolicy):
+    """The linearly homomorphic MAC at every attack step, on the Paillier loop (registry name
+    ``"mac"``; :class:`PaillierMac`, bound in :mod:`encctl_gym.security.verification`).
+
+    Each episode draws one Paillier key of the loop's modulus length for the tags (KeyGen from
+    the defender's first stream) and, per copy, the MAC's secrets. Every attack step it checks
+    the input the plant decoded at step ``k - 1``: the plant tags the state ``X(k - 1)`` it
+    encrypted then (``Enc(alpha X_j + rho gamma_j)`` and ``Enc(beta)``, real ciphertexts), the
+    server evaluates the tag rows with ``Phi_bar`` (:func:`evaluate_tags`), and the plant checks
+    them against the row sums it decrypted (read back exactly from the decoded input,
+    :func:`row_sums_of`). A failure in any copy ends the attack. The injection modes of the
+    environment (replace, add, scale) forge the rows and forward the tags the server computed;
+    an attacker that forges tags too is measured in ``experiments/integrity.py``.
+
+    Parameters
+    ----------
+    alpha_range : int, optional
+        ``A``: ``alpha`` uniform in ``{1..A}`` (default ``n - 1``); a falsified step passes with
+        probability at most ``1 / A + 2 / p_min``.
+
+    Raises
+    ------
+    ParameterError
+        For a loop that is not the Paillier scheme's state-feedback loop, ``A < 2``, or an
+        encoding whose row sums could reach ``2^52``.
+    """
+
+    name = "mac"
+
+    def __init__(self, alpha_range: int | None = None) -> None:
+        self.alpha_range = None if alpha_range is None else check_secret_range("alpha_range", alpha_range)
+        self.checks = self.failures = 0
+
+    def group(self, params: LoopSpec) -> Any:
+        if params.observe != "state":
+            raise ParameterError(f"the MAC verifies the state-feedback loop; observe = {params.observe!r} is not supported")
+        scheme = params.encryption()
+        if scheme.name != "paillier":
+            raise ParameterError(f"the MAC verifies the paillier scheme's loop, not {scheme.name!r} (use linear-check)")
+        group = super().group(params)
+        self.bits = int(group.key_length)
+        self.encoder = scheme.encoder(group, self.delta)
+        self.E = [[self.encoder.quantize(v) for v in row] for row in self.Phi.tolist()]
+        check_exact_sums("the MAC", self.E, self.delta, float(params.x_bound))
+        return group
+
+    def reset(self, K: int, n: int, m: int, rngs: Sequence[np.random.Generator]) -> None:
+        from ..crypto.paillier import keygen
+
+        super().reset(K, n, m, rngs)
+        _, self.sk = keygen(self.bits, rng=rngs[0])
+        if self.alpha_range is not None and self.alpha_range >= self.sk.public.n:
+            raise ParameterError(f"alpha_range must be below the modulus n, got {format_value(self.alpha_range)}")
+        self._macs = [PaillierMac(self.sk, self.E, rngs[i], alpha_range=self.alpha_range) for i in range(K)]
+        self.checks = self.failures = 0
+
+    @property
+    def epsilon(self) -> float:
+        """The largest probability that one falsified step passes."""
+        n = self.sk.public.n if hasattr(self, "sk") else 1 << (self.bits - 1)  # before a reset: n's lower bound
+        return mac_pass_bound(self.alpha_range or n - 1, self.bits)
+
+    def caught(self, x_prev: np.ndarray, last_input: np.ndarray) -> bool:
+        """Tag every copy's state ``x_{k-1}``, evaluate the tag rows, check them against the row
+        sums of its decoded input ``u_{k-1}``; whether any failed."""
+        failed = False
+        for k, mac in enumerate(self._macs):
+            tagged, masks = mac.tag_state(self.encoder.quantize_array(x_prev[k]))
+            ok = mac.passes_sums(row_sums_of(last_input[k], int(self.delta)), evaluate_tags(self.E, tagged, masks))
+            self.checks += 1
+            self.failures += not ok
+            failed = failed or not ok
+        return failed
+
+    def act(self, view: PlantView) -> DefenderAction | None:
+        x_prev, self._x_prev = self._x_prev, np.array(view.state, dtype=float)
+        if x_prev is None:
+            return None
+        return DefenderAction(end=True) if self.caught(x_prev, view.last_input) else None
+
+    def __repr__(self) -> str:
+        return f"MacDefender(alpha_range={self.alpha_range!r})"
+
+
+DEFENDERS.update({"mac": MacDefender})
+
+
+def verifier_for(params: LoopSpec, secret_range: int) -> LinearCheckDefender | MacDefender:
+    """The plant side's exact check for the loop of ``params``: the MAC on the Paillier scheme,
+    the keyed linear check (range ``secret_range``) on the ElGamal schemes; set up for ``params``
+    (its :meth:`group` called), so a loop the check cannot verify is refused here."""
+    check: LinearCheckDefender | MacDefender
+    check = MacDefender() if params.encryption().name == "paillier" else LinearCheckDefender(secret_range)
+    check.group(params)
+    return check
 
 
 def measure_check_seconds(m: int, n: int, *, secret_range: int = 1 << 64, entry_bits: int = 24, repeats: int = 2000) -> float:

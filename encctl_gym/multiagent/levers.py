@@ -32,7 +32,10 @@ The defender's action is a vector in ``[-1, 1]``, one entry per lever of :data:`
   (:class:`~encctl_gym.loop.verification.LinearCheckDefender`, secret range
   :attr:`GameRules.verify_secret_range`, its own spawned streams): a falsified input fails it
   but with probability ``1 / R`` (never for one input), with no tolerance (unlike an audit), and
-  ends the attack; an honest one never fails. Each check costs :attr:`GameRules.verify_cost`.
+  ends the attack; an honest one never fails. On the Paillier scheme's loop the lever runs the
+  linearly homomorphic MAC instead (:class:`~encctl_gym.loop.verification.MacDefender`: real tag
+  ciphertexts, bound ``1 / A + 2 / p_min`` with ``A = n - 1``). Each check costs
+  :attr:`GameRules.verify_cost`.
 
 A new lever is one more name in :data:`LEVERS`, one more entry of the action, one more field
 of :class:`Decision`, and its cost in :meth:`DefenderLevers.cost`.
@@ -61,7 +64,7 @@ from ..loop.defender import DefenderAction, DefenderStreams, PlantView
 from ..loop.defenses import _PlantSidePolicy, audit_tolerance
 from ..loop.detection import Audit, ChiSquaredDetector
 from ..loop.rotation import GenerationTally, GroupPool, RotationGroups, check_ahead
-from ..loop.verification import LinearCheckDefender
+from ..loop.verification import LinearCheckDefender, MacDefender, verifier_for
 from ..security.defenses import noise_defense_price
 from ..security.verification import check_secret_range
 
@@ -210,10 +213,10 @@ class DefenderLevers(_PlantSidePolicy):
         if self.rules.rotation and isinstance(group, GroupParams) and group.is_safe_prime:  # as the "rotate" defender
             self.groups = RotationGroups(group.bits, params.crypto_seed, self.rules.rotation_ahead)
             self.pool = self.groups.fixed
-        self._verifier: LinearCheckDefender | None = LinearCheckDefender(self.rules.verify_secret_range)
+        self._verifier: LinearCheckDefender | MacDefender | None = None
         self._no_verifier = ""
-        try:
-            self._verifier.group(params)
+        try:  # the linear check on ElGamal, the MAC on Paillier
+            self._verifier = verifier_for(params, self.rules.verify_secret_range)
         except ParameterError as exc:  # an output loop, or a Delta too large: the lever is off
             self._verifier, self._no_verifier = None, str(exc)
         return group

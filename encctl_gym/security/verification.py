@@ -19,20 +19,34 @@ sends:
   ``n + m`` integer products and sums of integers of ``log2(R) + log2(p)`` bits.
 * **The linearly homomorphic MAC** (``"mac"``, for the additive Paillier scheme; the
   Catalano-Fiore style of a MAC evaluated through an additive homomorphism, with the secret
-  ``gamma`` binding the server's coefficients to Phi and a fresh ``beta_t`` per step against
-  replays). The plant keeps ``alpha`` (uniform in a set of ``A`` residues), ``gamma`` (uniform in
-  ``Z_n^n``), ``delta = E gamma mod n`` and fresh ``beta_t`` (uniform in ``Z_n^m``); it sends
-  ``Enc(X_j)``, ``Enc(alpha X_j + gamma_j)`` and ``Enc(beta_t,i)``; the server returns
-  ``c_i = Enc(S_i)`` and ``tau_i = Enc(sum_j E_ij (alpha X_j + gamma_j) + beta_t,i)``; the plant
-  accepts iff ``Dec(tau_i) = alpha Dec(c_i) + delta_i + beta_t,i (mod n)``. A falsified output
-  passes with probability at most ``1 / A + 2 / p_min`` (the check is a polynomial of degree at
-  most 2 in the secrets, not identically zero unless the output is honest, and the adversary's
-  view is independent of the secrets by the semantic security of Paillier's scheme; over
-  ``Z_n``, ``n = p q``, a nonzero polynomial of degree ``d`` in ``alpha`` has at most ``d`` roots
-  modulo each prime, so at most ``1/A`` of the ``alpha`` (degree 1 in ``alpha`` for an output built
-  from the untagged ciphertexts) plus ``d / p_min`` for the terms through ``gamma`` and ``beta``,
-  with ``p_min >= 2^(ceil(k/2) - 1)`` for a ``k``-bit modulus from
-  :func:`encctl_gym.crypto.paillier.keygen`).
+  ``gamma`` binding the server's coefficients to Phi, a fresh secret factor ``rho_t`` per step
+  binding the tags to the step, and a fresh ``beta_t`` per step against replays). The plant
+  keeps ``alpha`` (uniform in a set of ``A`` residues), ``gamma`` (uniform in ``Z_n^n``),
+  ``delta = E gamma mod n`` and, each step, fresh ``rho_t`` (uniform in ``Z_n``) and ``beta_t``
+  (uniform in ``Z_n^m``); it sends ``Enc(X_j)``, ``Enc(alpha X_j + rho_t gamma_j)`` and
+  ``Enc(beta_t,i)``; the server returns ``c_i = Enc(S_i)`` and ``tau_i = Enc(sum_j E_ij (alpha
+  X_j + rho_t gamma_j) + beta_t,i)``; the plant accepts iff ``Dec(tau_i) = alpha Dec(c_i) +
+  rho_t delta_i + beta_t,i (mod n)``. A falsified output passes with probability at most
+  ``1 / A + 2 / p_min``. The argument: the server can only form affine combinations, with
+  integer coefficients it chooses, of everything it was sent at this step and every earlier
+  one, and of constants it encrypts itself. Write its output as such a combination: the check
+  ``tau' - alpha c' - rho_t delta - beta_t`` is then a polynomial in the secrets (``alpha``, every
+  ``rho_s``, ``gamma``, every ``beta_s``). It is identically zero only if ``c'`` uses no tagged
+  or mask ciphertext (``alpha c'`` would hold ``alpha^2`` or ``alpha rho_s gamma_j`` terms that
+  ``tau'`` cannot), ``tau'`` uses this step's tagged states with exactly the coefficients ``E``
+  and no earlier step's (the ``rho_s gamma_j`` terms must be ``rho_t delta``) and this step's
+  mask once, and then ``Dec(c') = E X(t)``: the honest output. For any other output, at most one
+  ``alpha`` makes every coefficient vanish as a polynomial in the other secrets (the
+  coefficient of ``rho_s gamma_j`` or of the constant is of degree at most 1 in ``alpha`` once
+  ``c'`` holds no tagged term), and for any other ``alpha`` the polynomial, of degree at most 2 in
+  the secrets uniform in ``Z_n`` (so uniform modulo each prime of ``n = p q``), vanishes with
+  probability at most ``2 / p_min`` (Schwartz-Zippel modulo the smaller prime), with ``p_min >=
+  2^(ceil(k/2) - 1)`` for a ``k``-bit modulus from :func:`encctl_gym.crypto.paillier.keygen`;
+  the adversary's view is independent of the secrets by the semantic security of Paillier's
+  scheme. Without ``rho_t`` (one ``gamma`` for every step, as this package first built it) the
+  difference of two steps' tagged states is ``Enc(alpha (X(t) - X(s)))``: a forgery ``u' = Phi
+  x_t + K (x_t - x_s)`` with the tags moved alike passes with probability 1
+  (:func:`encctl_gym.loop.verification.forge_across_steps`; measured, ``docs/verification.md``).
 
 Per step versus per attack: both keys are kept for an episode, so a falsification that passes
 once tells the adversary a relation the key satisfies and it may pass again (the linear check's
