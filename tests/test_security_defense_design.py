@@ -46,9 +46,13 @@ def test_each_cost_term_is_the_hand_count():
     assert mix.rotation_seconds == pytest.approx((0.5 + (1 + 2 * n * m + n * m) * k * 1e-6) / 100, rel=1e-12)
     assert mix.audit_seconds == pytest.approx(1e-4 * 1e-3, rel=1e-12)
     assert mix.total_seconds == pytest.approx(mix.step_seconds + mix.rotation_seconds + mix.audit_seconds, rel=1e-12)
-    # p = 1e-4 is below p*: the key carries the security, and (1 - p)^N* is the hand's
+    # p = 1e-4 is below p_J: the key carries the security, and (1 - p)^J is the hand's, J the
+    # sparse attacker's fewest falsified steps (Phi = 0: J_min = sigma_w2 m / ((n + m) u_max^2 gamma_c))
+    u2 = 16 * PRESET.sigma_u2
+    J = math.ceil(PRESET.sigma_w2 * m / ((n + m) * u2 * PRESET.gamma_c))
+    assert d.fewest_falsified_steps == J and d.audit_steps == min(J, d.N_star) < d.N_star
     assert mix.key_secure and not mix.audit_secure
-    assert mix.undetected_probability == pytest.approx(math.exp(d.N_star * math.log(1 - 1e-4)), rel=1e-12)
+    assert mix.undetected_probability == pytest.approx(math.exp(d.audit_steps * math.log(1 - 1e-4)), rel=1e-12)
 
 
 def test_the_noise_moves_n_star_and_its_control_cost_is_the_lyapunov_price():
@@ -119,10 +123,12 @@ def test_auto_audits_pick_the_cheaper_of_two_hand_computable_mixes(local, winner
     d = design(cost_models=("paper",), audit_rate="auto", detection_delta=1e-3, costs=toy_costs(local))
     N = d.N_star
     p_star = 1 - 1e-3 ** (1 / N)
-    assert d.minimum_audit_rate == pytest.approx(p_star, rel=1e-9)
+    assert d.minimum_audit_rate == pytest.approx(p_star, rel=1e-9)  # the rule for an attacker falsifying every sample
+    p_J = 1 - 1e-3 ** (1 / d.audit_steps)  # the sparse attacker's: the rate audit-secure mixes pay
+    assert d.sparse_audit_rate == pytest.approx(p_J, rel=1e-9) and p_J > p_star
     k_star = d.models["paper"].k_star
     key_mix = (3 * n + 1) * k_star * 1e-6  # the fixed group at k*, no audits
-    audit_mix = (3 * n + 1) * 40 * 1e-6 + p_star * local  # the smallest key, audits at p*
+    audit_mix = (3 * n + 1) * 40 * 1e-6 + p_J * local  # the smallest key, audits at p_J
     chosen = d.models["paper"].chosen
     assert chosen.total_seconds == pytest.approx(min(key_mix, audit_mix), rel=1e-9)
     assert (chosen.audit_secure, chosen.key_length) == ((True, 40) if winner == "audit" else (False, k_star))

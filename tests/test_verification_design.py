@@ -43,8 +43,9 @@ def test_a_check_too_weak_alone_is_not_secure_and_auto_audits_complete_it():
     assert v.epsilon == 0.1
     for entry in v.models.values():
         vm = entry["verified"]
-        # epsilon (1 - p)^(N* - 1) <= delta with the smallest such p
-        assert vm.verification_secure and 0 < vm.audit_rate < d.minimum_audit_rate
+        # epsilon (1 - p)^(J - 1) <= delta with the smallest such p, J the sparse attacker's falsified steps
+        assert vm.verification_secure and 0 < vm.audit_rate < d.sparse_audit_rate
+        assert vm.undetected_probability == pytest.approx(0.1 * (1 - vm.audit_rate) ** (d.audit_steps - 1), rel=1e-12)
         assert vm.undetected_probability <= 1e-3 * (1 + 1e-9)
 
 

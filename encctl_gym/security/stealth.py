@@ -517,10 +517,12 @@ def frontier_point(
     sparse: tuple[float, float] | None = None,
     horizon: int | None = None,
     audit_fraction: float | None = None,
+    steps: int | None = None,
 ) -> FrontierPoint:
     """The frontier at one attack (module docstring): Gaussian excitation ``Sigma_d``, or a sparse
     attacker ``sparse = (q, amplitude)`` (``Sigma_d = q amplitude^2 I``, its detection from the
-    mixture laws). The detection is evaluated within ``min(samples, horizon)`` steps.
+    mixture laws). The detection is evaluated within ``min(samples, horizon)`` steps, or
+    exactly ``steps`` when given (an attack longer than its samples to ``gamma_c``).
     ``audit_fraction``: the fraction of steps an audit can catch (default 1, a sparse attack's ``q``)."""
     A, B, Phi = _matrices(A, B, Phi)
     n = A.shape[0]
@@ -532,8 +534,10 @@ def frontier_point(
         Sigma_d = q * amp * amp * np.eye(B.shape[1])
     S1 = innovation_covariance(B, sw, Sigma_d)
     samples = samples_to_gamma_c(identification_rate(A, B, Phi, sigma_w2=sw, Sigma_d=Sigma_d), gamma_c)
-    steps = samples if horizon is None else min(samples, check_int("horizon", horizon, minimum=1))
-    steps = int(min(steps, 10**9))
+    length: int | float = check_int("steps", steps, minimum=1) if steps is not None else samples
+    if steps is None and horizon is not None:
+        length = min(samples, check_int("horizon", horizon, minimum=1))
+    steps = int(min(length, 10**9))
     h = chi2_threshold(n, window, alpha)
     if sparse is not None:
         lam = float(np.mean(sparse_noncentralities(B, sw, amp)))

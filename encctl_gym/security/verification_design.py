@@ -192,7 +192,7 @@ def design_verification(
     t_check = check_nonnegative("check_seconds", check_seconds)
     name, R = _check(str(verify.get("name")), dict(verify.get("params") or {}), costs.m, design.detection_delta)
     eps = linear_check_pass_bound(costs.m, R)
-    N, delta = design.N_star, design.detection_delta
+    N, delta = design.audit_steps or design.N_star, design.detection_delta  # the falsified steps an audit must catch one of
     rates = [0.0] if not isinstance(design.audit_rate, float) else [float(design.audit_rate)]
     if design.audit_rate == "auto" and eps > delta:
         p_v = -_expm1_root(delta / eps, max(N - 1, 1))
@@ -201,7 +201,7 @@ def design_verification(
         rates.append(p_v)
     models: dict[str, dict[str, Any]] = {}
     for model, md in design.models.items():
-        k = min(design.min_key_length, md.chosen.key_length)  # the smallest key the design allows
+        k = md.key_floor or min(design.min_key_length, md.chosen.key_length)  # the smallest key the design allows
         mixes = [_verified(costs, k, p, name, R, eps, N, delta, t_check) for p in rates]
         secure = [v for v in mixes if v.verification_secure]
         verified = min(secure or mixes, key=lambda v: v.total_seconds)
