@@ -153,7 +153,36 @@ def row_sums_of(u: Any, delta: int) -> list[int]:
     return [round(Fraction(float(v)) * d2) for v in np.asarray(u, dtype=float).ravel()]
 
 
-class LinearCheckDefender(_PlantSidePolicy):
+class _ExactCheckPolicy(_PlantSidePolicy):
+    """What the exact checks share: every attack step, each copy's decoded input ``u_{k-1}``
+    checked against the state ``x_{k-1}`` the plant encrypted then (:meth:`_passes`, one per
+    check), the counts, and the end of the attack at the first failure."""
+
+    checks: int
+    failures: int
+
+    def _passes(self, k: int, x_prev: np.ndarray, sums: list[int]) -> bool:
+        raise NotImplementedError
+
+    def caught(self, x_prev: np.ndarray, last_input: np.ndarray) -> bool:
+        """Check every copy's decoded input ``u_{k-1}`` against its state ``x_{k-1}``; whether any
+        failed (the game's ``"verify"`` lever calls it at the steps the defender asks for)."""
+        failed = False
+        for k in range(self.K):
+            ok = self._passes(k, x_prev[k], row_sums_of(last_input[k], int(self.delta)))
+            self.checks += 1
+            self.failures += not ok
+            failed = failed or not ok
+        return failed
+
+    def act(self, view: PlantView) -> DefenderAction | None:
+        x_prev, self._x_prev = self._x_prev, np.array(view.state, dtype=float)
+        if x_prev is None:
+            return None
+        return DefenderAction(end=True) if self.caught(x_prev, view.last_input) else None
+
+
+class LinearCheckDefender(_ExactCheckPolicy):
     """The keyed linear check at every attack step (registry name ``"linear-check"``).
 
     Before the period of step ``k`` it checks the input the plant decoded at step ``k - 1``
@@ -216,23 +245,8 @@ class LinearCheckDefender(_PlantSidePolicy):
         """The largest probability that one falsified step passes."""
         return linear_check_pass_bound(self.B.shape[1], self.secret_range)
 
-    def caught(self, x_prev: np.ndarray, last_input: np.ndarray) -> bool:
-        """Check every copy's decoded input ``u_{k-1}`` against its state ``x_{k-1}``; whether any
-        failed (the game's ``"verify"`` lever calls it at the steps the defender asks for)."""
-        failed = False
-        for k, check in enumerate(self._checks):
-            X = self.quantization.encode_state(x_prev[k])
-            ok = check.passes(row_sums_of(last_input[k], int(self.delta)), X)
-            self.checks += 1
-            self.failures += not ok
-            failed = failed or not ok
-        return failed
-
-    def act(self, view: PlantView) -> DefenderAction | None:
-        x_prev, self._x_prev = self._x_prev, np.array(view.state, dtype=float)
-        if x_prev is None:
-            return None
-        return DefenderAction(end=True) if self.caught(x_prev, view.last_input) else None
+    def _passes(self, k: int, x_prev: np.ndarray, sums: list[int]) -> bool:
+        return self._checks[k].passes(sums, self.quantization.encode_state(x_prev))
 
     def __repr__(self) -> str:
         return f"LinearCheckDefender(secret_range={self.secret_range!r})"
@@ -366,7 +380,7 @@ def forge_across_steps(
     return moved(rows, x_now, x_before), moved(tags, tag_now, tag_before)
 
 
-class MacDefender(_PlantSidePolicy):
+class MacDefender(_ExactCheckPolicy):
     """The linearly homomorphic MAC at every attack step, on the Paillier loop (registry name
     ``"mac"``; :class:`PaillierMac`, bound in :mod:`encctl_gym.security.verification`).
 
@@ -428,23 +442,11 @@ class MacDefender(_PlantSidePolicy):
         n = self.sk.public.n if hasattr(self, "sk") else 1 << (self.bits - 1)  # before a reset: n's lower bound
         return mac_pass_bound(self.alpha_range or n - 1, self.bits)
 
-    def caught(self, x_prev: np.ndarray, last_input: np.ndarray) -> bool:
-        """Tag every copy's state ``x_{k-1}``, evaluate the tag rows, check them against the row
-        sums of its decoded input ``u_{k-1}``; whether any failed."""
-        failed = False
-        for k, mac in enumerate(self._macs):
-            tagged, masks = mac.tag_state(self.encoder.quantize_array(x_prev[k]))
-            ok = mac.passes_sums(row_sums_of(last_input[k], int(self.delta)), evaluate_tags(self.E, tagged, masks))
-            self.checks += 1
-            self.failures += not ok
-            failed = failed or not ok
-        return failed
-
-    def act(self, view: PlantView) -> DefenderAction | None:
-        x_prev, self._x_prev = self._x_prev, np.array(view.state, dtype=float)
-        if x_prev is None:
-            return None
-        return DefenderAction(end=True) if self.caught(x_prev, view.last_input) else None
+    def _passes(self, k: int, x_prev: np.ndarray, sums: list[int]) -> bool:
+        """Tag the state ``x_{k-1}``, evaluate the tag rows, check them against the row sums."""
+        mac = self._macs[k]
+        tagged, masks = mac.tag_state(self.encoder.quantize_array(x_prev))
+        return mac.passes_sums(sums, evaluate_tags(self.E, tagged, masks))
 
     def __repr__(self) -> str:
         return f"MacDefender(alpha_range={self.alpha_range!r})"
