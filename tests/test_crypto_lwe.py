@@ -67,7 +67,8 @@ def test_linear_combination_decrypts_to_the_integer_product(seed: int, data: st.
     p = lwe.LWEParams(n=16, q=2**40 + 15, t=2**16, eta=2)
     pk, sk = lwe.keygen(p, seed)
     k = data.draw(st.integers(1, 5))
-    mu = data.draw(st.lists(st.integers(-300, 300), min_size=k, max_size=k))
+    # |sum_j K_ij mu_j| <= 5 * 40 * 160 = 32000 <= (t - 1) / 2 = 32767: every draw is decryptable
+    mu = data.draw(st.lists(st.integers(-160, 160), min_size=k, max_size=k))
     K = data.draw(st.lists(st.lists(st.integers(-40, 40), min_size=k, max_size=k), min_size=1, max_size=4))
     stream = lwe.ByteStream(seeded_random(seed, "enc"))
     ct = lwe.encrypt(pk, mu, stream)
