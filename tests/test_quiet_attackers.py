@@ -39,6 +39,18 @@ def test_the_fewest_falsified_steps_by_hand():
     assert big.steps == 3
 
 
+def _sparse_fraction(A, B, Phi, sigma_w2, gamma_c, u_max, N):
+    """The smallest fraction q (bisected in log) whose mean excitation q u_max^2 I reaches gamma_c
+    in N samples by the closed form c(q) / (N - 1)."""
+    lo, hi = 1e-9, 1.0
+    for _ in range(100):
+        mid = math.sqrt(lo * hi)
+        Sd = mid * u_max * u_max * np.eye(np.shape(B)[1])
+        ok = identification_rate(A, B, Phi, sigma_w2=sigma_w2, Sigma_d=Sd) / (N - 1) < gamma_c
+        lo, hi = (lo, mid) if ok else (mid, hi)
+    return hi
+
+
 def test_the_limit_is_approached_from_above_by_the_finite_sample_attacker():
     """``J(N) = q*(N) N`` (q* the smallest fraction reaching gamma_c in N samples) decreases to
     J_min: every finite attack falsifies more steps than the audit rate is sized for."""
@@ -47,12 +59,7 @@ def test_the_limit_is_approached_from_above_by_the_finite_sample_attacker():
     J_min = fewest_falsified_steps(A, B, Phi, sigma_w2=sw, gamma_c=gc, input_bound=u).steps
     last = math.inf
     for N in (5_000, 20_000, 100_000, 1_000_000):
-        lo, hi = 1e-9, 1.0
-        for _ in range(100):
-            mid = math.sqrt(lo * hi)
-            ok = identification_rate(A, B, Phi, sigma_w2=sw, Sigma_d=mid * u * u * np.eye(2)) / (N - 1) < gc
-            lo, hi = (lo, mid) if ok else (mid, hi)
-        J = hi * N
+        J = _sparse_fraction(A, B, Phi, sw, gc, u, N) * N
         assert J_min - 1 < J < last  # above the limit (J_min is its ceiling), falling with N
         last = J
     assert last < 1.1 * J_min
@@ -134,12 +141,7 @@ def test_a_sparse_attacker_reaches_gamma_c_with_about_the_fewest_steps_and_audit
     J_min = fewest_falsified_steps(p.A, p.B, Phi, sigma_w2=p.sigma_w2, gamma_c=gc, input_bound=p.u_max).steps
     assert J_min == 30
     N = 2000
-    lo, hi = 1e-9, 1.0
-    for _ in range(100):
-        mid = math.sqrt(lo * hi)
-        ok = identification_rate(p.A, p.B, Phi, sigma_w2=p.sigma_w2, Sigma_d=mid * p.u_max**2 * np.eye(p.m)) / (N - 1) < gc
-        lo, hi = (lo, mid) if ok else (mid, hi)
-    q = hi
+    q = _sparse_fraction(p.A, p.B, Phi, p.sigma_w2, gc, p.u_max, N)
     cfg = budget_config(env_config({**base, "gamma_c": gc}), N)
     att = SparseAttacker(resolve_params(cfg), q=q, level=1.0)
     free = rollout(att, cfg, episodes=64, seed=0, record=False)

@@ -385,40 +385,12 @@ def test_the_experiment_cells_measure_the_checks_on_real_ciphertexts():
 
 
 # ---------------------------------------------------------------------- the game's lever
-def test_the_verify_lever_catches_an_injection_and_never_a_passed_through_input():
-    pytest.importorskip("pettingzoo")
-    from encctl_gym.agents.evaluate import budget_config, env_config
+def _play_the_verify_lever(game, verify_cost=None):
+    """An episode passing ``Phi x`` through with the verify lever at every step (never detected;
+    a check at every step but the first), then one injecting from its second step (caught at
+    the first check); returns the last infos and terminations."""
     from encctl_gym.agents.game import defender_action
-    from encctl_gym.multiagent import EncryptedControlGame
 
-    game = EncryptedControlGame(budget_config(env_config({"preset": "small"}), 20), {"verify_cost": 0.125, "audit_cost": 0.0})
-    m, verify = game.params.m, defender_action(verify=1.0)
-    game.reset(seed=0)
-    passing = np.r_[np.full(m, 0.3), -1.0].astype(np.float32)
-    steps = 0
-    while game.agents:
-        _, rew, _, _, info = game.step({"attacker": passing, "defender": verify})
-        steps += 1
-        assert not info["defender"]["detected"]
-        assert info["defender"]["cost"] == (0.125 if steps > 1 else 0.0)  # nothing to check at the first step
-    assert info["defender"]["checks"] == steps - 1
-    game.reset(seed=0)
-    inject = np.r_[np.full(m, 0.3), 1.0].astype(np.float32)
-    game.step({"attacker": inject, "defender": defender_action()})
-    _, _, term, _, info = game.step({"attacker": inject, "defender": verify})
-    assert term["defender"] and info["defender"]["detected"] and info["defender"]["verified"]
-
-
-def test_the_verify_lever_runs_the_mac_on_a_paillier_loop():
-    pytest.importorskip("pettingzoo")
-    from encctl_gym.agents.evaluate import budget_config, env_config
-    from encctl_gym.agents.game import defender_action
-    from encctl_gym.loop.verification import MacDefender
-    from encctl_gym.multiagent import EncryptedControlGame
-
-    cfg = budget_config(env_config({"preset": "small", "scheme": "paillier", "key_length": 256, "max_samples": 12}), 12)
-    game = EncryptedControlGame(cfg)
-    assert isinstance(game.levers._verifier, MacDefender)
     m, verify = game.params.m, defender_action(verify=1.0)
     game.reset(seed=0)
     passing = np.r_[np.full(m, 0.3), -1.0].astype(np.float32)
@@ -427,9 +399,34 @@ def test_the_verify_lever_runs_the_mac_on_a_paillier_loop():
         _, _, _, _, info = game.step({"attacker": passing, "defender": verify})
         steps += 1
         assert not info["defender"]["detected"]
+        if verify_cost is not None:
+            assert info["defender"]["cost"] == (verify_cost if steps > 1 else 0.0)  # nothing to check at the first step
     assert info["defender"]["checks"] == steps - 1
     game.reset(seed=0)
     inject = np.r_[np.full(m, 0.3), 1.0].astype(np.float32)
     game.step({"attacker": inject, "defender": defender_action()})
     _, _, term, _, info = game.step({"attacker": inject, "defender": verify})
+    return term, info
+
+
+def test_the_verify_lever_catches_an_injection_and_never_a_passed_through_input():
+    pytest.importorskip("pettingzoo")
+    from encctl_gym.agents.evaluate import budget_config, env_config
+    from encctl_gym.multiagent import EncryptedControlGame
+
+    game = EncryptedControlGame(budget_config(env_config({"preset": "small"}), 20), {"verify_cost": 0.125, "audit_cost": 0.0})
+    term, info = _play_the_verify_lever(game, verify_cost=0.125)
+    assert term["defender"] and info["defender"]["detected"] and info["defender"]["verified"]
+
+
+def test_the_verify_lever_runs_the_mac_on_a_paillier_loop():
+    pytest.importorskip("pettingzoo")
+    from encctl_gym.agents.evaluate import budget_config, env_config
+    from encctl_gym.loop.verification import MacDefender
+    from encctl_gym.multiagent import EncryptedControlGame
+
+    cfg = budget_config(env_config({"preset": "small", "scheme": "paillier", "key_length": 256, "max_samples": 12}), 12)
+    game = EncryptedControlGame(cfg)
+    assert isinstance(game.levers._verifier, MacDefender)
+    term, info = _play_the_verify_lever(game)
     assert term["defender"] and info["defender"]["detected"]
