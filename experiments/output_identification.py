@@ -70,7 +70,7 @@ def run(runs: int, points: int, n_max: int | None, seed: int, attacks: tuple[str
         ol_design = optimal_attack_design(p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2, feedback=False)
         ls_fit = fit_empirical_complexity(grid, ref["state_ls_markov"])
         target = float(ls_fit(paper.N_star))
-        base = empirical_design(ls_fit, ThreatModel.of(p), gamma_c=target)
+        base = empirical_design(ls_fit, ThreatModel.of(p), reference=(ls_fit, paper.N_star))
         rows.append(
             _row(
                 system, "states (least squares)", 0.0, "gaussian", "ls", grid, ref["state_ls_markov"], ls_fit, base,
@@ -88,7 +88,7 @@ def run(runs: int, points: int, n_max: int | None, seed: int, attacks: tuple[str
                         fit = fit_empirical_complexity(grid, out["markov"])
                         d: Any
                         try:
-                            d = empirical_design(fit, ThreatModel.of(p), gamma_c=target)
+                            d = empirical_design(fit, ThreatModel.of(p), reference=(ls_fit, paper.N_star))
                         except EncctlError as exc:  # a rate that does not decrease: reported, not designed
                             d = exc
                         rows.append(_row(system, label, sv, attack, est, grid, out["markov"], fit, d, paper.N_star, target))
@@ -231,11 +231,32 @@ def write(
     return [csv_path, md, png]
 
 
-def sic_check(runs: int = 200, seed: int = 1) -> str:
+#: The systems of the eq:sic check: every distinct preset (the paper's design example and Figures
+#: 1 and 2) and the shipped example plant file.
+SIC_CHECK_SYSTEMS: tuple[str, ...] = (
+    "paper-example", "small", *(f"fig1-{c}" for c in "abcdefghi"),
+    *(f"fig2-psi{v}" for v in ("2", "1", "0.5", "0.3", "0.2", "0.1")), "examples/plant_output.yaml",
+)  # fmt: skip
+
+
+def _sic_check_system(name: str) -> tuple[np.ndarray, np.ndarray, float, float, float]:
+    """``(A, B, sigma_u2, sigma_w2, sigma_x2)`` of a preset or a plant file."""
+    if name.endswith((".yaml", ".yml")):
+        from encctl_gym.plant_file import load_plant_file
+
+        p = load_plant_file(name).preset  # relative to the clone, like the pages the experiments write
+    else:
+        p = get_preset(name)
+    return p.A, p.B, p.sigma_u2, p.sigma_w2, p.sigma_x2
+
+
+def sic_check(runs: int = 200, seed: int = 1, systems: tuple[str, ...] = SIC_CHECK_SYSTEMS) -> str:
     """eq:sic against the exact large-N mean error of least squares on the states (``C = I``, no
-    measurement noise): ``sigma_w2 tr(Sigma^-1) / ((n + m) N)`` with the stationary regressor
-    covariance ``Sigma``, and the Monte Carlo band; a markdown table of the ratios to the exact value."""
-    from encctl_gym.security.bayes_complexity import stationary_regressor_covariance
+    measurement noise), ``sigma_w2 tr(Sigma^-1) / ((n + m) N)`` with the stationary regressor
+    covariance ``Sigma``, and against the Monte Carlo mean; beside the closed form of their ratio
+    (:func:`~encctl_gym.security.bayes_complexity.sic_tightness`). A markdown table, one row per
+    system, each column the range over ``N = 400 .. 6400``."""
+    from encctl_gym.security.bayes_complexity import sic_tightness, stationary_regressor_covariance
     from encctl_gym.security.complexity import sic_from_traces
     from encctl_gym.security.gramians import controllability_gramian, noise_gramian
     from encctl_gym.sim.montecarlo import gaussian_attack_errors
@@ -243,26 +264,33 @@ def sic_check(runs: int = 200, seed: int = 1) -> str:
     grid = np.array([400, 800, 1600, 3200, 6400])
     lines = [
         f"# eq:sic against the exact large-N mean error\n\nCommand: `python -m encctl_gym.experiments.output_identification "
-        f"--sic-check` ({runs} Gaussian attacks, least squares on the states; 95 % bootstrap band). "
-        "Every column is a ratio to the exact value sigma_w2 tr(Sigma^-1) / ((n + m) N).\n",
-        "| system | N | band low | Monte Carlo mean | band high | eq:sic |",
-        "|---|---|---|---|---|---|",
+        f"--sic-check` ({runs} Gaussian attacks per system, least squares on the states, N = 400 .. 6400; 95 % bootstrap "
+        "band). Exact: sigma_w2 tr(Sigma^-1) / ((n + m) N), Sigma the stationary regressor covariance. HM/AM: the "
+        "harmonic over the arithmetic mean of Sigma's eigenvalues, the closed-form large-N ratio of eq:sic to the exact "
+        "mean (`sic_tightness`). Each cell is the range over the five sample sizes.\n",
+        "| system | n, m | sigma_u2 / sigma_w2 | HM/AM | eq:sic / exact | eq:sic / Monte Carlo mean | Monte Carlo mean / exact | "
+        "eq:sic below the band |",
+        "|---|---|---|---|---|---|---|---|",
     ]
-    for system in ("small", "paper-example"):
-        p = get_preset(system)
-        errors = gaussian_attack_errors(
-            LinearPlant(p.A, p.B, sigma_w2=p.sigma_w2), sample_sizes=grid, runs=runs, sigma_u2=p.sigma_u2, seed=seed
-        )
+    for system in systems:
+        A, B, su, sw, sx = _sic_check_system(system)
+        n, m = B.shape
+        errors = gaussian_attack_errors(LinearPlant(A, B, sigma_w2=sw, sigma_x2=sx), sample_sizes=grid, runs=runs,
+                                        sigma_u2=su, seed=seed)  # fmt: skip
         fit = fit_empirical_complexity(grid, errors)
-        S = stationary_regressor_covariance(p.A, p.B, sigma_u2=p.sigma_u2, sigma_w2=p.sigma_w2)
-        exact = p.sigma_w2 * np.trace(np.linalg.inv(S)) / (p.n + p.m) / grid
-        tr_u, tr_w = np.trace(controllability_gramian(p.A, p.B)), np.trace(noise_gramian(p.A))
-        sic = np.asarray(sic_from_traces(grid, tr_u, tr_w, p.m, p.n, p.sigma_u2, p.sigma_w2, p.sigma_x2))
-        for g, N in enumerate(grid):
-            lines.append(
-                f"| {system} | {N} | {fit.low[g] / exact[g]:.3f} | {fit.mean[g] / exact[g]:.3f} | "
-                f"{fit.high[g] / exact[g]:.3f} | {sic[g] / exact[g]:.3f} |"
-            )
+        S = stationary_regressor_covariance(A, B, sigma_u2=su, sigma_w2=sw)
+        exact = sw * np.trace(np.linalg.inv(S)) / (n + m) / grid
+        tr_u, tr_w = np.trace(controllability_gramian(A, B)), np.trace(noise_gramian(A))
+        sic = np.asarray(sic_from_traces(grid, tr_u, tr_w, m, n, su, sw, sx))
+
+        def span(v: np.ndarray) -> str:
+            return f"{v.min():.3f} to {v.max():.3f}"
+
+        below = int(np.sum(sic < fit.low))
+        lines.append(
+            f"| {system} | {n}, {m} | {su / sw:g} | {sic_tightness(A, B, sigma_u2=su, sigma_w2=sw):.3f} | {span(sic / exact)} | "
+            f"{span(sic / fit.mean)} | {span(fit.mean / exact)} | {below} of {len(grid)} |"
+        )
     return "\n".join(lines) + "\n"
 
 

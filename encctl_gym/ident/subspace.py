@@ -44,6 +44,7 @@ __all__ = [
     "arx",
     "arx_realisation",
     "block_hankel",
+    "default_block_rows",
     "markov_error",
     "markov_parameters",
     "moesp",
@@ -159,18 +160,36 @@ def _lq_of_windows(u: np.ndarray, y: np.ndarray, i: int) -> tuple[np.ndarray, in
 def _lower_factor(M: np.ndarray) -> np.ndarray:
     """``L`` (lower triangular, positive diagonal) with ``M M^T = L L^T``: the ``L`` of the LQ
     factorisation ``M = L Q^T`` (``Q`` is never needed). The Cholesky factor of the small Gram
-    matrix is the same ``L`` at a fraction of the cost; where the Gram matrix is singular or too
-    ill-conditioned for it (an input that does not excite every direction), the Householder
-    triangle of ``M^T`` is taken instead, with its signs made positive."""
+    matrix is the same ``L`` at a fraction of the cost; for a run whose Gram matrix is singular
+    or too ill-conditioned for it (an input that does not excite every direction), the
+    Householder triangle of ``M^T`` is taken instead, with its signs made positive. The choice is
+    made run by run, so a run's factor does not depend on the other runs of the batch."""
+    if M.shape[2] < M.shape[1]:  # fewer columns than rows: every Gram matrix is singular
+        return _householder_lower(M)
     gram = M @ M.transpose(0, 2, 1)
     scale = np.linalg.norm(gram, ord=2, axis=(1, 2))
+    L = np.zeros_like(gram)
+    ok = np.zeros(len(gram), dtype=bool)
     try:
         L = np.linalg.cholesky(gram)
-        diag = np.diagonal(L, axis1=1, axis2=2)
-        if np.all(diag**2 > 1e-10 * scale[:, None]):  # squared condition number below ~1e10
-            return L
-    except np.linalg.LinAlgError:
-        pass
+        ok[:] = True
+    except np.linalg.LinAlgError:  # some run's Gram matrix is not positive definite: find which
+        for r in range(len(gram)):
+            try:
+                L[r] = np.linalg.cholesky(gram[r])
+                ok[r] = True
+            except np.linalg.LinAlgError:
+                pass
+    diag = np.diagonal(L, axis1=1, axis2=2)
+    ok &= np.all(diag**2 > 1e-10 * scale[:, None], axis=1)  # squared condition number below ~1e10
+    if not ok.all():
+        L[~ok] = _householder_lower(M[~ok])
+    return L
+
+
+def _householder_lower(M: np.ndarray) -> np.ndarray:
+    """The lower factor of ``M = L Q^T`` from the Householder triangle of ``M^T``, signs made positive
+    (shape ``(R, rows, min(rows, cols))``)."""
     r: np.ndarray = np.linalg.qr(M.transpose(0, 2, 1), mode="r")  # type: ignore[assignment]  # mode="r": R only
     sign = np.where(np.diagonal(r, axis1=1, axis2=2) < 0, -1.0, 1.0)
     return (r * sign[:, :, None]).transpose(0, 2, 1)
@@ -192,13 +211,19 @@ def select_order(singular_values: np.ndarray, max_order: int | None = None) -> i
     return int(np.argmax(gaps)) + 1
 
 
+def default_block_rows(order: int | None, p: int) -> int:
+    """``i`` when none is given: ``2 order`` (at least 2), or ``ceil(10 / p)`` (at least 3) when the
+    order is to be chosen."""
+    return max(2, 2 * order) if order else max(3, -(-10 // p))
+
+
 def _check_design(u: np.ndarray, y: np.ndarray, order: int | None, block_rows: int | None) -> tuple[int, int | None]:
     R, N, m = u.shape
     p = y.shape[2]
     if order is not None:
         order = check_int("order", order, minimum=1)
     if block_rows is None:
-        block_rows = max(2, 2 * order) if order else max(3, -(-10 // p))
+        block_rows = default_block_rows(order, p)
     i = check_int("block_rows", block_rows, minimum=1)
     if order is not None and order > p * i:
         raise ParameterError(f"order = {order} exceeds p * block_rows = {p * i}: give block_rows >= {-(-order // p)}")

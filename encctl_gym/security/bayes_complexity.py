@@ -92,6 +92,7 @@ __all__ = [
     "bayesian_sample_identifying_complexity",
     "prior_sample_equivalent",
     "stationary_regressor_covariance",
+    "sic_tightness",
     "bayes_risk_iid_gaussian",
 ]
 
@@ -324,6 +325,29 @@ def stationary_regressor_covariance(A: Any, B: Any, *, sigma_u2: float, sigma_w2
     S[:n, :n] = su * controllability_gramian(A, B) + sw * noise_gramian(A)
     S[n:, n:] = su * np.eye(m)
     return S
+
+
+def sic_tightness(A: Any, B: Any, *, sigma_u2: float, sigma_w2: float) -> float:
+    """How far below the least-squares error eq:sic lies at large ``N``: their ratio,
+    ``(n + m)^2 / (tr Sigma tr Sigma^-1)``, with ``Sigma`` of :func:`stationary_regressor_covariance`.
+
+    The mean least-squares error of Definition def:error tends to ``sigma_w2 tr(Sigma^-1) /
+    ((n + m) N)`` (the first identity of the proof of Theorem thm:sic with ``G ~ N Sigma``);
+    eq:sic tends to ``(n + m) sigma_w2 / (N tr Sigma)``, its denominator being ``(N - 1) tr Sigma``.
+    The proof's step ``tr X^-1 >= d^2 / tr X`` is what separates them, so the ratio is the
+    harmonic over the arithmetic mean of the eigenvalues of ``Sigma``: 1 only for isotropic
+    regressors, and as small as the regressors are unevenly excited (a state the inputs barely
+    reach, with noise variance far below ``sigma_u2``).
+
+    Returns
+    -------
+    float
+        In ``(0, 1]``.
+    """
+    # positive definite: the state block is at least sigma_w2 Psi_w >= sigma_w2 I, the input block sigma_u2 I
+    lam = np.linalg.eigvalsh(stationary_regressor_covariance(A, B, sigma_u2=sigma_u2, sigma_w2=sigma_w2))
+    d = len(lam)
+    return float(min(1.0, d * d / (np.sum(lam) * np.sum(1.0 / lam))))
 
 
 def _wishart(rng: np.random.Generator, L: np.ndarray, T: int, draws: int) -> np.ndarray:

@@ -47,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import check_int, format_value, parse_number
+from .._validation import check_int, check_positive, format_value, parse_number
 from ..errors import ConfigError, ParameterError
 from ..plant_file import fields_help, load_plant_file, load_system
 from ..presets import DESIGN_FIELDS, design_defaults, get_preset, preset_names
@@ -146,6 +146,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--runs", metavar="R", help="with --estimator: simulated attacks per N (default 20)")
     parser.add_argument("--points", metavar="P", help="with --estimator: attack lengths on the log grid (default 6)")
     parser.add_argument("--seed", metavar="S", help="with --estimator: seed of the simulated attacks (default 0)")
+    parser.add_argument(
+        "--memory-limit",
+        dest="memory_limit",
+        metavar="GIB",
+        help="with --estimator: GiB the simulated attacks may hold, checked before they run (default 8, or less under ulimit -v)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
 
 
@@ -268,6 +274,8 @@ def _format_table(res: dict[str, Any], title: str, sources: str | None = None) -
         f"Upsilon = {p['upsilon']:.4g} FLOPS",
         f"  upper bounds at N = {b['N']}: eq:bound (m+n)/((N-1) m R) = {b['input_upper_bound']:.4e}, "
         f"(m+n)/((N-1) n) = {b['noise_upper_bound']:.4e}",
+        f"  eq:sic / mean least-squares error at large N = {b['sic_tightness']:.3f} (HM/AM of the eigenvalues of the regressor "
+        f"covariance): least squares reaches gamma_c near {1 / b['sic_tightness']:.3g}x the paper's N*",
         "",
         f"  {'complexity':<34}{'N*':>10}{'lam*':>6}{'k*':>7}{'log2 Omega(k*)':>16}{'gamma(N*)':>13}{'gamma/paper':>13}",
     ]
@@ -410,10 +418,10 @@ def run(args: argparse.Namespace, defenses: Callable[..., DefenseDesign] | None 
 
 def _output_design(args: argparse.Namespace, A: Any, B: Any, C: Any, sigma_v2: float, threat: ThreatModel) -> Any:
     """The empirical design of ``--estimator`` (None without it); its options only apply with it."""
-    given = [opt for opt in ("runs", "points", "seed") if getattr(args, opt) is not None]
+    given = [opt for opt in ("runs", "points", "seed", "memory_limit") if getattr(args, opt) is not None]
     if args.estimator is None:
         if given:
-            raise ConfigError(f"{', '.join('--' + g for g in given)} only applies with --estimator")
+            raise ConfigError(f"{', '.join('--' + g.replace('_', '-') for g in given)} only applies with --estimator")
         return None
     from ..plant import Plant
     from .output_design import output_design
@@ -422,9 +430,19 @@ def _output_design(args: argparse.Namespace, A: Any, B: Any, C: Any, sigma_v2: f
         raw = getattr(args, name)
         return default if raw is None else check_int(name, parse_number(name, raw), minimum)
 
+    limit = None
+    if args.memory_limit is not None:
+        gib = check_positive("memory_limit", parse_number("memory_limit", args.memory_limit))
+        limit = max(1, int(gib * 2**30)) if gib < 2**40 else 2**70  # beyond any machine: no limit in effect
     plant = Plant(A, B, C=np.eye(A.shape[0]) if C is None else C, sigma_v2=sigma_v2)
     return output_design(
-        plant, threat, estimator=args.estimator, runs=opt("runs", 20, 2), points=opt("points", 6, 3), seed=opt("seed", 0, 0)
+        plant,
+        threat,
+        estimator=args.estimator,
+        runs=opt("runs", 20, 2),
+        points=opt("points", 6, 3),
+        seed=opt("seed", 0, 0),
+        memory_limit=limit,
     )
 
 

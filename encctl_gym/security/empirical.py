@@ -13,6 +13,12 @@ not fall below, so a Monte Carlo estimate of ``E[error](N)`` with its uncertaint
    by eq:opt_key under a deciphering-cost model, each with the interval the bootstrap carries to
    it. ``N*`` beyond the largest simulated ``N`` is an extrapolation of the fitted rate and is
    flagged as one.
+3. Where the accuracy target is itself a Monte Carlo estimate (the output design moves
+   ``gamma_c`` into another error measure by evaluating a second fit at the paper's ``N*``,
+   :mod:`encctl_gym.security.output_design`), :func:`empirical_design` takes that fit as
+   ``reference=(fit, N)``: every bootstrap replicate designs against its own replicate of the
+   target. The two fits resample the same runs (same run count, replicates and seed), so the
+   correlation of the two errors, measured on the same trajectories, is kept too.
 
 Only sample sizes where the mean error exists should be fitted: at ``N <= n + m + 2`` the
 least-squares error has no mean (the smallest eigenvalue of the Gram matrix has a density that
@@ -34,7 +40,7 @@ from .design import optimal_security_parameter
 from .key_length import design_key_length
 from .threat import ThreatModel
 
-__all__ = ["EmpiricalComplexity", "EmpiricalDesign", "empirical_design", "fit_empirical_complexity"]
+__all__ = ["EmpiricalComplexity", "EmpiricalDesign", "empirical_design", "fit_empirical_complexity", "paired"]
 
 
 @dataclass(frozen=True)
@@ -57,6 +63,9 @@ class EmpiricalComplexity:
         Number of runs behind every mean.
     boot_a, boot_c : ndarray (B,)
         The bootstrap replicates (for carrying the uncertainty to ``N*`` and ``k*``).
+    seed : int
+        Seed of the resampling: two fits of ``R`` runs with the same seed and ``B`` resampled
+        the same runs in every replicate (:func:`paired`).
     """
 
     N: np.ndarray
@@ -71,6 +80,7 @@ class EmpiricalComplexity:
     runs: int
     boot_a: np.ndarray
     boot_c: np.ndarray
+    seed: int = 0
 
     def __call__(self, N: Any) -> Any:
         """The fitted mean error ``c / N^a``."""
@@ -102,7 +112,7 @@ def fit_empirical_complexity(
     bootstrap : int
         Number of bootstrap resamples of the runs (>= 100).
     seed : int
-        Seed of the resampling.
+        Seed of the resampling (fits of the same runs with the same seed are :func:`paired`).
 
     Returns
     -------
@@ -128,6 +138,7 @@ def fit_empirical_complexity(
     if not level < 1:
         raise ParameterError(f"level must lie in (0, 1), got {level}")
     B = check_int("bootstrap", bootstrap, minimum=100, maximum=10**6)
+    seed = check_int("seed", seed, minimum=0)
     mean = errors.mean(axis=0)
     a, c = _fit_log(N, mean)
     rng = np.random.default_rng(seed)
@@ -151,7 +162,14 @@ def fit_empirical_complexity(
         runs=R,
         boot_a=fits[:, 0],
         boot_c=fits[:, 1],
+        seed=seed,
     )
+
+
+def paired(first: EmpiricalComplexity, second: EmpiricalComplexity) -> bool:
+    """Whether the two fits' bootstrap replicates resampled the same runs (replicate ``b`` of one
+    belongs with replicate ``b`` of the other): same number of runs, of replicates, and seed."""
+    return first.runs == second.runs and len(first.boot_a) == len(second.boot_a) and first.seed == second.seed
 
 
 @dataclass(frozen=True)
@@ -159,7 +177,9 @@ class EmpiricalDesign:
     """``N*``, ``lambda*`` and ``k*`` from an empirical complexity, each with its interval.
 
     ``extrapolated`` says that ``N*`` (or the top of its interval) lies beyond the largest
-    simulated sample size: there the fitted rate, not a measurement, decides it.
+    simulated sample size: there the fitted rate, not a measurement, decides it. ``target`` and
+    ``target_interval`` are the accuracy target and its bootstrap interval when it came from a
+    reference fit (module docstring, step 3), else ``None``.
     """
 
     N_star: int
@@ -170,6 +190,8 @@ class EmpiricalDesign:
     k_star_interval: tuple[int, int]
     model: str
     extrapolated: bool
+    target: float | None = None
+    target_interval: tuple[float, float] | None = None
 
 
 def _n_star(a: float, c: float, gamma_c: float) -> int:
@@ -185,7 +207,12 @@ def _n_star(a: float, c: float, gamma_c: float) -> int:
 
 
 def empirical_design(
-    fit: EmpiricalComplexity, threat: ThreatModel, *, gamma_c: float | None = None, level: float | None = None
+    fit: EmpiricalComplexity,
+    threat: ThreatModel,
+    *,
+    gamma_c: float | None = None,
+    level: float | None = None,
+    reference: tuple[EmpiricalComplexity, int] | None = None,
 ) -> EmpiricalDesign:
     """The design of Theorem thm:opt_sec and eq:opt_key from an empirical complexity (step 2).
 
@@ -207,19 +234,47 @@ def empirical_design(
         own threshold).
     level : float, optional
         Confidence level of the intervals.
+    reference : (EmpiricalComplexity, int), optional
+        The target as a Monte Carlo estimate (step 3): ``gamma_c = ref(N_ref)``, and replicate
+        ``b`` of ``fit`` designs against replicate ``b`` of ``ref`` at ``N_ref``, so the interval
+        of ``N*`` carries the target's spread. Exclusive with ``gamma_c``; the two fits must be
+        :func:`paired`.
 
     Returns
     -------
     EmpiricalDesign
+
+    Raises
+    ------
+    ParameterError
+        A non-positive fitted exponent (for most replicates too), ``reference`` with ``gamma_c``,
+        or a reference fit not paired with ``fit``.
     """
-    gamma_c = check_positive("gamma_c", threat.require("gamma_c").gamma_c if gamma_c is None else gamma_c)
     tau_c, upsilon = threat.tau_c, threat.upsilon
     level = fit.level if level is None else check_positive("level", level)
+    q = [(1 - level) / 2, (1 + level) / 2]
+    if reference is None:
+        gamma_c = check_positive("gamma_c", threat.require("gamma_c").gamma_c if gamma_c is None else gamma_c)
+        targets = np.full(len(fit.boot_a), gamma_c)
+        target_interval = None
+    else:
+        ref, at = reference
+        at = check_int("reference sample size", at, minimum=1)
+        if gamma_c is not None:
+            raise ParameterError("give either gamma_c or reference (the target as a fit), not both")
+        if not paired(fit, ref):
+            raise ParameterError(
+                f"the reference fit is not paired with the fit (runs {ref.runs} / {fit.runs}, replicates "
+                f"{len(ref.boot_a)} / {len(fit.boot_a)}, seed {ref.seed} / {fit.seed}): fit the same runs with one seed"
+            )
+        gamma_c = float(ref(at))
+        targets = ref.boot_c / float(at) ** ref.boot_a
+        lo_t, hi_t = np.quantile(targets, q)
+        target_interval = (float(lo_t), float(hi_t))
     N_star = _n_star(fit.a, fit.c, gamma_c)
-    boot = np.array([_n_star(a, c, gamma_c) for a, c in zip(fit.boot_a, fit.boot_c) if a > 0])
+    boot = np.array([_n_star(a, c, g) for a, c, g in zip(fit.boot_a, fit.boot_c, targets) if a > 0])
     if len(boot) < 0.5 * len(fit.boot_a):
         raise ParameterError("most bootstrap fits have a non-positive exponent: the data do not show a decreasing error")
-    q = [(1 - level) / 2, (1 + level) / 2]
     n_lo, n_hi = (int(v) for v in np.quantile(boot, q, method="nearest"))
     lam = optimal_security_parameter(N_star, tau_c=tau_c, upsilon=upsilon)
     lam_ends = sorted(optimal_security_parameter(v, tau_c=tau_c, upsilon=upsilon) for v in (n_lo, n_hi))
@@ -234,4 +289,6 @@ def empirical_design(
         k_star_interval=(k_ends[0], k_ends[1]),
         model=str(getattr(threat.cost_model, "name", threat.cost_model)),
         extrapolated=bool(max(N_star, n_hi) > fit.N[-1]),
+        target=None if reference is None else gamma_c,
+        target_interval=target_interval,
     )

@@ -16,7 +16,10 @@ Gaussian attacks (:func:`~encctl_gym.sim.output.output_attack_errors`):
    have; the target is the accuracy the paper's design protects, in an error both attackers share;
 3. **the output-measured design**: the chosen estimator (N4SID, PO-MOESP or ARX) on ``y = C x + v``,
    fitted and designed against that target, ``N*``, ``lambda*`` and ``k*`` with the intervals the
-   bootstrap carries to them.
+   bootstrap carries to them. The target is a Monte Carlo estimate too: each bootstrap replicate
+   of the output fit designs against the same replicate of the target (the two fits resample the
+   same runs), so the intervals carry its spread (``reference=`` of
+   :func:`~encctl_gym.security.empirical.empirical_design`).
 
 ``encctl-gym design plant.yaml --estimator n4sid`` prints :func:`format_output_design`.
 """
@@ -51,7 +54,8 @@ class OutputDesign:
     state_fit, state_design : EmpiricalComplexity, EmpiricalDesign
         Least squares on the states, Definition def:error, against ``gamma_c``.
     target : float
-        The Markov-parameter error of state least squares at the paper's ``N*`` (fitted).
+        The Markov-parameter error of state least squares at the paper's ``N*`` (fitted); its
+        bootstrap interval is ``output_design.target_interval``.
     output_fit : EmpiricalComplexity
         The estimator on the outputs, Markov-parameter error.
     output_design : EmpiricalDesign or None
@@ -95,6 +99,7 @@ class OutputDesign:
             "paper": {"N_star": self.paper.N_star, "lambda_star": self.paper.lam_star, "k_star": self.paper.k_star},
             "state_least_squares": {"fit": fit(self.state_fit), "design": des(self.state_design)},
             "markov_target": self.target,
+            "markov_target_interval": None if self.output_design is None else list(self.output_design.target_interval or ()),
             "output": {"fit": fit(self.output_fit), "design": des(self.output_design), "note": self.note},
         }
 
@@ -120,6 +125,7 @@ def output_design(
     sample_sizes: Any = None,
     seed: int = 0,
     bootstrap: int = 1000,
+    memory_limit: int | None = None,
 ) -> OutputDesign:
     """The empirical design of a plant measured through outputs (module docstring).
 
@@ -141,14 +147,21 @@ def output_design(
         Seed of the attacks (the same trajectories for the state and the output fits).
     bootstrap : int
         Bootstrap resamples of the fits.
+    memory_limit : int, optional
+        Bytes the simulated attacks may hold (:func:`~encctl_gym.sim.output.output_attack_errors`:
+        the estimators stream over chunks of runs; the trajectories are held whole).
 
     Raises
     ------
     ParameterError
         An unknown estimator, fewer than two runs, a grid the estimator's order does not fit in
         (too few samples for its windows), or the state fit's exponent not positive.
+    ResourceLimitError
+        When the attacks at the grid's largest ``N`` need more than ``memory_limit``, before any
+        simulation.
     """
-    from ..sim.output import OUTPUT_ESTIMATORS, output_attack_errors
+    from ..resources import check_memory
+    from ..sim.output import OUTPUT_ESTIMATORS, output_attack_bytes, output_attack_errors
     from ..sim.plant import LinearPlant
 
     if estimator not in OUTPUT_ESTIMATORS:
@@ -159,8 +172,12 @@ def output_design(
     paper = design_security_parameter(p, t)
     grid = output_design_grid(paper.N_star, points) if sample_sizes is None else np.asarray(sample_sizes)
     sim_plant = LinearPlant(p.A, p.B, sigma_w2=t.sigma_w2, sigma_x2=t.sigma_x2)
-    common = {"sample_sizes": grid, "runs": runs, "sigma_u2": t.sigma_u2, "seed": seed}
-    # the outputs first: a grid too short for the estimator's windows fails before any other work
+    common = {"sample_sizes": grid, "runs": runs, "sigma_u2": t.sigma_u2, "seed": seed, "memory_limit": memory_limit}
+    # both simulations' memory, then the outputs: a limit too small, or a grid too short for the
+    # estimator's windows, fails before any other work
+    need, _ = output_attack_bytes(runs, int(grid[-1]), p.n, p.m, p.n, "arx", p.n)
+    check_memory(f"the state-measured reference ({runs} attacks of N = {int(grid[-1])} samples)", need, memory_limit,
+                 "use fewer runs, a larger gamma_c (shorter attacks) or a larger memory limit")  # fmt: skip
     out = output_attack_errors(sim_plant, p.output_matrix(), sigma_v2=p.sigma_v2, estimator=estimator, **common)
     ref = output_attack_errors(sim_plant, np.eye(p.n), sigma_v2=0.0, estimator="arx", **common)
     state_fit = fit_empirical_complexity(grid, ref["state_ls"], bootstrap=bootstrap, seed=seed)
@@ -169,7 +186,7 @@ def output_design(
     target = float(markov_fit(paper.N_star))
     output_fit = fit_empirical_complexity(grid, out["markov"], bootstrap=bootstrap, seed=seed)
     try:
-        design: EmpiricalDesign | None = empirical_design(output_fit, t, gamma_c=target)
+        design: EmpiricalDesign | None = empirical_design(output_fit, t, reference=(markov_fit, paper.N_star))
         note = ""
     except ParameterError as exc:  # a rate that does not decrease: reported, not designed
         design, note = None, str(exc)
@@ -205,7 +222,12 @@ def format_output_design(d: OutputDesign) -> str:
 
     lines.append(row("state, least squares, def:error", d.state_fit, sd))
     lines.append(row(f"output, {d.estimator}, Markov error", d.output_fit, od, d.note))
-    lines.append(f"  target in the Markov error: {d.target:.4g} (state least squares at the paper's N* = {d.paper.N_star})")
+    spread = ""
+    if od is not None and od.target_interval is not None:
+        spread = f" [{od.target_interval[0]:.4g}, {od.target_interval[1]:.4g}], carried into the output row's intervals"
+    lines.append(
+        f"  target in the Markov error: {d.target:.4g}{spread} (state least squares at the paper's N* = {d.paper.N_star})"
+    )
     if od is not None:
         lines.append(
             f"  measuring outputs costs the attacker {od.N_star / d.paper.N_star:.2f}x the paper's N* and saves the defender "

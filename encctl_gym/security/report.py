@@ -19,6 +19,7 @@ from .._validation import check_int, check_system, format_value
 from ..errors import ParameterError, ResourceLimitError
 from ..plant import Plant, as_plant
 from .attack_design import gaussian_attack_design, optimal_attack_design, robust_security_design
+from .bayes_complexity import sic_tightness
 from .complexity import input_upper_bound, noise_upper_bound, sic_asymptotic_from_traces, sic_from_traces
 from .cost_models import GUILLEVIC_CORRECTION, check_gnfs_correction, gnfs_log2_complexity
 from .design import SecurityDesign, design_from_traces
@@ -174,6 +175,7 @@ def design_report(
             "N": N_ref,
             "input_upper_bound": float(input_upper_bound(N_ref, m, n, su / sw)),
             "noise_upper_bound": float(noise_upper_bound(N_ref, m, n)),
+            "sic_tightness": sic_tightness(A, B, sigma_u2=su, sigma_w2=sw),
         },
         "designs": out_designs,
         "skipped": skipped,

@@ -6,6 +6,11 @@ the same seed gives the same states as the state-measured experiments); the outp
 measurement noise ``v ~ N(0, sigma_v2 I)`` from a stream of its own. The attacker sees only its
 inputs and ``y``. With ``C = I`` and ``sigma_v2 = 0`` the least-squares error of Definition
 def:error on the same trajectories is returned beside, so both errors can be compared.
+
+Memory: the trajectories are held whole, and the estimators run over chunks of runs whose
+working set stays near :data:`STREAM_BYTES` (:func:`estimator_bytes`: the subspace methods'
+block Hankel rows, ARX's regressors). The sum is checked against the memory limit before any
+simulation (:func:`output_attack_bytes`); a run too long for it is refused with the estimate.
 """
 
 from __future__ import annotations
@@ -18,17 +23,65 @@ from .._validation import check_int, check_nonnegative
 from ..errors import ParameterError
 from ..ident.grid import identification_errors
 from ..ident.least_squares import prefix_estimates
-from ..ident.subspace import arx, markov_error, moesp, n4sid
+from ..ident.subspace import arx, default_block_rows, markov_error, moesp, n4sid
 from ..plant import check_output_matrix, observable_order
+from ..resources import check_memory
 from .plant import LinearPlant, simulate, simulate_gaussian_attack
 
-__all__ = ["OUTPUT_ATTACKS", "OUTPUT_ESTIMATORS", "attack_inputs", "check_output_matrix", "output_attack_errors"]
+__all__ = [
+    "OUTPUT_ATTACKS",
+    "OUTPUT_ESTIMATORS",
+    "STREAM_BYTES",
+    "attack_inputs",
+    "check_output_matrix",
+    "estimator_bytes",
+    "output_attack_bytes",
+    "output_attack_errors",
+]
+
+#: The working set (bytes) one chunk of runs may give an estimator; the chunk holds at least one run.
+STREAM_BYTES = 256 * 2**20
+
+
+def _arx_lags(order: int, p: int) -> int:
+    """ARX's ``na = nb``: ``ceil(order / p) + 1`` lags, enough for a plant of that order."""
+    return -(-order // p) + 1
 
 
 def _arx(u: np.ndarray, y: np.ndarray, order: int) -> Any:
     """ARX with ``na = nb = ceil(order / p) + 1`` lags: enough for a plant of that order."""
-    lags = -(-order // y.shape[-1]) + 1
+    lags = _arx_lags(order, y.shape[-1])
     return arx(u, y, na=lags, nb=lags)
+
+
+def estimator_bytes(estimator: str, N: int, m: int, p: int, order: int) -> int:
+    """Bytes one run of ``N`` samples needs inside an estimator of :data:`OUTPUT_ESTIMATORS`.
+
+    The subspace methods hold the ``2 (m + p) i`` rows of ``[U_f; W_p; Y_f]`` twice while they
+    factor it (``i`` of :func:`~encctl_gym.ident.subspace.default_block_rows`): measured with
+    ``tracemalloc`` at 4.0 to 4.1 words per sample and unit of ``(m + p) i``, estimated at 5.
+    ARX holds its ``k = lags (m + p)`` regressor columns and the least-squares workspace: 3.0
+    words per sample and column, estimated at 4. The tests hold the estimate above the measured
+    peak and below twice it.
+    """
+    if estimator == "arx":
+        words = 4 * _arx_lags(order, p) * (m + p)
+    else:
+        words = 5 * (m + p) * default_block_rows(order, p)
+    return 8 * int(N) * words
+
+
+def _trajectory_bytes(runs: int, N: int, n: int, m: int, p: int) -> int:
+    """States, process noise, inputs and outputs of ``runs`` attacks of ``N`` samples."""
+    return 8 * runs * N * (2 * n + m + p)
+
+
+def output_attack_bytes(runs: int, N: int, n: int, m: int, p: int, estimator: str, order: int) -> tuple[int, int]:
+    """``(total bytes, runs per chunk)`` of :func:`output_attack_errors` at its largest ``N``: the
+    trajectories whole, plus one chunk of runs in the estimator (:data:`STREAM_BYTES`, at least one run)."""
+    per_run = estimator_bytes(estimator, N, m, p, order)
+    chunk = max(1, min(runs, STREAM_BYTES // per_run))
+    return _trajectory_bytes(runs, N, n, m, p) + chunk * per_run, chunk
 
 
 #: The output-side estimators by name: a batch function ``(u, y, order) -> SubspaceEstimate``.
@@ -78,6 +131,40 @@ def attack_inputs(
     raise ParameterError(f"unknown attack {attack!r}; choose one of {', '.join(OUTPUT_ATTACKS)}")
 
 
+def _measured_attacks(
+    plant: LinearPlant, C: np.ndarray, sigma_v2: float, attack: str, *, N: int, runs: int, sigma_u2: float, seed: Any, design: Any
+) -> tuple[Any, np.ndarray]:
+    """The trajectories of ``runs`` attacks (the engine's, for ``"gaussian"``) and their outputs
+    ``y = C x + v``, the measurement noise from a child stream of its own."""
+    ss = np.random.SeedSequence(seed) if not isinstance(seed, np.random.SeedSequence) else seed
+    traj_seed, noise_seed = ss.spawn(2)
+    if attack == "gaussian":
+        sim = simulate_gaussian_attack(plant, N=N, runs=runs, sigma_u2=sigma_u2, seed=traj_seed)
+    else:
+        input_seed, plant_seed = traj_seed.spawn(2)
+        u = attack_inputs(plant, attack, N=N, runs=runs, sigma_u2=sigma_u2, seed=input_seed, design=design)
+        sim = simulate(plant, u, plant_seed)
+    rng = np.random.default_rng(noise_seed)
+    return sim, sim.states @ C.T + np.sqrt(sigma_v2) * rng.normal(size=(runs, sim.N, C.shape[0]))
+
+
+def _streamed_markov_errors(
+    estimator: str, u: np.ndarray, y: np.ndarray, grid: np.ndarray, order: int, true: tuple[Any, ...], markov_length: int
+) -> np.ndarray:
+    """The Markov error ``(runs, G)`` of ``estimator`` on each prefix of the grid, over chunks of
+    runs of about :data:`STREAM_BYTES` each (every run is estimated on its own, so the chunking
+    does not change a number)."""
+    runs, m, p = u.shape[0], u.shape[2], y.shape[2]
+    fit = OUTPUT_ESTIMATORS[estimator]
+    markov = np.empty((runs, len(grid)))
+    for g, N in enumerate(grid):
+        per_chunk = max(1, STREAM_BYTES // estimator_bytes(estimator, int(N), m, p, order))
+        for r0 in range(0, runs, per_chunk):
+            r1 = min(runs, r0 + per_chunk)
+            markov[r0:r1, g] = markov_error(true, fit(u[r0:r1, :N], y[r0:r1, :N], order), markov_length)
+    return markov
+
+
 def output_attack_errors(
     plant: LinearPlant,
     C: Any,
@@ -92,6 +179,7 @@ def output_attack_errors(
     markov_length: int = 20,
     attack: str = "gaussian",
     design: Any = None,
+    memory_limit: int | None = None,
 ) -> dict[str, np.ndarray]:
     """Errors of ``runs`` attacks identified from outputs, on a grid of sample sizes.
 
@@ -121,6 +209,9 @@ def output_attack_errors(
         trajectories are :func:`~encctl_gym.sim.plant.simulate_gaussian_attack`'s).
     design : AttackDesign, optional
         The open-loop design ``"optimal-ol"`` plays (:func:`attack_inputs`).
+    memory_limit : int, optional
+        Bytes the call may hold (default :func:`~encctl_gym.resources.default_memory_limit`);
+        checked against :func:`output_attack_bytes` before any simulation.
 
     Returns
     -------
@@ -134,6 +225,8 @@ def output_attack_errors(
     ParameterError
         For an unknown estimator, an unobservable pair asked to fit more states than it shows, or
         too few samples for the method.
+    ResourceLimitError
+        When the trajectories and one run's estimate exceed ``memory_limit``.
     """
     if estimator not in OUTPUT_ESTIMATORS:
         raise ParameterError(f"unknown output estimator {estimator!r}; choose one of {', '.join(OUTPUT_ESTIMATORS)}")
@@ -150,23 +243,17 @@ def output_attack_errors(
         raise ParameterError(
             f"order = {order} exceeds the observable order {observable} of (A, C): the outputs show {observable} states"
         )
-    ss = np.random.SeedSequence(seed) if not isinstance(seed, np.random.SeedSequence) else seed
-    traj_seed, noise_seed = ss.spawn(2)
-    if attack == "gaussian":
-        sim = simulate_gaussian_attack(plant, N=int(grid[-1]), runs=runs, sigma_u2=sigma_u2, seed=traj_seed)
-    else:
-        input_seed, plant_seed = traj_seed.spawn(2)
-        u = attack_inputs(plant, attack, N=int(grid[-1]), runs=runs, sigma_u2=sigma_u2, seed=input_seed, design=design)
-        sim = simulate(plant, u, plant_seed)
-    rng = np.random.default_rng(noise_seed)
-    y = sim.states @ C.T + np.sqrt(sv) * rng.normal(size=(runs, sim.N, C.shape[0]))
+    p = C.shape[0]
+    need, chunk = output_attack_bytes(runs, int(grid[-1]), plant.n, plant.m, p, estimator, order)
+    check_memory(
+        f"{runs} attacks of N = {int(grid[-1])} samples identified by {estimator} ({chunk} run(s) per chunk)",
+        need,
+        memory_limit,
+        "use fewer runs, a larger gamma_c (shorter attacks) or a larger memory limit",
+    )
+    sim, y = _measured_attacks(plant, C, sv, attack, N=int(grid[-1]), runs=runs, sigma_u2=sigma_u2, seed=seed, design=design)
     true = (plant.A, plant.B, C, np.zeros((C.shape[0], plant.m)))
-    fit = OUTPUT_ESTIMATORS[estimator]
-    markov = np.empty((runs, len(grid)))
-    for g, N in enumerate(grid):
-        est = fit(sim.inputs[:, :N], y[:, :N], order)
-        markov[:, g] = markov_error(true, est, markov_length)
-    out = {"markov": markov}
+    out = {"markov": _streamed_markov_errors(estimator, sim.inputs, y, grid, order, true, markov_length)}
     if sv == 0.0 and C.shape == (plant.n, plant.n) and np.array_equal(C, np.eye(plant.n)):
         out["state_ls"] = identification_errors(sim.states, sim.inputs, plant.A, plant.B, grid)
         AB = prefix_estimates(sim.states, sim.inputs, grid)  # (runs, G, n, n + m)
