@@ -28,6 +28,10 @@ import math
 import numpy as np
 from numba import njit
 
+from .._jit import install_compile_notice
+
+install_compile_notice()  # one line on stderr before the first compile (encctl_gym._jit)
+
 __all__ = ["reduced_basis", "SievePlan", "sieve_candidates"]
 
 

@@ -40,8 +40,11 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from .._jit import install_compile_notice
 from ..ident._rls_kernels import _BLOCK, _rls, add_columns, add_gram, estimation_error
 from ..loop.quantize import OK, STATE_OVERFLOW, _collect, _forge
+
+install_compile_notice()  # one line on stderr before the first compile (encctl_gym._jit)
 
 __all__ = ["OK", "STATE_OVERFLOW", "PARALLEL_CHUNK", "dims", "add_columns", "add_gram", "estimation_error"]
 

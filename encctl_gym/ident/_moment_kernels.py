@@ -24,6 +24,10 @@ import math
 import numpy as np
 from numba import njit
 
+from .._jit import install_compile_notice
+
+install_compile_notice()  # one line on stderr before the first compile (encctl_gym._jit)
+
 _EPS = np.finfo(np.float64).eps
 
 

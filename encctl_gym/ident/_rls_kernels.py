@@ -18,6 +18,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .._jit import install_compile_notice
+
+install_compile_notice()  # one line on stderr before the first compile (encctl_gym._jit)
+
 __all__ = ["add_columns", "add_gram", "estimation_error"]
 
 #: copies whose running least squares are updated together over a run of periods

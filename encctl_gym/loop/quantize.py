@@ -25,6 +25,10 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from .._jit import install_compile_notice
+
+install_compile_notice()  # one line on stderr before the first compile (encctl_gym._jit)
+
 __all__ = ["Quantization", "OK", "STATE_OVERFLOW", "forge_inputs", "collect_states"]
 
 # status codes of the compiled stages
