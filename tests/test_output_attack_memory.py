@@ -61,6 +61,13 @@ def test_streaming_over_chunks_of_runs_gives_the_same_errors_and_a_smaller_peak(
     assert peak_streamed < 0.5 * peak_whole  # 12 runs at once against 2
 
 
+def test_an_unknown_estimator_has_no_memory_estimate():
+    from encctl_gym.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="unknown output estimator 'cva'"):
+        estimator_bytes("cva", 1000, 1, 1, 3)
+
+
 def test_attacks_beyond_the_memory_limit_are_refused_before_they_run(monkeypatch):
     calls = []
     monkeypatch.setattr(sim_output, "simulate_gaussian_attack", lambda *a, **k: calls.append(1))

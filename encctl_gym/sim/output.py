@@ -64,6 +64,8 @@ def estimator_bytes(estimator: str, N: int, m: int, p: int, order: int) -> int:
     words per sample and column, estimated at 4. The tests hold the estimate above the measured
     peak and below twice it.
     """
+    if estimator not in OUTPUT_ESTIMATORS:
+        raise ParameterError(f"unknown output estimator {estimator!r}; choose one of {', '.join(OUTPUT_ESTIMATORS)}")
     if estimator == "arx":
         words = 4 * _arx_lags(order, p) * (m + p)
     else:
