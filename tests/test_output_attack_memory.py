@@ -104,3 +104,12 @@ def test_a_runs_lq_factor_does_not_depend_on_the_other_runs_of_its_chunk():
     for r in range(3):
         np.testing.assert_array_equal(batch[r], _lower_factor(M[r : r + 1])[0])
     np.testing.assert_allclose(batch[1] @ batch[1].T, M[1] @ M[1].T, atol=1e-9)
+
+
+@pytest.mark.parametrize("grid", [[], [400, 200, 100], ["a", "b", "c"], [[100, 200]]])
+def test_a_bad_grid_is_refused_before_the_memory_check(grid):
+    from encctl_gym.errors import ParameterError
+
+    p = get_preset("small-output")
+    with pytest.raises(ParameterError, match="strictly increasing 1-D sequence"):
+        output_design(p.plant(), ThreatModel.of(p), estimator="n4sid", runs=3, sample_sizes=grid, bootstrap=100)

@@ -161,7 +161,7 @@ def output_design(
         simulation.
     """
     from ..resources import check_memory
-    from ..sim.output import OUTPUT_ESTIMATORS, output_attack_bytes, output_attack_errors
+    from ..sim.output import OUTPUT_ESTIMATORS, check_sample_grid, output_attack_bytes, output_attack_errors
     from ..sim.plant import LinearPlant
 
     if estimator not in OUTPUT_ESTIMATORS:
@@ -170,7 +170,7 @@ def output_design(
     runs = check_int("runs", runs, minimum=2)
     t = threat.require("sigma_u2", "sigma_w2", "gamma_c")
     paper = design_security_parameter(p, t)
-    grid = output_design_grid(paper.N_star, points) if sample_sizes is None else np.asarray(sample_sizes)
+    grid = output_design_grid(paper.N_star, points) if sample_sizes is None else check_sample_grid(sample_sizes)
     sim_plant = LinearPlant(p.A, p.B, sigma_w2=t.sigma_w2, sigma_x2=t.sigma_x2)
     common = {"sample_sizes": grid, "runs": runs, "sigma_u2": t.sigma_u2, "seed": seed, "memory_limit": memory_limit}
     # both simulations' memory, then the outputs: a limit too small, or a grid too short for the

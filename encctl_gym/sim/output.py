@@ -34,6 +34,7 @@ __all__ = [
     "STREAM_BYTES",
     "attack_inputs",
     "check_output_matrix",
+    "check_sample_grid",
     "estimator_bytes",
     "output_attack_bytes",
     "output_attack_errors",
@@ -150,6 +151,14 @@ def _measured_attacks(
     return sim, sim.states @ C.T + np.sqrt(sigma_v2) * rng.normal(size=(runs, sim.N, C.shape[0]))
 
 
+def check_sample_grid(sample_sizes: Any) -> np.ndarray:
+    """``sample_sizes`` as a strictly increasing 1-D integer array of sizes >= 2 (else ``ParameterError``)."""
+    grid = np.asarray(sample_sizes)
+    if grid.ndim != 1 or len(grid) < 1 or grid.dtype.kind not in "iuf" or np.any(np.diff(grid) <= 0):
+        raise ParameterError("sample_sizes must be a strictly increasing 1-D sequence of sample sizes")
+    return np.array([check_int("sample size", v, minimum=2) for v in grid.tolist()])
+
+
 def _streamed_markov_errors(
     estimator: str, u: np.ndarray, y: np.ndarray, grid: np.ndarray, order: int, true: tuple[Any, ...], markov_length: int
 ) -> np.ndarray:
@@ -234,10 +243,7 @@ def output_attack_errors(
         raise ParameterError(f"unknown output estimator {estimator!r}; choose one of {', '.join(OUTPUT_ESTIMATORS)}")
     C = check_output_matrix(C, plant.n)
     sv = check_nonnegative("sigma_v2", sigma_v2)
-    grid = np.asarray(sample_sizes)
-    if grid.ndim != 1 or len(grid) < 1 or np.any(np.diff(grid) <= 0):
-        raise ParameterError("sample_sizes must be a strictly increasing 1-D sequence")
-    grid = np.array([check_int("sample size", int(v), minimum=2) for v in grid])
+    grid = check_sample_grid(sample_sizes)
     runs = check_int("runs", runs, minimum=1)
     observable = observable_order(plant.A, C)
     order = observable if order is None else check_int("order", order, minimum=1)
