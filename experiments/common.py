@@ -24,6 +24,7 @@ from encctl_gym.plotting import save_figure
 from encctl_gym.sim.montecarlo import log_grid
 
 __all__ = [
+    "system_preset",
     "GridConfig",
     "FULL",
     "QUICK",
@@ -291,6 +292,15 @@ def plot_panel(ax: Any, s: dict[str, Any], title: str, *, bound: bool = False) -
         ax.loglog(N, s["bound"], ":", color="k", lw=1.6, label=r"$\bar\gamma(N)$ (eq:bound)")
     ax.set_title(title, fontsize=9)
     ax.grid(True, which="major", alpha=0.3)
+
+
+def system_preset(name: str) -> Any:
+    """The :class:`~encctl_gym.presets.SystemPreset` of a preset name, or of a plant file
+    (``.yaml``/``.yml``, a path relative to the working directory, like the pages the experiments write)."""
+    from encctl_gym.plant_file import load_plant_file
+    from encctl_gym.presets import get_preset
+
+    return load_plant_file(name).preset if name.endswith((".yaml", ".yml")) else get_preset(name)
 
 
 def preset_spec(name: str) -> Any:

@@ -21,13 +21,11 @@ import sys
 from pathlib import Path
 
 from encctl_gym.errors import EncctlError
-from encctl_gym.plant_file import load_plant_file
-from encctl_gym.presets import get_preset
 from encctl_gym.security.empirical import empirical_design
 from encctl_gym.security.output_design import output_design
 from encctl_gym.security.threat import ThreatModel
 
-from .common import ensure_out_dir, write_recorded_table
+from .common import ensure_out_dir, system_preset, write_recorded_table
 
 __all__ = ["CASES", "REFERENCE_RUNS", "coverage", "main"]
 
@@ -46,7 +44,7 @@ REFERENCE_SEED = 10**6
 
 def coverage(plant: str, estimator: str, runs: int, seeds: int) -> dict[str, float | int]:
     """The reference ``N*`` and the fraction of seeds whose interval covers it, carried and fixed."""
-    p = load_plant_file(plant).preset if plant.endswith((".yaml", ".yml")) else get_preset(plant)
+    p = system_preset(plant)
     threat = ThreatModel.of(p)
     ref = output_design(p.plant(), threat, estimator=estimator, runs=REFERENCE_RUNS, seed=REFERENCE_SEED, bootstrap=200)
     if ref.output_design is None:

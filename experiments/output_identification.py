@@ -46,6 +46,8 @@ from encctl_gym.security.threat import ThreatModel
 from encctl_gym.sim.output import OUTPUT_ATTACKS, OUTPUT_ESTIMATORS, output_attack_errors
 from encctl_gym.sim.plant import LinearPlant
 
+from .common import system_preset
+
 SYSTEMS = ("paper-example", "fig1-c")
 OUTPUTS = {"C = I": np.eye(4), "C = [I 0]": np.eye(4)[:2], "one output": np.ones((1, 4))}
 #: The estimators each attack is identified by: every one for the paper's Gaussian attack, the
@@ -239,17 +241,6 @@ SIC_CHECK_SYSTEMS: tuple[str, ...] = (
 )  # fmt: skip
 
 
-def _sic_check_system(name: str) -> tuple[np.ndarray, np.ndarray, float, float, float]:
-    """``(A, B, sigma_u2, sigma_w2, sigma_x2)`` of a preset or a plant file."""
-    if name.endswith((".yaml", ".yml")):
-        from encctl_gym.plant_file import load_plant_file
-
-        p = load_plant_file(name).preset  # relative to the clone, like the pages the experiments write
-    else:
-        p = get_preset(name)
-    return p.A, p.B, p.sigma_u2, p.sigma_w2, p.sigma_x2
-
-
 def sic_check(runs: int = 200, seed: int = 1, systems: tuple[str, ...] = SIC_CHECK_SYSTEMS) -> str:
     """eq:sic against the exact large-N mean error of least squares on the states (``C = I``, no
     measurement noise), ``sigma_w2 tr(Sigma^-1) / ((n + m) N)`` with the stationary regressor
@@ -273,7 +264,8 @@ def sic_check(runs: int = 200, seed: int = 1, systems: tuple[str, ...] = SIC_CHE
         "|---|---|---|---|---|---|---|---|",
     ]
     for system in systems:
-        A, B, su, sw, sx = _sic_check_system(system)
+        ps = system_preset(system)
+        A, B, su, sw, sx = ps.A, ps.B, ps.sigma_u2, ps.sigma_w2, ps.sigma_x2
         n, m = B.shape
         errors = gaussian_attack_errors(LinearPlant(A, B, sigma_w2=sw, sigma_x2=sx), sample_sizes=grid, runs=runs,
                                         sigma_u2=su, seed=seed)  # fmt: skip

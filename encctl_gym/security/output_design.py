@@ -161,11 +161,10 @@ def output_design(
         simulation.
     """
     from ..resources import check_memory
-    from ..sim.output import OUTPUT_ESTIMATORS, check_sample_grid, output_attack_bytes, output_attack_errors
+    from ..sim.output import check_output_estimator, check_sample_grid, output_attack_bytes, output_attack_errors
     from ..sim.plant import LinearPlant
 
-    if estimator not in OUTPUT_ESTIMATORS:
-        raise ParameterError(f"unknown output estimator {estimator!r}; choose one of {', '.join(OUTPUT_ESTIMATORS)}")
+    check_output_estimator(estimator)
     p = as_plant(plant)
     runs = check_int("runs", runs, minimum=2)
     t = threat.require("sigma_u2", "sigma_w2", "gamma_c")

@@ -33,6 +33,7 @@ __all__ = [
     "OUTPUT_ESTIMATORS",
     "STREAM_BYTES",
     "attack_inputs",
+    "check_output_estimator",
     "check_output_matrix",
     "check_sample_grid",
     "estimator_bytes",
@@ -65,13 +66,19 @@ def estimator_bytes(estimator: str, N: int, m: int, p: int, order: int) -> int:
     words per sample and column, estimated at 4. The tests hold the estimate above the measured
     peak and below twice it.
     """
-    if estimator not in OUTPUT_ESTIMATORS:
-        raise ParameterError(f"unknown output estimator {estimator!r}; choose one of {', '.join(OUTPUT_ESTIMATORS)}")
+    check_output_estimator(estimator)
     if estimator == "arx":
         words = 4 * _arx_lags(order, p) * (m + p)
     else:
         words = 5 * (m + p) * default_block_rows(order, p)
     return 8 * int(N) * words
+
+
+def check_output_estimator(estimator: Any) -> str:
+    """``estimator`` if it names one of :data:`OUTPUT_ESTIMATORS`, else ``ParameterError``."""
+    if estimator not in OUTPUT_ESTIMATORS:
+        raise ParameterError(f"unknown output estimator {estimator!r}; choose one of {', '.join(OUTPUT_ESTIMATORS)}")
+    return str(estimator)
 
 
 def _trajectory_bytes(runs: int, N: int, n: int, m: int, p: int) -> int:
@@ -239,8 +246,7 @@ def output_attack_errors(
     ResourceLimitError
         When the trajectories and one run's estimate exceed ``memory_limit``.
     """
-    if estimator not in OUTPUT_ESTIMATORS:
-        raise ParameterError(f"unknown output estimator {estimator!r}; choose one of {', '.join(OUTPUT_ESTIMATORS)}")
+    check_output_estimator(estimator)
     C = check_output_matrix(C, plant.n)
     sv = check_nonnegative("sigma_v2", sigma_v2)
     grid = check_sample_grid(sample_sizes)
