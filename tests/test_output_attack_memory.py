@@ -113,3 +113,9 @@ def test_a_bad_grid_is_refused_before_the_memory_check(grid):
     p = get_preset("small-output")
     with pytest.raises(ParameterError, match="strictly increasing 1-D sequence"):
         output_design(p.plant(), ThreatModel.of(p), estimator="n4sid", runs=3, sample_sizes=grid, bootstrap=100)
+
+
+def test_a_memory_limit_beyond_any_machine_is_accepted(tmp_path):
+    f = tmp_path / "plant.yaml"
+    f.write_text("A: [[0.6, 0.2], [-0.1, 0.5]]\nB: [[1.0, 0.0], [0.3, 0.8]]\nC: [1, 0]\nsigma_v2: 0.01\ngamma_c: 1e-3\n")
+    assert main(["design", str(f), "--estimator", "arx", "--runs", "3", "--points", "3", "--memory-limit", "1e300"]) == 0

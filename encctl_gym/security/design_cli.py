@@ -433,7 +433,8 @@ def _output_design(args: argparse.Namespace, A: Any, B: Any, C: Any, sigma_v2: f
     limit = None
     if args.memory_limit is not None:
         gib = check_positive("memory_limit", parse_number("memory_limit", args.memory_limit))
-        limit = max(1, int(gib * 2**30)) if gib < 2**40 else 2**70  # beyond any machine: no limit in effect
+        # gib * 2**30 overflows a float near 1e299 GiB; anything above 2**40 GiB is beyond any machine
+        limit = max(1, int(gib * 2**30)) if gib < 2**40 else 2**70
     plant = Plant(A, B, C=np.eye(A.shape[0]) if C is None else C, sigma_v2=sigma_v2)
     return output_design(
         plant,
